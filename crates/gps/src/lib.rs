@@ -1,1 +1,448 @@
+//! # tubemem-gps — the closed form
+//!
+//! The algebraic equations of the generalized plane strain (GPS) and plane strain (PS) theories
+//! of translation-invariant pressurized membranes (reference paper, Secs. 3.6, 3.7 and 4), for
+//! **any** law of [`tubemem_material`]. Everything is dimensionless: R = 1, μH = 1, so
+//! ϖ = pR/(μH) (eq. 67), ρ = r/R, χ = c/(πR) (eq. 72), resultants are N/(μH).
+//!
+//! * [`inflate`] / [`inflation_curve`]: free inflation at a given hoop stretch λs.
+//!   GPS solves eq. (66), ϖλs = N_s and ϖλs/2 = N_z, for (ϖ, λz) by Newton (N_s = 2N_z is solved
+//!   for λz, then ϖ = N_s/λs). Eq. (68) is **not** assumed: it holds only for laws whose two
+//!   resultants share one factor (neo-Hookean, Anssari-Benam–Bucchi); tests check that it does
+//!   and that it fails for Mooney–Rivlin. PS is eq. (69)–(70): λz = 1, ϖ = N_s(λs, 1)/λs.
+//! * [`flatten`] / [`flattening_curve`]: squeezing between two parallel plates with a closed
+//!   amount of gas, GPS eqs. (76)–(77) with the erratum of eq. (74) (N_z = (ϖρ/2)(ρ+2χ)/(ρ+χ)),
+//!   PS eqs. (78)–(79), by continuation in ρ from the inflated state λs* with the previous point
+//!   (linearly extrapolated) as the initial guess (Sec. 4.3) and automatic step cut-back.
+//!   Unknowns (ϖ, λs, λz, χ): eq. (77)₁ gives χ = λs − ρ and eq. (76)₁ gives ϖ = N_s/ρ exactly,
+//!   so Newton runs on the remaining two, (λs, λz) (one, λs, for PS).
+//! * [`limits::limit_points`]: pressure maximum and minimum of the inflation curve and the
+//!   Maxwell equal-area pressure on the (v, ϖ) curve, v = πλs²λz.
+//! * [`linear`]: the small-strain slopes of Appendix F.
+//! * [`Scales`]: back to dimensional pressure, force per unit length and plate travel.
+//!
+//! ```
+//! use tubemem_gps::{inflate, flatten, Hypothesis};
+//! use tubemem_material::laws::AnssariBenamBucchi;
+//! let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+//! let s = inflate(&law, Hypothesis::Gps, 1.3).unwrap();
+//! assert!((s.n_s - 2.0 * s.n_z).abs() < 1e-12);      // eq. (66): N_z = N_s/2
+//! let f = flatten(&law, Hypothesis::Gps, 1.3, 1.0).unwrap();
+//! assert!((f.lambda_s - f.rho - f.chi).abs() < 1e-12); // eq. (77)₁
+//! ```
 
+mod error;
+pub mod limits;
+pub mod linear;
+mod newton;
+mod resultants;
+mod scales;
+
+use error::invalid;
+pub use error::GpsError;
+pub use scales::Scales;
+use serde::{Deserialize, Serialize};
+use tubemem_material::MembraneLaw;
+
+/// Which kinematic hypothesis closes the cross-section problem.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Hypothesis {
+    /// Generalized plane strain: a constant axial stretch λz set by the end-cap force.
+    Gps,
+    /// Plane strain (De Simone & Luongo): λz = 1.
+    Ps,
+}
+
+impl Hypothesis {
+    pub fn label(self) -> &'static str {
+        match self {
+            Hypothesis::Gps => "GPS",
+            Hypothesis::Ps => "PS",
+        }
+    }
+}
+
+/// A free-inflation state (dimensionless).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InflationState {
+    /// ϖ = pR/(μH)
+    pub w: f64,
+    pub lambda_s: f64,
+    pub lambda_z: f64,
+    /// N_s/(μH), hoop resultant
+    pub n_s: f64,
+    /// N_z/(μH), axial resultant (under PS: the reaction that keeps λz = 1)
+    pub n_z: f64,
+}
+
+/// A flattening state (dimensionless).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FlatteningState {
+    pub w: f64,
+    pub lambda_s: f64,
+    pub lambda_z: f64,
+    pub n_s: f64,
+    pub n_z: f64,
+    /// ρ = r/R, the half-gap between the plates
+    pub rho: f64,
+    /// χ = c/(πR), the reduced contact length
+    pub chi: f64,
+    /// reduced force ϖχ (eq. 80)
+    pub force: f64,
+    /// reduced displacement λs* − ρ (eq. 81)
+    pub displacement: f64,
+}
+
+const MAX_CUTS: usize = 30;
+
+fn at_ls(ls: f64) -> String {
+    format!("λs = {ls}")
+}
+
+/// Neo-Hookean/GPS axial stretch of eq. (68), used only as an initial guess for other laws.
+pub fn eq68_lambda_z(ls: f64) -> f64 {
+    0.5 * (ls * ls + (ls.powi(4) + 8.0 / (ls * ls)).sqrt()).sqrt()
+}
+
+fn inflation_solve(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    ls: f64,
+    lz_guess: f64,
+) -> Result<InflationState, GpsError> {
+    let material = |source| GpsError::Material {
+        stage: "free inflation",
+        at: at_ls(ls),
+        source,
+    };
+    let lz = match hyp {
+        Hypothesis::Ps => 1.0,
+        Hypothesis::Gps => {
+            let g = |lz: f64| {
+                let r = resultants::resultants(law, ls, lz)?;
+                Ok((r.ns - 2.0 * r.nz, r.jac[0][1] - 2.0 * r.jac[1][1]))
+            };
+            let scale = resultants::resultants(law, ls, lz_guess)
+                .map(|r| r.ns.abs() + 2.0 * r.nz.abs())
+                .unwrap_or(1.0);
+            newton::scalar(g, lz_guess, 1e-9 * (1.0 + scale)).map_err(|f| match f.material {
+                Some(e) => material(e),
+                None => GpsError::NoConvergence {
+                    stage: "free inflation (GPS, eq. 66)",
+                    at: at_ls(ls),
+                    residual: f.residual,
+                    iterations: f.iterations,
+                },
+            })?
+        }
+    };
+    let r = resultants::resultants(law, ls, lz).map_err(material)?;
+    Ok(InflationState {
+        w: r.ns / ls,
+        lambda_s: ls,
+        lambda_z: lz,
+        n_s: r.ns,
+        n_z: r.nz,
+    })
+}
+
+fn check_stretch(ls: f64) -> Result<(), GpsError> {
+    if ls.is_finite() && ls >= 1.0 {
+        Ok(())
+    } else {
+        Err(invalid(
+            "lambda_s",
+            ls,
+            "the hoop stretch of an inflated membrane must be finite and ≥ 1",
+        ))
+    }
+}
+
+/// Free inflation to hoop stretch `lambda_s` (≥ 1).
+pub fn inflate(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    lambda_s: f64,
+) -> Result<InflationState, GpsError> {
+    check_stretch(lambda_s)?;
+    inflation_solve(law, hyp, lambda_s, eq68_lambda_z(lambda_s))
+}
+
+/// `points` states equally spaced in λs from `from` to `to` (both ≥ 1), each solved from the
+/// previous one (Sec. 4.3).
+pub fn inflation_curve(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    from: f64,
+    to: f64,
+    points: usize,
+) -> Result<Vec<InflationState>, GpsError> {
+    check_stretch(from)?;
+    check_stretch(to)?;
+    if points < 2 {
+        return Err(invalid(
+            "points",
+            points as f64,
+            "a curve needs at least 2 points",
+        ));
+    }
+    let mut out: Vec<InflationState> = Vec::with_capacity(points);
+    for i in 0..points {
+        let ls = from + (to - from) * i as f64 / (points - 1) as f64;
+        let guess = match out.len() {
+            0 => eq68_lambda_z(ls),
+            1 => out[0].lambda_z,
+            n => 2.0 * out[n - 1].lambda_z - out[n - 2].lambda_z,
+        };
+        let s = inflation_solve(law, hyp, ls, guess)
+            .or_else(|_| inflation_solve(law, hyp, ls, eq68_lambda_z(ls)))?;
+        out.push(s);
+    }
+    Ok(out)
+}
+
+/// The flattening problem from a given inflated state.
+struct Flattening<'a> {
+    law: &'a dyn MembraneLaw,
+    hyp: Hypothesis,
+    initial: InflationState,
+    /// Boyle's law constant: ϖ* λs*² λz* (eq. 77₂; λz* = 1 under PS, eq. 79₂)
+    gas: f64,
+}
+
+impl<'a> Flattening<'a> {
+    fn new(
+        law: &'a dyn MembraneLaw,
+        hyp: Hypothesis,
+        initial_stretch: f64,
+    ) -> Result<Self, GpsError> {
+        check_stretch(initial_stretch)?;
+        if initial_stretch <= 1.0 {
+            return Err(invalid(
+                "initial_stretch",
+                initial_stretch,
+                "flattening needs an inflated tube (λs* > 1) holding gas",
+            ));
+        }
+        let initial = inflate(law, hyp, initial_stretch)?;
+        let gas = initial.w * initial.lambda_s.powi(2) * initial.lambda_z;
+        Ok(Self {
+            law,
+            hyp,
+            initial,
+            gas,
+        })
+    }
+
+    fn start(&self) -> FlatteningState {
+        let s = self.initial;
+        FlatteningState {
+            w: s.w,
+            lambda_s: s.lambda_s,
+            lambda_z: s.lambda_z,
+            n_s: s.n_s,
+            n_z: s.n_z,
+            rho: s.lambda_s,
+            chi: 0.0,
+            force: 0.0,
+            displacement: 0.0,
+        }
+    }
+
+    /// Solve at half-gap `rho` from the guess (λs, λz).
+    fn solve(&self, rho: f64, guess: [f64; 2]) -> Result<FlatteningState, GpsError> {
+        let at = format!("ρ = {rho} (λs* = {})", self.initial.lambda_s);
+        let law = self.law;
+        let m = self.gas;
+        let fail = |f: newton::Failure, stage: &'static str| match f.material {
+            Some(source) => GpsError::Material {
+                stage,
+                at: at.clone(),
+                source,
+            },
+            None => GpsError::NoConvergence {
+                stage,
+                at: at.clone(),
+                residual: f.residual,
+                iterations: f.iterations,
+            },
+        };
+        let (ls, lz) = match self.hyp {
+            Hypothesis::Gps => {
+                // F1 = N_s (2λs − ρ)/(2λs) − N_z        (eq. 76₂ with ϖρ = N_s, χ = λs − ρ)
+                // F2 = λz N_s (2λs − ρ)/M − 1           (eq. 77₂, M = ϖ*λs*²λz*)
+                let f = |x: [f64; 2]| {
+                    let [ls, lz] = x;
+                    let r = resultants::resultants(law, ls, lz)?;
+                    let q = 1.0 - rho / (2.0 * ls);
+                    let dq = rho / (2.0 * ls * ls);
+                    let t = 2.0 * ls - rho;
+                    let f1 = r.ns * q - r.nz;
+                    let f2 = lz * r.ns * t / m - 1.0;
+                    let j = [
+                        [
+                            r.jac[0][0] * q + r.ns * dq - r.jac[1][0],
+                            r.jac[0][1] * q - r.jac[1][1],
+                        ],
+                        [
+                            lz * (r.jac[0][0] * t + 2.0 * r.ns) / m,
+                            (r.ns * t + lz * r.jac[0][1] * t) / m,
+                        ],
+                    ];
+                    Ok((
+                        [f1 / self.initial.n_s, f2],
+                        [
+                            [j[0][0] / self.initial.n_s, j[0][1] / self.initial.n_s],
+                            j[1],
+                        ],
+                    ))
+                };
+                let x = newton::system2(f, guess, 1e-10)
+                    .map_err(|e| fail(e, "flattening (GPS, eqs. 76–77)"))?;
+                (x[0], x[1])
+            }
+            Hypothesis::Ps => {
+                // h = N_s(λs, 1) (2λs − ρ)/M − 1     (eqs. 78–79, M = ϖ*λs*²)
+                let h = |ls: f64| {
+                    let r = resultants::resultants(law, ls, 1.0)?;
+                    let t = 2.0 * ls - rho;
+                    Ok((r.ns * t / m - 1.0, (r.jac[0][0] * t + 2.0 * r.ns) / m))
+                };
+                let ls = newton::scalar(h, guess[0], 1e-10)
+                    .map_err(|e| fail(e, "flattening (PS, eqs. 78–79)"))?;
+                (ls, 1.0)
+            }
+        };
+        let r = resultants::resultants(law, ls, lz).map_err(|source| GpsError::Material {
+            stage: "flattening",
+            at: at.clone(),
+            source,
+        })?;
+        let chi = ls - rho;
+        if chi < -1e-10 {
+            return Err(GpsError::NoConvergence {
+                stage: "flattening (negative contact length)",
+                at,
+                residual: chi,
+                iterations: 0,
+            });
+        }
+        let w = r.ns / rho;
+        Ok(FlatteningState {
+            w,
+            lambda_s: ls,
+            lambda_z: lz,
+            n_s: r.ns,
+            n_z: r.nz,
+            rho,
+            chi,
+            force: w * chi,
+            displacement: self.initial.lambda_s - rho,
+        })
+    }
+
+    /// Continue from `prev` (with `prev2` for a linear predictor) to `rho`, cutting the step in
+    /// half whenever Newton fails.
+    fn continue_to(
+        &self,
+        prev: FlatteningState,
+        prev2: Option<FlatteningState>,
+        rho: f64,
+    ) -> Result<FlatteningState, GpsError> {
+        let predict = |a: &FlatteningState, b: Option<&FlatteningState>, rho: f64| match b {
+            Some(b) if (a.rho - b.rho).abs() > 0.0 => {
+                let t = (rho - a.rho) / (a.rho - b.rho);
+                [
+                    a.lambda_s + t * (a.lambda_s - b.lambda_s),
+                    a.lambda_z + t * (a.lambda_z - b.lambda_z),
+                ]
+            }
+            _ => [a.lambda_s, a.lambda_z],
+        };
+        let (mut cur, mut before) = (prev, prev2);
+        let mut step = rho - prev.rho;
+        let mut cuts = 0;
+        loop {
+            let target = if (rho - cur.rho).abs() <= step.abs() {
+                rho
+            } else {
+                cur.rho + step
+            };
+            let guess = predict(&cur, before.as_ref(), target);
+            match self
+                .solve(target, guess)
+                .or_else(|_| self.solve(target, [cur.lambda_s, cur.lambda_z]))
+            {
+                Ok(s) => {
+                    before = Some(cur);
+                    cur = s;
+                    if target == rho {
+                        return Ok(cur);
+                    }
+                }
+                Err(e) => {
+                    cuts += 1;
+                    if cuts > MAX_CUTS {
+                        return Err(e);
+                    }
+                    step *= 0.5;
+                }
+            }
+        }
+    }
+}
+
+fn check_rho(rho: f64, initial_stretch: f64) -> Result<(), GpsError> {
+    if rho.is_finite() && rho > 0.0 && rho < initial_stretch {
+        Ok(())
+    } else {
+        Err(invalid(
+            "rho",
+            rho,
+            "the half-gap ρ must satisfy 0 < ρ < λs* (the plates start at the inflated radius)",
+        ))
+    }
+}
+
+/// The state at half-gap `rho` after inflating to `initial_stretch` and closing the gas in.
+pub fn flatten(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    initial_stretch: f64,
+    rho: f64,
+) -> Result<FlatteningState, GpsError> {
+    let fl = Flattening::new(law, hyp, initial_stretch)?;
+    check_rho(rho, initial_stretch)?;
+    fl.continue_to(fl.start(), None, rho)
+}
+
+/// `points` states equally spaced in ρ from λs* (no contact) down to `rho_to`.
+pub fn flattening_curve(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    initial_stretch: f64,
+    rho_to: f64,
+    points: usize,
+) -> Result<Vec<FlatteningState>, GpsError> {
+    let fl = Flattening::new(law, hyp, initial_stretch)?;
+    check_rho(rho_to, initial_stretch)?;
+    if points < 2 {
+        return Err(invalid(
+            "points",
+            points as f64,
+            "a curve needs at least 2 points",
+        ));
+    }
+    let mut out = vec![fl.start()];
+    for i in 1..points {
+        let rho = initial_stretch + (rho_to - initial_stretch) * i as f64 / (points - 1) as f64;
+        let n = out.len();
+        let prev2 = if n >= 2 { Some(out[n - 2]) } else { None };
+        out.push(fl.continue_to(out[n - 1], prev2, rho)?);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,40 @@
+use thiserror::Error;
+use tubemem_material::MaterialError;
+
+/// Why a closed-form computation failed.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum GpsError {
+    /// An input outside its admissible range (λs < 1, ρ ≥ λs*, a point count < 2, …).
+    #[error("invalid input `{name}` = {value}: {requirement}")]
+    InvalidInput {
+        name: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    /// The material law rejected a state on the way (typically the locking limit).
+    #[error("{stage} at {at}: {source}")]
+    Material {
+        stage: &'static str,
+        at: String,
+        #[source]
+        source: MaterialError,
+    },
+    /// Newton did not converge, even after step cut-back.
+    #[error(
+        "{stage} did not converge at {at}: residual {residual:.3e} after {iterations} iterations"
+    )]
+    NoConvergence {
+        stage: &'static str,
+        at: String,
+        residual: f64,
+        iterations: usize,
+    },
+}
+
+pub(crate) fn invalid(name: &'static str, value: f64, requirement: &'static str) -> GpsError {
+    GpsError::InvalidInput {
+        name,
+        value,
+        requirement,
+    }
+}

@@ -1,0 +1,160 @@
+//! Small Newton solvers with backtracking. A trial point the law rejects (e.g. beyond locking)
+//! is treated like a step that increased the residual: the step is halved.
+
+use tubemem_material::MaterialError;
+
+pub(crate) struct Failure {
+    pub residual: f64,
+    pub iterations: usize,
+    /// The last material error met, if that is what stopped the iteration.
+    pub material: Option<MaterialError>,
+}
+
+const MAX_IT: usize = 60;
+const MAX_HALVINGS: usize = 40;
+
+/// Solve f(x) = 0 (f returns value and derivative), x > 0, from `x0`.
+/// Converged when the Newton step is below 1e-14 (1 + |x|) and |f| ≤ `ftol`.
+pub(crate) fn scalar(
+    f: impl Fn(f64) -> Result<(f64, f64), MaterialError>,
+    x0: f64,
+    ftol: f64,
+) -> Result<f64, Failure> {
+    let mut x = x0;
+    let (mut fx, mut dfx) = f(x).map_err(|e| Failure {
+        residual: f64::NAN,
+        iterations: 0,
+        material: Some(e),
+    })?;
+    let mut last_err = None;
+    for it in 1..=MAX_IT {
+        if fx == 0.0 {
+            return Ok(x);
+        }
+        if !dfx.is_finite() {
+            break;
+        }
+        let step = if dfx != 0.0 && dfx.is_finite() {
+            -fx / dfx
+        } else {
+            0.0
+        };
+        if step == 0.0 || !step.is_finite() {
+            break;
+        }
+        let mut t = 1.0;
+        let mut accepted = false;
+        for _ in 0..MAX_HALVINGS {
+            let xt = x + t * step;
+            if xt > 0.0 {
+                match f(xt) {
+                    Ok((ft, dft))
+                        if ft.is_finite()
+                            && (ft.abs() < fx.abs()
+                                || t * step.abs() < 1e-12 * (1.0 + x.abs())) =>
+                    {
+                        x = xt;
+                        fx = ft;
+                        dfx = dft;
+                        accepted = true;
+                        break;
+                    }
+                    Ok(_) => {}
+                    Err(e) => last_err = Some(e),
+                }
+            }
+            t *= 0.5;
+        }
+        if !accepted {
+            return Err(Failure {
+                residual: fx.abs(),
+                iterations: it,
+                material: last_err,
+            });
+        }
+        if (t * step).abs() <= 1e-14 * (1.0 + x.abs()) && fx.abs() <= ftol {
+            return Ok(x);
+        }
+    }
+    if fx.abs() <= ftol {
+        return Ok(x);
+    }
+    Err(Failure {
+        residual: fx.abs(),
+        iterations: MAX_IT,
+        material: last_err,
+    })
+}
+
+/// Solve F(x) = 0 in two unknowns (F returns value and Jacobian), both unknowns > 0.
+/// Merit |F|₂; converged when |F|₂ ≤ `ftol` and the step is below 1e-13 (1 + |x|).
+pub(crate) fn system2(
+    f: impl Fn([f64; 2]) -> Result<([f64; 2], [[f64; 2]; 2]), MaterialError>,
+    x0: [f64; 2],
+    ftol: f64,
+) -> Result<[f64; 2], Failure> {
+    let norm = |v: [f64; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
+    let mut x = x0;
+    let (mut fx, mut jx) = f(x).map_err(|e| Failure {
+        residual: f64::NAN,
+        iterations: 0,
+        material: Some(e),
+    })?;
+    let mut last_err = None;
+    for it in 1..=MAX_IT {
+        let det = jx[0][0] * jx[1][1] - jx[0][1] * jx[1][0];
+        if !(det.is_finite() && det != 0.0) {
+            return Err(Failure {
+                residual: norm(fx),
+                iterations: it,
+                material: last_err,
+            });
+        }
+        let step = [
+            -(jx[1][1] * fx[0] - jx[0][1] * fx[1]) / det,
+            -(-jx[1][0] * fx[0] + jx[0][0] * fx[1]) / det,
+        ];
+        let x_start = x;
+        let small = |t: f64| {
+            (t * step[0]).abs() <= 1e-13 * (1.0 + x_start[0].abs())
+                && (t * step[1]).abs() <= 1e-13 * (1.0 + x_start[1].abs())
+        };
+        let mut t = 1.0;
+        let mut accepted = false;
+        for _ in 0..MAX_HALVINGS {
+            let xt = [x[0] + t * step[0], x[1] + t * step[1]];
+            if xt[0] > 0.0 && xt[1] > 0.0 {
+                match f(xt) {
+                    Ok((ft, jt)) if norm(ft).is_finite() && (norm(ft) < norm(fx) || small(t)) => {
+                        x = xt;
+                        fx = ft;
+                        jx = jt;
+                        accepted = true;
+                        break;
+                    }
+                    Ok(_) => {}
+                    Err(e) => last_err = Some(e),
+                }
+            }
+            t *= 0.5;
+        }
+        if !accepted {
+            return Err(Failure {
+                residual: norm(fx),
+                iterations: it,
+                material: last_err,
+            });
+        }
+        if small(t) && norm(fx) <= ftol {
+            return Ok(x);
+        }
+    }
+    if norm(fx) <= ftol {
+        return Ok(x);
+    }
+    Err(Failure {
+        residual: norm(fx),
+        iterations: MAX_IT,
+        material: last_err,
+    })
+}
