@@ -136,7 +136,8 @@ fn gps_flattening_matches_nested_bisection_of_eqs_76_77() {
         let curve = flattening_curve(&law, Hypothesis::Gps, ls0, rhos[3], points).unwrap();
         for rho in rhos {
             // For a trial λs: λz from eq. (76)₂ (with ϖρ = N_s, χ = λs − ρ), bracketed in
-            // [0.9, 8] where the residual changes sign once (checked by `bisect`).
+            // [0.9, λz_lock) where λz_lock keeps I1 = λs² + λz² + (λsλz)⁻² below 3𝒩 (the
+            // residual changes sign once there; `bisect` checks the bracket).
             let lz_of = |ls: f64| {
                 bisect(
                     |lz| {
@@ -144,7 +145,7 @@ fn gps_flattening_matches_nested_bisection_of_eqs_76_77() {
                         0.5 * ns * (2.0 * ls - rho) / ls - nz
                     },
                     0.9,
-                    8.0,
+                    (3.0 * kn - ls * ls - 1.0).sqrt(), // (λsλz)⁻² < 1 here
                 )
             };
             let ls = bisect(
