@@ -1,1 +1,68 @@
-fn main() {}
+//! `tubemem`: the command-line front end.
+//!
+//! With no arguments it runs the main job: the closed-form GPS-versus-PS comparison for the
+//! paper's example (ABB law, 𝒩 = 30) and the figures, written to `tubemem-out/`.
+
+mod figures;
+mod gps_cmd;
+mod material_args;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "tubemem",
+    version,
+    about = "Verification suite for pressurized membrane tubes: closed-form generalized plane strain (GPS) and plane strain (PS)",
+    long_about = "Verification suite for pressurized membrane tubes.\n\nWith no subcommand, runs the main job: the closed-form GPS-versus-PS comparison of the paper's example (Anssari-Benam–Bucchi law, 𝒩 = 30) and the figures, written to ./tubemem-out."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Closed-form GPS / PS solutions (paper Secs. 3.6, 3.7, 4).
+    Gps {
+        #[command(subcommand)]
+        command: gps_cmd::GpsCommand,
+    },
+    /// Write PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure.
+    Figures {
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "tubemem-out/figures")]
+        out: PathBuf,
+        /// Kuhn segment number 𝒩 of the Anssari-Benam–Bucchi law.
+        #[arg(long, default_value_t = 30.0)]
+        kuhn: f64,
+    },
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        None => gps_cmd::default_job(&PathBuf::from("tubemem-out")),
+        Some(Command::Gps { command }) => gps_cmd::run(command),
+        Some(Command::Figures { out, kuhn }) => {
+            let written = figures::write_all(&out, kuhn)?;
+            for p in written {
+                println!("wrote {}", p.display());
+            }
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

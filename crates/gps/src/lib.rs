@@ -217,8 +217,7 @@ impl<'a> Flattening<'a> {
         hyp: Hypothesis,
         initial_stretch: f64,
     ) -> Result<Self, GpsError> {
-        check_stretch(initial_stretch)?;
-        if initial_stretch <= 1.0 {
+        if !(initial_stretch.is_finite() && initial_stretch > 1.0) {
             return Err(invalid(
                 "initial_stretch",
                 initial_stretch,

@@ -1,0 +1,434 @@
+//! End-to-end tests of the `tubemem` binary: the public flags and JSON keys of issue #2, the
+//! CSV curves, the figures, and bad input (non-zero exit, a clear message, never a panic).
+//! Reference values come from the paper's explicit formulas (eq. 68), not from the binary.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn tubemem(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .output()
+        .expect("the tubemem binary runs")
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = tubemem(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+fn num(v: &Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("key `{key}` missing or not a number in {v}"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tubemem-cli-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The failure contract: non-zero exit, an `error:` line naming the problem, no panic.
+fn assert_clean_failure(args: &[&str], needle: &str) {
+    let out = tubemem(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} should fail");
+    assert!(
+        !err.contains("panicked") && !err.contains("backtrace"),
+        "{args:?} panicked: {err}"
+    );
+    assert!(
+        err.contains(needle),
+        "{args:?}: expected `{needle}` in: {err}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "{args:?} printed a result despite failing"
+    );
+}
+
+#[test]
+fn inflate_json_has_the_public_keys_and_matches_eq68() {
+    let v = json(&[
+        "gps",
+        "inflate",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--hypothesis",
+        "gps",
+        "--stretch",
+        "1.3",
+        "--json",
+    ]);
+    for k in ["w", "lambda_s", "lambda_z", "n_s", "n_z"] {
+        num(&v, k);
+    }
+    let ls: f64 = 1.3;
+    let lz68 = 0.5 * (ls * ls + (ls.powi(4) + 8.0 / (ls * ls)).sqrt()).sqrt();
+    assert!((num(&v, "lambda_z") - lz68).abs() < 1e-12);
+    assert!(
+        (num(&v, "n_s") - 2.0 * num(&v, "n_z")).abs() < 1e-12,
+        "eq. 66: N_z = N_s/2"
+    );
+    assert!(
+        (num(&v, "w") * ls - num(&v, "n_s")).abs() < 1e-12,
+        "eq. 66: ϖλs = N_s"
+    );
+
+    let ps = json(&[
+        "gps",
+        "inflate",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--hypothesis",
+        "ps",
+        "--stretch",
+        "1.3",
+        "--json",
+    ]);
+    assert_eq!(num(&ps, "lambda_z"), 1.0);
+    let mr = json(&[
+        "gps",
+        "inflate",
+        "--material",
+        "mooney-rivlin",
+        "--alpha",
+        "0.1",
+        "--stretch",
+        "2",
+        "--json",
+    ]);
+    assert!(num(&mr, "w") > 0.0);
+    let nh = json(&[
+        "gps",
+        "inflate",
+        "--material",
+        "neo-hookean",
+        "--stretch",
+        "2",
+        "--json",
+    ]);
+    assert!((num(&nh, "lambda_z") - 0.5 * (4.0f64 + (16.0f64 + 2.0).sqrt()).sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn inflate_and_flatten_write_csv_curves() {
+    let d = tmp("curves");
+    let csv = d.join("inflation.csv");
+    let out = tubemem(&[
+        "gps",
+        "inflate",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--hypothesis",
+        "gps",
+        "--from",
+        "1",
+        "--to",
+        "7.5",
+        "--points",
+        "1000",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "w,lambda_s,lambda_z,n_s,n_z");
+    assert_eq!(lines.len(), 1001);
+    assert!(
+        lines[1000]
+            .split(',')
+            .nth(1)
+            .unwrap()
+            .parse::<f64>()
+            .unwrap()
+            == 7.5
+    );
+
+    let fcsv = d.join("flat.csv");
+    let out = tubemem(&[
+        "gps",
+        "flatten",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--initial-stretch",
+        "6.0",
+        "--to",
+        "3.0",
+        "--points",
+        "50",
+        "--csv",
+        fcsv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&fcsv).unwrap();
+    assert!(text.starts_with("w,lambda_s,lambda_z,n_s,n_z,rho,chi,force,displacement\n"));
+    assert_eq!(text.lines().count(), 51);
+}
+
+#[test]
+fn flatten_json_has_the_public_keys_and_satisfies_eq77() {
+    let v = json(&[
+        "gps",
+        "flatten",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--hypothesis",
+        "gps",
+        "--initial-stretch",
+        "6.0",
+        "--rho",
+        "4.5",
+        "--json",
+    ]);
+    for k in [
+        "w",
+        "lambda_s",
+        "lambda_z",
+        "n_s",
+        "n_z",
+        "rho",
+        "chi",
+        "force",
+        "displacement",
+    ] {
+        num(&v, k);
+    }
+    assert_eq!(num(&v, "rho"), 4.5);
+    assert!((num(&v, "lambda_s") - num(&v, "rho") - num(&v, "chi")).abs() < 1e-12);
+    assert!((num(&v, "displacement") - 1.5).abs() < 1e-15);
+    assert!((num(&v, "force") - num(&v, "w") * num(&v, "chi")).abs() < 1e-12);
+}
+
+#[test]
+fn limits_json_reports_max_min_and_maxwell() {
+    let v = json(&[
+        "gps",
+        "limits",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--json",
+    ]);
+    let obj = v.as_object().unwrap();
+    assert_eq!(obj.len(), 3, "exactly max, min, maxwell: {v}");
+    let mx = num(&v["max"], "lambda_s");
+    let mn = num(&v["min"], "lambda_s");
+    num(&v["max"], "lambda_z");
+    let pm = num(&v["maxwell"], "w");
+    assert!(
+        mx > 1.5 && mx < 1.7 && mn > mx,
+        "paper Fig. 5: maximum near λs ≈ 1.6"
+    );
+    assert!(pm > num(&v["min"], "w") && pm < num(&v["max"], "w"));
+    assert!(num(&v["maxwell"], "lambda_s_lower") < mx && num(&v["maxwell"], "lambda_s_upper") > mn);
+    let nh = json(&["gps", "limits", "--material", "neo-hookean", "--json"]);
+    assert!(nh["max"].is_object() && nh["min"].is_null() && nh["maxwell"].is_null());
+    let ps = json(&[
+        "gps",
+        "limits",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--hypothesis",
+        "ps",
+        "--json",
+    ]);
+    assert!(ps["max"].is_null() && ps["min"].is_null());
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    assert_clean_failure(
+        &["gps", "inflate", "--material", "rubber", "--stretch", "1.3"],
+        "rubber",
+    );
+    assert_clean_failure(
+        &["gps", "inflate", "--material", "abb", "--stretch", "1.3"],
+        "--kuhn",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "mooney-rivlin",
+            "--stretch",
+            "1.3",
+        ],
+        "--alpha",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "neo-hookean",
+            "--kuhn",
+            "3",
+            "--stretch",
+            "1.3",
+        ],
+        "--kuhn",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "1",
+            "--stretch",
+            "1.3",
+        ],
+        "kuhn",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "mooney-rivlin",
+            "--alpha",
+            "-1",
+            "--stretch",
+            "1.3",
+        ],
+        "alpha",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--stretch",
+            "0.9",
+        ],
+        "lambda_s",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--stretch",
+            "nan",
+        ],
+        "lambda_s",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "3",
+            "--stretch",
+            "3",
+        ],
+        "locking",
+    );
+    assert_clean_failure(
+        &["gps", "inflate", "--material", "abb", "--kuhn", "30"],
+        "--stretch",
+    );
+    let flat = [
+        "gps",
+        "flatten",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--initial-stretch",
+        "1.3",
+        "--rho",
+    ];
+    for bad in ["1.3", "2.0", "0", "-1"] {
+        let mut a = flat.to_vec();
+        a.push(bad);
+        assert_clean_failure(&a, "rho");
+    }
+    assert_clean_failure(
+        &[
+            "gps",
+            "flatten",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--initial-stretch",
+            "0.8",
+            "--rho",
+            "0.5",
+        ],
+        "initial_stretch",
+    );
+}
+
+#[test]
+fn figures_writes_pngs_and_csvs() {
+    let d = tmp("figures");
+    let out = tubemem(&["figures", "--out", d.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "fig5_pressure_stretch.png",
+        "fig6_force_displacement_ls1.3.png",
+        "fig7_force_displacement_ls6.0.png",
+        "fig_lambda_z.png",
+    ] {
+        let bytes = std::fs::read(d.join(f)).unwrap();
+        assert!(bytes.len() > 10_000 && bytes.starts_with(b"\x89PNG"), "{f}");
+    }
+    for f in [
+        "inflation_gps.csv",
+        "inflation_ps.csv",
+        "flattening_ls1.3_gps.csv",
+        "flattening_ls6.0_ps.csv",
+    ] {
+        assert!(
+            std::fs::read_to_string(d.join(f)).unwrap().lines().count() > 100,
+            "{f}"
+        );
+    }
+}
