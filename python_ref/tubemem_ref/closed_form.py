@@ -1,0 +1,120 @@
+"""The paper's closed form, written independently of the Rust crate `tubemem-gps`.
+
+Different formulations on purpose, so that agreement means something:
+
+* free inflation (GPS): eq. (66) solved for lambda_z by Brent's method on N_s - 2 N_z;
+* flattening (GPS): the full four-unknown system (76)-(77) in (w, lambda_s, lambda_z, chi)
+  solved by scipy.optimize.root (MINPACK hybrd), continued in rho from the inflated state;
+* limit points: zeros of dw/dlambda_s from a complex-step derivative of eq. (68) + eq. (66);
+* Maxwell pressure: equal areas on the (v, w) curve with scipy.integrate.quad.
+
+Only the Anssari-Benam--Bucchi law (eqs. 58-59, 62) is implemented here.
+"""
+
+import numpy as np
+from scipy import integrate, optimize
+
+
+def abb_n(ls, lz, kuhn):
+    """eq. (59)."""
+    p = ls**2 * lz**2
+    return ((1 - kuhn) * (1 + p * (ls**2 + lz**2 - 9 * kuhn))
+            / ((ls * lz) ** 3 * (1 - 3 * kuhn) * (1 + p * (ls**2 + lz**2 - 3 * kuhn))))
+
+
+def abb_resultants(ls, lz, kuhn):
+    """eq. (58): (N_s, N_z) / (mu H)."""
+    n = abb_n(ls, lz, kuhn)
+    return n * (ls**4 * lz**2 - 1), n * (ls**2 * lz**4 - 1)
+
+
+def lock_lambda_z(ls, kuhn):
+    """The lambda_z at which I1 = ls^2 + lz^2 + (ls lz)^-2 reaches 3 N (largest root)."""
+    f = lambda lz: ls**2 + lz**2 + 1 / (ls * lz) ** 2 - 3 * kuhn
+    return optimize.brentq(f, 1.0, np.sqrt(3 * kuhn), xtol=1e-15)
+
+
+def gps_inflation(ls, kuhn=30.0):
+    """(w, lambda_z) for free inflation under GPS, eq. (66)."""
+    if ls == 1.0:
+        return 0.0, 1.0
+    g = lambda lz: np.subtract(*np.multiply(abb_resultants(ls, lz, kuhn), (1.0, 2.0)))
+    lz = optimize.brentq(g, 0.5, lock_lambda_z(ls, kuhn) * (1 - 1e-12), xtol=1e-15, rtol=1e-15)
+    ns, _ = abb_resultants(ls, lz, kuhn)
+    return ns / ls, lz
+
+
+def ps_inflation(ls, kuhn=30.0):
+    """w for free inflation under PS, eq. (70)."""
+    k = kuhn
+    return ((1 - k) * (ls**4 - 1) * (1 + ls**2 * (ls**2 + 1 - 9 * k))
+            / (ls**4 * (1 - 3 * k) * (1 + ls**2 * (ls**2 + 1 - 3 * k))))
+
+
+def gps_flattening(ls0, rhos, kuhn=30.0):
+    """States along the GPS flattening, eqs. (76)-(77), for the decreasing half-gaps `rhos`.
+
+    Unknowns x = (w, ls, lz, chi); returns a list of dicts.
+    """
+    w0, lz0 = gps_inflation(ls0, kuhn)
+    gas = w0 * ls0**2 * lz0
+
+    def residual(x, rho):
+        w, ls, lz, chi = x
+        ns, nz = abb_resultants(ls, lz, kuhn)
+        return [w * rho - ns,
+                0.5 * w * rho * (rho + 2 * chi) / (rho + chi) - nz,
+                ls - rho - chi,
+                (lz * w * rho * (rho + 2 * chi) - gas) / gas]
+
+    x = np.array([w0, ls0, lz0, 0.0])
+    out, rho_prev = [], ls0
+    for rho in rhos:
+        # sub-steps of at most 0.01 ls0 keep hybrd inside its basin of attraction
+        n = max(1, int(np.ceil(abs(rho_prev - rho) / (0.01 * ls0))))
+        for r in np.linspace(rho_prev, rho, n + 1)[1:]:
+            sol = optimize.root(residual, x, args=(r,), method="hybr", tol=1e-14)
+            # hybrd reports "no further improvement" once at machine precision: judge by residual
+            if not sol.success and np.max(np.abs(residual(sol.x, r))) > 1e-11:
+                raise RuntimeError(f"hybrd failed at rho = {r}: {sol.message}")
+            x = sol.x
+        rho_prev = rho
+        w, ls, lz, chi = x
+        out.append(dict(rho=rho, w=w, lambda_s=ls, lambda_z=lz, chi=chi, force=w * chi))
+    return out
+
+
+def _w_eq68(ls, kuhn):
+    lz = 0.5 * np.sqrt(ls**2 + np.sqrt(ls**4 + 8 / ls**2))
+    ns, _ = abb_resultants(ls, lz, kuhn)
+    return ns / ls
+
+
+def gps_limit_points(kuhn=30.0):
+    """(ls_max, w_max), (ls_min, w_min) from the complex-step derivative of eq. (68)+(66)."""
+    h = 1e-30
+    dw = lambda ls: np.imag(_w_eq68(ls + 1j * h, kuhn)) / h
+    ls_max = optimize.brentq(dw, 1.2, 2.5, xtol=1e-14)
+    ls_min = optimize.brentq(dw, 3.0, 6.0, xtol=1e-14)
+    return (ls_max, _w_eq68(ls_max, kuhn)), (ls_min, _w_eq68(ls_min, kuhn))
+
+
+def gps_maxwell(kuhn=30.0):
+    """(w_M, ls_lower, ls_upper): equal areas on (v, w), v = pi ls^2 lz, by adaptive quadrature."""
+    (ls_max, w_max), (ls_min, w_min) = gps_limit_points(kuhn)
+    lz68 = lambda ls: 0.5 * np.sqrt(ls**2 + np.sqrt(ls**4 + 8 / ls**2))
+    v = lambda ls: np.pi * ls**2 * lz68(ls)
+    h = 1e-30
+    dv = lambda ls: np.imag(v(ls + 1j * h)) / h
+
+    def area(p):
+        l1 = optimize.brentq(lambda s: _w_eq68(s, kuhn) - p, 1.0 + 1e-12, ls_max, xtol=1e-15)
+        l3 = optimize.brentq(lambda s: _w_eq68(s, kuhn) - p, ls_min, 7.7, xtol=1e-15)
+        f = lambda s: (_w_eq68(s, kuhn) - p) * dv(s)
+        a = sum(integrate.quad(f, a, b, epsabs=1e-14, epsrel=1e-13, limit=200)[0]
+                for a, b in [(l1, ls_max), (ls_max, ls_min), (ls_min, l3)])
+        return a, l1, l3
+
+    p = optimize.brentq(lambda q: area(q)[0], w_min + 1e-9, w_max - 1e-9, xtol=1e-15, rtol=1e-14)
+    _, l1, l3 = area(p)
+    return p, l1, l3

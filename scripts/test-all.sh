@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Runs every tubemem test: formatting, clippy, the Rust workspace tests, and the Python reference
+# tests in a virtual environment that this script creates (./.venv) and fills from PyPI.
+# This is the README's test command, and .ci/run calls exactly this.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy (all targets, warnings are errors)"
+cargo clippy --workspace --all-targets -- -D warnings
+echo "== cargo test (workspace)"
+cargo test --workspace
+# The Python tests drive the release binary (the same one users run).
+cargo build --release -p tubemem-cli
+
+echo "== Python reference tests"
+PY=${PYTHON:-python3}
+if [ ! -x .venv/bin/python ]; then
+  "$PY" -m venv .venv
+fi
+.venv/bin/python -m pip install --quiet --upgrade pip
+.venv/bin/python -m pip install --quiet -r python_ref/requirements.txt
+.venv/bin/python -m pip install --quiet -e python_ref
+TUBEMEM_BIN="$PWD/target/release/tubemem" .venv/bin/python -m pytest python_ref/tests -q
