@@ -1,0 +1,344 @@
+//! # tubemem-mesh — quadrilateral membrane surfaces
+//!
+//! * [`tube::capped_tube`]: a cylinder of radius R and length L closed by two hemispherical caps,
+//!   quadrilaterals only. Each cap is the upper half of an equiangular cube-sphere (no pole, no
+//!   degenerate element), and its equator conforms node for node with the cylinder's end ring.
+//!   Symmetry reductions (half, quarter, eighth) keep the elements on one side of the planes
+//!   z = 0, x = 0, y = 0, which are mesh lines by construction.
+//! * [`tube::sphere`]: the full cube-sphere, for tests.
+//! * [`Mesh::check`]: degenerate, inverted (inconsistently oriented), non-manifold and open
+//!   meshes are rejected with an error that names the element or edge.
+//! * [`vtu`]: VTK XML unstructured-grid output (ParaView, meshio) and `.pvd` time series.
+//!
+//! Node numbering of a quad (counter-clockwise seen from outside, so that g1 × g2 points out):
+//!
+//! ```text
+//!  3 ───── 2        η
+//!  │       │        ↑
+//!  │       │        └─→ ξ
+//!  0 ───── 1
+//! ```
+
+pub mod tube;
+pub mod vtu;
+
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use thiserror::Error;
+
+/// A mesh error, naming the element, edge or parameter concerned.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MeshError {
+    #[error("invalid mesh parameter `{name}` = {value}: {requirement}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    #[error("element {element} refers to node {node}, but the mesh has {nodes} nodes")]
+    NodeOutOfRange {
+        element: usize,
+        node: usize,
+        nodes: usize,
+    },
+    #[error("element {element} is degenerate: {reason}")]
+    Degenerate { element: usize, reason: String },
+    #[error("element {element} is inverted: its orientation disagrees with its neighbour {neighbour} across edge ({a}, {b})")]
+    Inverted {
+        element: usize,
+        neighbour: usize,
+        a: usize,
+        b: usize,
+    },
+    #[error("edge ({a}, {b}) is shared by {count} elements (non-manifold surface)")]
+    NonManifold { a: usize, b: usize, count: usize },
+    #[error(
+        "the surface is open at edge ({a}, {b}) (element {element}) but must be closed{where_}"
+    )]
+    Open {
+        a: usize,
+        b: usize,
+        element: usize,
+        where_: String,
+    },
+    #[error(
+        "the enclosed volume is {volume} ≤ 0: the element normals point inward (inverted mesh)"
+    )]
+    InwardNormals { volume: f64 },
+    #[error("cannot write {path}: {reason}")]
+    Io { path: String, reason: String },
+}
+
+/// Which symmetry planes bound the mesh (open edges are allowed only on these planes, and the
+/// matching displacement component is fixed there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Symmetry {
+    /// the whole surface
+    #[default]
+    None,
+    /// z ≥ 0 (plane z = 0)
+    Half,
+    /// z ≥ 0, y ≥ 0 (planes z = 0, y = 0)
+    Quarter,
+    /// z ≥ 0, y ≥ 0, x ≥ 0 (planes z = 0, y = 0, x = 0)
+    Eighth,
+}
+
+impl Symmetry {
+    /// The coordinate axes (0 = x, 1 = y, 2 = z) whose zero planes are symmetry planes.
+    pub fn planes(self) -> &'static [usize] {
+        match self {
+            Symmetry::None => &[],
+            Symmetry::Half => &[2],
+            Symmetry::Quarter => &[2, 1],
+            Symmetry::Eighth => &[2, 1, 0],
+        }
+    }
+    /// How many copies of the model make the whole tube.
+    pub fn multiplicity(self) -> f64 {
+        match self {
+            Symmetry::None => 1.0,
+            Symmetry::Half => 2.0,
+            Symmetry::Quarter => 4.0,
+            Symmetry::Eighth => 8.0,
+        }
+    }
+}
+
+/// A surface mesh of bilinear quadrilaterals.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    pub nodes: Vec<[f64; 3]>,
+    pub quads: Vec<[usize; 4]>,
+    pub symmetry: Symmetry,
+}
+
+/// Distance below which a node counts as lying on a symmetry plane, relative to the mesh size.
+const PLANE_TOL: f64 = 1e-9;
+
+impl Mesh {
+    /// A characteristic size: the largest absolute coordinate.
+    pub fn scale(&self) -> f64 {
+        self.nodes
+            .iter()
+            .flat_map(|p| p.iter())
+            .fold(0.0_f64, |m, v| m.max(v.abs()))
+            .max(1e-300)
+    }
+
+    /// Nodes lying on the symmetry plane `axis` = 0.
+    pub fn on_plane(&self, axis: usize) -> Vec<bool> {
+        let tol = PLANE_TOL * self.scale();
+        self.nodes.iter().map(|p| p[axis].abs() <= tol).collect()
+    }
+
+    /// The enclosed volume, V = (1/3) Σ ∫ x·(g1 × g2) dξdη (exact for bilinear quads with 2×2
+    /// Gauss). For a symmetry-reduced mesh this is the volume of the reduced part: the missing
+    /// closing faces lie on planes through the origin, where x·n = 0.
+    pub fn volume(&self) -> f64 {
+        self.quads
+            .iter()
+            .map(|q| {
+                let x = q.map(|i| self.nodes[i]);
+                quad_volume(&x)
+            })
+            .sum()
+    }
+
+    /// Check connectivity, shape and orientation. A symmetry-reduced mesh may be open only along
+    /// its symmetry planes.
+    pub fn check(&self) -> Result<(), MeshError> {
+        let n = self.nodes.len();
+        for (e, q) in self.quads.iter().enumerate() {
+            for &i in q {
+                if i >= n {
+                    return Err(MeshError::NodeOutOfRange {
+                        element: e,
+                        node: i,
+                        nodes: n,
+                    });
+                }
+            }
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    if q[a] == q[b] {
+                        return Err(MeshError::Degenerate {
+                            element: e,
+                            reason: format!("node {} appears twice", q[a]),
+                        });
+                    }
+                }
+            }
+            let x = q.map(|i| self.nodes[i]);
+            let area = quad_area(&x);
+            let diag = dist(&x[0], &x[2]).max(dist(&x[1], &x[3]));
+            if !(area > 1e-12 * diag * diag) {
+                return Err(MeshError::Degenerate {
+                    element: e,
+                    reason: format!("area {area:e} is zero for diagonal {diag:e}"),
+                });
+            }
+            // The Jacobian g1 × g2 must keep the direction of the centre normal at every corner
+            // (a collapsed edge gives zero there, a bow-tie a reversed one).
+            let (_, c1, c2) = tangents(&x, 0.0, 0.0);
+            let n0 = cross(c1, c2);
+            for (k, (xi, eta)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .into_iter()
+                .enumerate()
+            {
+                let (_, g1, g2) = tangents(&x, xi, eta);
+                if !(dot(cross(g1, g2), n0) > 1e-8 * dot(n0, n0)) {
+                    return Err(MeshError::Degenerate {
+                        element: e,
+                        reason: format!("the Jacobian vanishes or reverses at corner {k} (collapsed edge or bow-tie)"),
+                    });
+                }
+            }
+        }
+        // Directed edges: in a consistently oriented manifold, every interior edge appears once
+        // in each direction.
+        let mut edges: HashMap<(usize, usize), Vec<(usize, bool)>> = HashMap::new();
+        for (e, q) in self.quads.iter().enumerate() {
+            for k in 0..4 {
+                let (a, b) = (q[k], q[(k + 1) % 4]);
+                let key = (a.min(b), a.max(b));
+                edges.entry(key).or_default().push((e, a < b));
+            }
+        }
+        let on: Vec<Vec<bool>> = (0..3).map(|ax| self.on_plane(ax)).collect();
+        let mut keys: Vec<_> = edges.keys().copied().collect();
+        keys.sort_unstable();
+        for key in keys {
+            let users = &edges[&key];
+            match users.len() {
+                1 => {
+                    let on_sym = self
+                        .symmetry
+                        .planes()
+                        .iter()
+                        .any(|&ax| on[ax][key.0] && on[ax][key.1]);
+                    if !on_sym {
+                        return Err(MeshError::Open {
+                            a: key.0,
+                            b: key.1,
+                            element: users[0].0,
+                            where_: if self.symmetry == Symmetry::None {
+                                String::new()
+                            } else {
+                                format!(
+                                    " (it is not on a symmetry plane of the {:?} model)",
+                                    self.symmetry
+                                )
+                            },
+                        });
+                    }
+                }
+                2 => {
+                    if users[0].1 == users[1].1 {
+                        return Err(MeshError::Inverted {
+                            element: users[1].0.max(users[0].0),
+                            neighbour: users[1].0.min(users[0].0),
+                            a: key.0,
+                            b: key.1,
+                        });
+                    }
+                }
+                c => {
+                    return Err(MeshError::NonManifold {
+                        a: key.0,
+                        b: key.1,
+                        count: c,
+                    })
+                }
+            }
+        }
+        let v = self.volume();
+        if !(v > 0.0) {
+            return Err(MeshError::InwardNormals { volume: v });
+        }
+        Ok(())
+    }
+}
+
+fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// 2×2 Gauss points on [−1, 1]².
+pub const GAUSS2: [(f64, f64); 4] = {
+    const G: f64 = 0.577_350_269_189_625_8;
+    [(-G, -G), (G, -G), (G, G), (-G, G)]
+};
+
+/// Bilinear shape functions and their (ξ, η) derivatives.
+pub fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
+    let n = [
+        0.25 * (1.0 - xi) * (1.0 - eta),
+        0.25 * (1.0 + xi) * (1.0 - eta),
+        0.25 * (1.0 + xi) * (1.0 + eta),
+        0.25 * (1.0 - xi) * (1.0 + eta),
+    ];
+    let d = [
+        [-0.25 * (1.0 - eta), -0.25 * (1.0 - xi)],
+        [0.25 * (1.0 - eta), -0.25 * (1.0 + xi)],
+        [0.25 * (1.0 + eta), 0.25 * (1.0 + xi)],
+        [-0.25 * (1.0 + eta), 0.25 * (1.0 - xi)],
+    ];
+    (n, d)
+}
+
+/// Tangent vectors g1, g2 and position at (ξ, η).
+pub fn tangents(x: &[[f64; 3]; 4], xi: f64, eta: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
+    let (n, d) = shape(xi, eta);
+    let mut p = [0.0; 3];
+    let mut g1 = [0.0; 3];
+    let mut g2 = [0.0; 3];
+    for a in 0..4 {
+        for k in 0..3 {
+            p[k] += n[a] * x[a][k];
+            g1[k] += d[a][0] * x[a][k];
+            g2[k] += d[a][1] * x[a][k];
+        }
+    }
+    (p, g1, g2)
+}
+
+/// (1/3) ∫ x·(g1 × g2) dξdη over one quad (exact with 2×2 Gauss).
+pub fn quad_volume(x: &[[f64; 3]; 4]) -> f64 {
+    GAUSS2
+        .iter()
+        .map(|&(xi, eta)| {
+            let (p, g1, g2) = tangents(x, xi, eta);
+            dot(p, cross(g1, g2)) / 3.0
+        })
+        .sum()
+}
+
+/// Area ∫ |g1 × g2| dξdη (2×2 Gauss).
+pub fn quad_area(x: &[[f64; 3]; 4]) -> f64 {
+    GAUSS2
+        .iter()
+        .map(|&(xi, eta)| {
+            let (_, g1, g2) = tangents(x, xi, eta);
+            dot(cross(g1, g2), cross(g1, g2)).sqrt()
+        })
+        .sum()
+}
+
+#[cfg(test)]
+mod tests;

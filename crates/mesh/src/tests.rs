@@ -1,0 +1,213 @@
+//! Mesh tests. Sources of truth: exact sphere/cylinder geometry, Euler's formula (V − E + F = 2
+//! for a closed genus-0 surface), and the exact volumes πR²L + 4πR³/3 and 4πR³/3, to which the
+//! polyhedral volume converges at second order in the element size (chordal error O(h²)).
+
+use super::*;
+use crate::tube::{capped_tube, sphere};
+use std::collections::HashSet;
+use std::f64::consts::PI;
+
+fn euler(mesh: &Mesh) -> i64 {
+    let mut edges = HashSet::new();
+    for q in &mesh.quads {
+        for k in 0..4 {
+            let (a, b) = (q[k], q[(k + 1) % 4]);
+            edges.insert((a.min(b), a.max(b)));
+        }
+    }
+    mesh.nodes.len() as i64 - edges.len() as i64 + mesh.quads.len() as i64
+}
+
+#[test]
+fn capped_tube_works() {
+    for (around, along) in [(8, 2), (16, 10), (24, 40)] {
+        let (r, l) = (1.0, 20.0);
+        let mesh = capped_tube(r, l, around, along, Symmetry::None).unwrap();
+        let m = around / 4;
+        assert_eq!(mesh.quads.len(), around * along + 2 * 3 * m * m);
+        assert_eq!(
+            mesh.nodes.len(),
+            around * (along + 1) + 2 * (3 * m * m - 2 * m + 1)
+        );
+        assert_eq!(euler(&mesh), 2, "closed genus-0 surface");
+        for p in &mesh.nodes {
+            let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+            if p[2].abs() <= 0.5 * l {
+                assert!((rho - r).abs() < 1e-14, "cylinder node off radius: {p:?}");
+            } else {
+                let c = 0.5 * l * p[2].signum();
+                let d = (rho * rho + (p[2] - c).powi(2)).sqrt();
+                assert!((d - r).abs() < 1e-14, "cap node off the sphere: {p:?}");
+            }
+        }
+    }
+}
+
+/// Observed order of convergence of the enclosed volume: log2(e(h)/e(h/2)) ≈ 2.
+#[test]
+fn enclosed_volume_converges_at_second_order() {
+    let (r, l) = (1.0, 4.0);
+    let exact_tube = PI * r * r * l + 4.0 / 3.0 * PI * r.powi(3);
+    let err = |k: usize| {
+        (capped_tube(r, l, 8 * k, 2 * k, Symmetry::None)
+            .unwrap()
+            .volume()
+            - exact_tube)
+            .abs()
+    };
+    let (e1, e2, e3) = (err(2), err(4), err(8));
+    let (o1, o2) = ((e1 / e2).log2(), (e2 / e3).log2());
+    assert!(
+        (o1 - 2.0).abs() < 0.15 && (o2 - 2.0).abs() < 0.1,
+        "orders {o1}, {o2}"
+    );
+    let exact_sphere = 4.0 / 3.0 * PI;
+    let es = |m: usize| (sphere(1.0, m, Symmetry::None).unwrap().volume() - exact_sphere).abs();
+    let (s1, s2, s3) = (es(4), es(8), es(16));
+    let (p1, p2) = ((s1 / s2).log2(), (s2 / s3).log2());
+    assert!(
+        (p1 - 2.0).abs() < 0.15 && (p2 - 2.0).abs() < 0.1,
+        "orders {p1}, {p2}"
+    );
+    // Inscribed polyhedron: the discrete volume is below the exact one.
+    assert!(sphere(1.0, 8, Symmetry::None).unwrap().volume() < exact_sphere);
+}
+
+#[test]
+fn symmetry_reductions_work() {
+    let full = capped_tube(1.0, 6.0, 16, 12, Symmetry::None).unwrap();
+    for sym in [Symmetry::Half, Symmetry::Quarter, Symmetry::Eighth] {
+        let part = capped_tube(1.0, 6.0, 16, 12, sym).unwrap();
+        assert_eq!(
+            part.quads.len() as f64 * sym.multiplicity(),
+            full.quads.len() as f64
+        );
+        // x·n = 0 on the cut planes through the origin: the reduced volume is exact.
+        assert!((part.volume() * sym.multiplicity() - full.volume()).abs() < 1e-12 * full.volume());
+        for &ax in sym.planes() {
+            assert!(part.nodes.iter().all(|p| p[ax] >= -1e-12));
+            assert!(part.on_plane(ax).iter().any(|&b| b));
+        }
+    }
+    let s8 = sphere(1.0, 4, Symmetry::Eighth).unwrap();
+    assert_eq!(s8.quads.len(), 12);
+}
+
+#[test]
+fn mesh_check_rejects_bad_meshes() {
+    let good = capped_tube(1.0, 4.0, 8, 4, Symmetry::None).unwrap();
+    let mut flipped = good.clone();
+    flipped.quads[5] = [
+        flipped.quads[5][0],
+        flipped.quads[5][3],
+        flipped.quads[5][2],
+        flipped.quads[5][1],
+    ];
+    assert!(
+        matches!(flipped.check(), Err(MeshError::Inverted { .. })),
+        "{:?}",
+        flipped.check()
+    );
+    let mut open = good.clone();
+    open.quads.remove(3);
+    assert!(matches!(open.check(), Err(MeshError::Open { .. })));
+    let mut degen = good.clone();
+    degen.quads[0][1] = degen.quads[0][0];
+    assert!(matches!(
+        degen.check(),
+        Err(MeshError::Degenerate { element: 0, .. })
+    ));
+    let mut range = good.clone();
+    range.quads[2][2] = 10_000;
+    assert!(matches!(
+        range.check(),
+        Err(MeshError::NodeOutOfRange { element: 2, .. })
+    ));
+    let mut nonmanifold = good.clone();
+    nonmanifold.quads.push(good.quads[0]);
+    assert!(matches!(
+        nonmanifold.check(),
+        Err(MeshError::NonManifold { .. }) | Err(MeshError::Inverted { .. })
+    ));
+    let mut inward = good.clone();
+    for q in &mut inward.quads {
+        *q = [q[0], q[3], q[2], q[1]];
+    }
+    assert!(matches!(
+        inward.check(),
+        Err(MeshError::InwardNormals { .. })
+    ));
+    let mut collapsed = good;
+    let q = collapsed.quads[7];
+    collapsed.nodes[q[1]] = collapsed.nodes[q[0]];
+    assert!(collapsed.check().is_err());
+}
+
+#[test]
+fn generators_reject_bad_parameters() {
+    assert!(matches!(
+        capped_tube(1.0, 4.0, 12, 4, Symmetry::None),
+        Err(MeshError::InvalidParameter { name: "around", .. })
+    ));
+    assert!(matches!(
+        capped_tube(1.0, 4.0, 8, 3, Symmetry::None),
+        Err(MeshError::InvalidParameter { name: "along", .. })
+    ));
+    assert!(matches!(
+        capped_tube(0.0, 4.0, 8, 4, Symmetry::None),
+        Err(MeshError::InvalidParameter { name: "radius", .. })
+    ));
+    assert!(matches!(
+        capped_tube(1.0, f64::NAN, 8, 4, Symmetry::None),
+        Err(MeshError::InvalidParameter { name: "length", .. })
+    ));
+    assert!(sphere(1.0, 3, Symmetry::None).is_err());
+}
+
+#[test]
+fn vtu_writer_works_and_rejects_non_finite_fields() {
+    let mesh = capped_tube(1.0, 4.0, 8, 4, Symmetry::Eighth).unwrap();
+    let dir = std::env::temp_dir().join(format!("tubemem-vtu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let disp = vec![0.5; 3 * mesh.nodes.len()];
+    let flag = vec![1.0; mesh.quads.len()];
+    let path = dir.join("t.vtu");
+    vtu::write_vtu(
+        &path,
+        &mesh.nodes,
+        &mesh.quads,
+        &[vtu::Field {
+            name: "displacement",
+            components: 3,
+            values: &disp,
+        }],
+        &[vtu::Field {
+            name: "wrinkled",
+            components: 1,
+            values: &flag,
+        }],
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains(&format!("NumberOfPoints=\"{}\"", mesh.nodes.len())));
+    assert!(text.contains("Name=\"displacement\" NumberOfComponents=\"3\""));
+    assert_eq!(
+        text.lines().filter(|l| *l == "          9").count(),
+        mesh.quads.len()
+    );
+    vtu::write_pvd(&dir.join("t.pvd"), &[(0.0, "t.vtu".into())]).unwrap();
+    let mut bad = disp.clone();
+    bad[4] = f64::NAN;
+    let e = vtu::write_vtu(
+        &path,
+        &mesh.nodes,
+        &mesh.quads,
+        &[vtu::Field {
+            name: "displacement",
+            components: 3,
+            values: &bad,
+        }],
+        &[],
+    );
+    assert!(e.unwrap_err().to_string().contains("non-finite"));
+}

@@ -1,0 +1,275 @@
+//! Capped-tube and sphere generators.
+//!
+//! The caps are halves of an *equiangular cube-sphere*: the cube [−1, 1]³ carries an m × m grid
+//! on each face, with lattice coordinate T(k) = tan(π/4 · (2k/m − 1)) (exactly −1, 0, 1 at
+//! k = 0, m/2, m), and each lattice point c is projected to the sphere as R c/|c|. The equator of
+//! a half cube-sphere has 4m nodes at uniform angles 2π/(4m), which are the nodes of the
+//! cylinder's end rings: the mesh conforms at the cap–cylinder junction by construction, and
+//! nodes are shared through their integer lattice keys (no tolerance-based merging).
+//!
+//! Elements: `around` = 4m around the cylinder (a multiple of 8, so that x = 0 and y = 0 are
+//! mesh lines), `along` along it (even, so that z = 0 is a mesh line), 3m² per cap.
+
+use crate::{cross, dot, sub, tangents, Mesh, MeshError, Symmetry};
+use std::collections::HashMap;
+use std::f64::consts::FRAC_PI_4;
+
+fn lattice(k: usize, m: usize) -> f64 {
+    if k == 0 {
+        -1.0
+    } else if k == m {
+        1.0
+    } else if 2 * k == m {
+        0.0
+    } else {
+        (FRAC_PI_4 * (2.0 * k as f64 / m as f64 - 1.0)).tan()
+    }
+}
+
+fn unit(c: [f64; 3]) -> [f64; 3] {
+    let n = dot(c, c).sqrt();
+    [c[0] / n, c[1] / n, c[2] / n]
+}
+
+/// The lattice points and quads of the cube surface with k ≥ `k_min` (0: whole cube,
+/// m/2: upper half).
+fn cube_surface(m: usize, k_min: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
+    let mut points = vec![];
+    for i in 0..=m {
+        for j in 0..=m {
+            for k in k_min..=m {
+                if i == 0 || i == m || j == 0 || j == m || k == 0 || k == m {
+                    points.push([i, j, k]);
+                }
+            }
+        }
+    }
+    let mut quads = vec![];
+    // Faces k = m and (whole cube only) k = 0: cells in (i, j).
+    let mut kfaces = vec![m];
+    if k_min == 0 {
+        kfaces.push(0);
+    }
+    for &k in &kfaces {
+        for i in 0..m {
+            for j in 0..m {
+                quads.push([[i, j, k], [i + 1, j, k], [i + 1, j + 1, k], [i, j + 1, k]]);
+            }
+        }
+    }
+    for i in [0, m] {
+        for j in 0..m {
+            for k in k_min..m {
+                quads.push([[i, j, k], [i, j + 1, k], [i, j + 1, k + 1], [i, j, k + 1]]);
+            }
+        }
+    }
+    for j in [0, m] {
+        for i in 0..m {
+            for k in k_min..m {
+                quads.push([[i, j, k], [i + 1, j, k], [i + 1, j, k + 1], [i, j, k + 1]]);
+            }
+        }
+    }
+    (points, quads)
+}
+
+/// Orient every quad so that g1 × g2 at its centre points away from `center(centroid)`.
+fn orient(nodes: &[[f64; 3]], quads: &mut [[usize; 4]], center: impl Fn([f64; 3]) -> [f64; 3]) {
+    for q in quads.iter_mut() {
+        let x = q.map(|i| nodes[i]);
+        let (p, g1, g2) = tangents(&x, 0.0, 0.0);
+        if dot(cross(g1, g2), sub(p, center(p))) < 0.0 {
+            *q = [q[0], q[3], q[2], q[1]];
+        }
+    }
+}
+
+/// The perimeter of the square cross-section of the cube at mid-height, counter-clockwise from
+/// (i, j) = (m, m/2), i.e. from angle 0: 4m lattice (i, j) pairs at increasing angle.
+fn perimeter(m: usize) -> Vec<(usize, usize)> {
+    let (mut i, mut j) = (m, m / 2);
+    let mut out = Vec::with_capacity(4 * m);
+    let mut step = |di: i64, dj: i64, count: usize, i: &mut usize, j: &mut usize| {
+        for _ in 0..count {
+            out.push((*i, *j));
+            *i = (*i as i64 + di) as usize;
+            *j = (*j as i64 + dj) as usize;
+        }
+    };
+    step(0, 1, m / 2, &mut i, &mut j);
+    step(-1, 0, m, &mut i, &mut j);
+    step(0, -1, m, &mut i, &mut j);
+    step(1, 0, m, &mut i, &mut j);
+    step(0, 1, m / 2, &mut i, &mut j);
+    out
+}
+
+fn check_positive(name: &'static str, v: f64) -> Result<(), MeshError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(MeshError::InvalidParameter {
+            name,
+            value: v,
+            requirement: "must be finite and > 0",
+        })
+    }
+}
+
+/// A capped tube: cylinder radius `radius`, cylinder length `length` (along z, centred at the
+/// origin), hemispherical caps, `around` elements around (multiple of 8, ≥ 8) and `along`
+/// elements along the cylinder (even, ≥ 2), reduced by `symmetry`.
+pub fn capped_tube(
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
+    check_positive("radius", radius)?;
+    check_positive("length", length)?;
+    if around < 8 || around % 8 != 0 {
+        return Err(MeshError::InvalidParameter {
+            name: "around",
+            value: around as f64,
+            requirement: "elements around must be a multiple of 8 (≥ 8), so that the caps are half cube-spheres and x = 0, y = 0 are mesh lines",
+        });
+    }
+    if along < 2 || along % 2 != 0 {
+        return Err(MeshError::InvalidParameter {
+            name: "along",
+            value: along as f64,
+            requirement:
+                "elements along must be even (≥ 2), so that the mid-span z = 0 is a mesh line",
+        });
+    }
+    let m = around / 4;
+    let per = perimeter(m);
+    let ring_dir: Vec<[f64; 3]> = per
+        .iter()
+        .map(|&(i, j)| unit([lattice(i, m), lattice(j, m), 0.0]))
+        .collect();
+    let np = per.len();
+    let mut nodes = Vec::new();
+    for l in 0..=along {
+        let z = -0.5 * length + length * l as f64 / along as f64;
+        let z = if 2 * l == along { 0.0 } else { z };
+        for d in &ring_dir {
+            nodes.push([radius * d[0], radius * d[1], z]);
+        }
+    }
+    let mut quads = Vec::new();
+    for l in 0..along {
+        for p in 0..np {
+            let q = (p + 1) % np;
+            quads.push([l * np + p, l * np + q, (l + 1) * np + q, (l + 1) * np + p]);
+        }
+    }
+    let ring_of: HashMap<(usize, usize), usize> =
+        per.iter().enumerate().map(|(p, &ij)| (ij, p)).collect();
+    let (points, cells) = cube_surface(m, m / 2);
+    for (sign, ring) in [(1.0, along), (-1.0, 0)] {
+        let mut id: HashMap<[usize; 3], usize> = HashMap::new();
+        for pt in &points {
+            if 2 * pt[2] == m {
+                id.insert(*pt, ring * np + ring_of[&(pt[0], pt[1])]);
+            } else {
+                let d = unit([lattice(pt[0], m), lattice(pt[1], m), lattice(pt[2], m)]);
+                id.insert(*pt, nodes.len());
+                nodes.push([
+                    radius * d[0],
+                    radius * d[1],
+                    sign * (0.5 * length + radius * d[2]),
+                ]);
+            }
+        }
+        for c in &cells {
+            quads.push(c.map(|pt| id[&pt]));
+        }
+    }
+    let half = 0.5 * length;
+    orient(&nodes, &mut quads, |p| [0.0, 0.0, p[2].clamp(-half, half)]);
+    let mesh = reduce(
+        Mesh {
+            nodes,
+            quads,
+            symmetry: Symmetry::None,
+        },
+        symmetry,
+    );
+    mesh.check()?;
+    Ok(mesh)
+}
+
+/// A sphere of radius `radius` centred at the origin: the equiangular cube-sphere with
+/// `m` × `m` elements per cube face (m even, ≥ 2), 6m² elements in all.
+pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshError> {
+    check_positive("radius", radius)?;
+    if m < 2 || m % 2 != 0 {
+        return Err(MeshError::InvalidParameter {
+            name: "m",
+            value: m as f64,
+            requirement: "elements per cube-face edge must be even (≥ 2)",
+        });
+    }
+    let (points, cells) = cube_surface(m, 0);
+    let mut id = HashMap::new();
+    let mut nodes = vec![];
+    for pt in &points {
+        let d = unit([lattice(pt[0], m), lattice(pt[1], m), lattice(pt[2], m)]);
+        id.insert(*pt, nodes.len());
+        nodes.push([radius * d[0], radius * d[1], radius * d[2]]);
+    }
+    let mut quads: Vec<[usize; 4]> = cells.iter().map(|c| c.map(|pt| id[&pt])).collect();
+    orient(&nodes, &mut quads, |_| [0.0; 3]);
+    let mesh = reduce(
+        Mesh {
+            nodes,
+            quads,
+            symmetry: Symmetry::None,
+        },
+        symmetry,
+    );
+    mesh.check()?;
+    Ok(mesh)
+}
+
+/// Keep the elements whose centroid lies on the positive side of each symmetry plane and
+/// renumber the nodes (in their original order, so numbering is deterministic).
+pub fn reduce(mesh: Mesh, symmetry: Symmetry) -> Mesh {
+    if symmetry == Symmetry::None {
+        return mesh;
+    }
+    let keep: Vec<[usize; 4]> = mesh
+        .quads
+        .iter()
+        .filter(|q| {
+            let c = q.iter().fold([0.0; 3], |s, &i| {
+                let p = mesh.nodes[i];
+                [s[0] + p[0], s[1] + p[1], s[2] + p[2]]
+            });
+            symmetry.planes().iter().all(|&ax| c[ax] > 0.0)
+        })
+        .copied()
+        .collect();
+    let mut used = vec![false; mesh.nodes.len()];
+    for q in &keep {
+        for &i in q {
+            used[i] = true;
+        }
+    }
+    let mut new_id = vec![usize::MAX; mesh.nodes.len()];
+    let mut nodes = vec![];
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        if used[i] {
+            new_id[i] = nodes.len();
+            nodes.push(*p);
+        }
+    }
+    Mesh {
+        nodes,
+        quads: keep.iter().map(|q| q.map(|i| new_id[i])).collect(),
+        symmetry,
+    }
+}
