@@ -19,6 +19,10 @@
 //!  0 ───── 1
 //! ```
 
+// `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a is NaN, so
+// a non-finite coordinate is reported instead of slipping through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod tube;
 pub mod vtu;
 
@@ -265,17 +269,20 @@ fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+/// a − b
+pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+/// a × b
+pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
 }
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+/// a · b
+pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
