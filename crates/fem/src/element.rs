@@ -48,7 +48,10 @@ impl RefElement {
             let n3 = cross(g1, g2);
             let area = norm(n3);
             if !(area > 1e-14 * norm(g1) * norm(g2)) {
-                return Err(FemError::DegenerateElement { element: id, gauss_point: g });
+                return Err(FemError::DegenerateElement {
+                    element: id,
+                    gauss_point: g,
+                });
             }
             let e1 = g1.map(|v| v / norm(g1));
             let e3 = n3.map(|v| v / area);
@@ -56,7 +59,10 @@ impl RefElement {
             // J = [[e1·G1, e1·G2], [e2·G1, e2·G2]]
             let j = [[dot(e1, g1), dot(e1, g2)], [dot(e2, g1), dot(e2, g2)]];
             let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-            let inv = [[j[1][1] / det, -j[0][1] / det], [-j[1][0] / det, j[0][0] / det]];
+            let inv = [
+                [j[1][1] / det, -j[0][1] / det],
+                [-j[1][0] / det, j[0][0] / det],
+            ];
             for a in 0..4 {
                 for i in 0..2 {
                     dn[g][a][i] = d[a][0] * inv[0][i] + d[a][1] * inv[1][i];
@@ -65,7 +71,12 @@ impl RefElement {
             nv[g] = n;
             w[g] = det;
         }
-        Ok(Self { nodes, dn, n: nv, w })
+        Ok(Self {
+            nodes,
+            dn,
+            n: nv,
+            w,
+        })
     }
 
     /// f_1, f_2 at Gauss point `g`.
@@ -164,7 +175,12 @@ pub struct PointState {
     pub principal: [f64; 2],
 }
 
-pub fn point_state(law: &dyn MembraneLaw, re: &RefElement, g: usize, x: &[[f64; 3]; 4]) -> Result<PointState, MaterialError> {
+pub fn point_state(
+    law: &dyn MembraneLaw,
+    re: &RefElement,
+    g: usize,
+    x: &[[f64; 3]; 4],
+) -> Result<PointState, MaterialError> {
     let f = re.gradient(g, x);
     let c = [dot(f[0], f[0]), dot(f[1], f[1]), dot(f[0], f[1])];
     let st = law.stress_tangent(c)?;
@@ -186,10 +202,19 @@ pub fn point_state(law: &dyn MembraneLaw, re: &RefElement, g: usize, x: &[[f64; 
     // Principal values of N in the tangent plane: N = (1/J) F S Fᵀ has the eigenvalues of
     // (1/J) S C (mixed form).
     let sc = [
-        [s[0][0] * c[0] + s[0][1] * c[2], s[0][0] * c[2] + s[0][1] * c[1]],
-        [s[1][0] * c[0] + s[1][1] * c[2], s[1][0] * c[2] + s[1][1] * c[1]],
+        [
+            s[0][0] * c[0] + s[0][1] * c[2],
+            s[0][0] * c[2] + s[0][1] * c[1],
+        ],
+        [
+            s[1][0] * c[0] + s[1][1] * c[2],
+            s[1][0] * c[2] + s[1][1] * c[1],
+        ],
     ];
-    let (t2, d2) = (sc[0][0] + sc[1][1], sc[0][0] * sc[1][1] - sc[0][1] * sc[1][0]);
+    let (t2, d2) = (
+        sc[0][0] + sc[1][1],
+        sc[0][0] * sc[1][1] - sc[0][1] * sc[1][0],
+    );
     let disc2 = (0.25 * t2 * t2 - d2).max(0.0).sqrt();
     Ok(PointState {
         stretches: [l1, l2],

@@ -10,7 +10,12 @@ use tubemem_material::laws::{AnssariBenamBucchi, MooneyRivlin};
 use tubemem_material::MembraneLaw;
 
 fn random_quad(rng: &mut ChaCha8Rng) -> [[f64; 3]; 4] {
-    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let base = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
     base.map(|p| {
         [
             p[0] + rng.random_range(-0.15..0.15),
@@ -59,10 +64,19 @@ fn membrane_tangents_match_finite_differences() {
                 let (mut rp, mut rm) = ([0.0; 12], [0.0; 12]);
                 let ep = membrane_kernel(law.as_ref(), &re, &xp, &mut rp, None).unwrap();
                 let em = membrane_kernel(law.as_ref(), &re, &xm, &mut rm, None).unwrap();
-                assert!(close(r[j], (ep - em) / (2.0 * h), scale), "{} r[{j}]", law.name());
+                assert!(
+                    close(r[j], (ep - em) / (2.0 * h), scale),
+                    "{} r[{j}]",
+                    law.name()
+                );
                 for i in 0..12 {
                     let fd = (rp[i] - rm[i]) / (2.0 * h);
-                    assert!(close(k[i * 12 + j], fd, scale), "{} K[{i}][{j}] = {} vs {fd}", law.name(), k[i * 12 + j]);
+                    assert!(
+                        close(k[i * 12 + j], fd, scale),
+                        "{} K[{i}][{j}] = {} vs {fd}",
+                        law.name(),
+                        k[i * 12 + j]
+                    );
                 }
             }
             for i in 0..12 {
@@ -92,7 +106,10 @@ fn volume_gradient_and_hessian_match_finite_differences() {
             let vm = volume_kernel(&xm, &mut gm, None);
             assert!(close(g[j], (vp - vm) / (2.0 * h), 1.0), "dV/dx[{j}]");
             for i in 0..12 {
-                assert!(close(hs[i * 12 + j], (gp[i] - gm[i]) / (2.0 * h), 1.0), "d2V[{i}][{j}]");
+                assert!(
+                    close(hs[i * 12 + j], (gp[i] - gm[i]) / (2.0 * h), 1.0),
+                    "d2V[{i}][{j}]"
+                );
                 assert!((hs[i * 12 + j] - hs[j * 12 + i]).abs() < 1e-14);
             }
         }

@@ -16,7 +16,11 @@ fn skew(a: [f64; 3]) -> [[f64; 3]; 3] {
 }
 
 /// Volume contribution of one quad; fills its gradient (12) and, if asked, Hessian (144).
-pub fn volume_kernel(x: &[[f64; 3]; 4], grad: &mut [f64; 12], mut hess: Option<&mut [f64; 144]>) -> f64 {
+pub fn volume_kernel(
+    x: &[[f64; 3]; 4],
+    grad: &mut [f64; 12],
+    mut hess: Option<&mut [f64; 144]>,
+) -> f64 {
     grad.fill(0.0);
     if let Some(h) = hess.as_deref_mut() {
         h.fill(0.0);
