@@ -24,6 +24,8 @@ pub struct RefElement {
     pub n: [[f64; 4]; 4],
     /// reference area weight dA0 per Gauss point
     pub w: [f64; 4],
+    /// the local orthonormal reference frame (e1, e2) per Gauss point
+    pub frame: [[[f64; 3]; 2]; 4],
 }
 
 fn norm(a: [f64; 3]) -> f64 {
@@ -35,6 +37,7 @@ impl RefElement {
         let mut dn = [[[0.0; 2]; 4]; 4];
         let mut nv = [[0.0; 4]; 4];
         let mut w = [0.0; 4];
+        let mut frame = [[[0.0; 3]; 2]; 4];
         for (g, &(xi, eta)) in GAUSS2.iter().enumerate() {
             let (n, d) = shape(xi, eta);
             let mut g1 = [0.0; 3];
@@ -70,9 +73,11 @@ impl RefElement {
             }
             nv[g] = n;
             w[g] = det;
+            frame[g] = [e1, e2];
         }
         Ok(Self {
             nodes,
+            frame,
             dn,
             n: nv,
             w,

@@ -9,9 +9,14 @@
 //! local vector and matrix; only [`model`] touches global structures.
 //! All quantities are per unit μH (energies, forces, resultants), with lengths in units of R.
 
+// Kernels index nodes, components and Gauss points explicitly, as the formulas are written;
+// `!(a > b)` is deliberate where NaN must fail the test.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod element;
 pub mod linsolve;
 pub mod model;
+pub mod post;
 pub mod volume;
 
 use thiserror::Error;

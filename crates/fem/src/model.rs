@@ -33,7 +33,11 @@ pub enum Control {
     /// prescribed total enclosed volume (whole tube, all symmetry copies)
     Volume(f64),
     /// prescribed coordinate of one degree of freedom (node, component), pressure as multiplier
-    Node { node: usize, component: usize, target: f64 },
+    Node {
+        node: usize,
+        component: usize,
+        target: f64,
+    },
     /// closed isothermal gas: p · V_total = `pv` (Boyle's constant)
     Gas { pv: f64 },
 }
@@ -141,7 +145,10 @@ impl Model {
         }
         // rotation about z
         if !planes.contains(&0) && !planes.contains(&1) {
-            if let Some(i) = (0..nn).filter(|&i| on[0][i] && on[2][i]).max_by(|&a, &b| mesh.nodes[a][1].total_cmp(&mesh.nodes[b][1])) {
+            if let Some(i) = (0..nn)
+                .filter(|&i| on[0][i] && on[2][i])
+                .max_by(|&a, &b| mesh.nodes[a][1].total_cmp(&mesh.nodes[b][1]))
+            {
                 fixed[3 * i] = true;
             }
         }
@@ -170,7 +177,10 @@ impl Model {
             let mut list = Vec::new();
             for i in 0..12 {
                 for j in 0..12 {
-                    if let (Some(a), Some(b)) = (eq[3 * el.nodes[i / 3] + i % 3], eq[3 * el.nodes[j / 3] + j % 3]) {
+                    if let (Some(a), Some(b)) = (
+                        eq[3 * el.nodes[i / 3] + i % 3],
+                        eq[3 * el.nodes[j / 3] + j % 3],
+                    ) {
                         if a >= b {
                             if a == b && diag[a] == usize::MAX {
                                 diag[a] = pairs.len();
@@ -229,13 +239,12 @@ impl Model {
                     g: [0.0; 12],
                     h: [0.0; 144],
                 };
-                l.energy = membrane_kernel(law, el, &xe, &mut l.r, tangent.then_some(&mut l.k)).map_err(|(gp, source)| {
-                    FemError::Material {
+                l.energy = membrane_kernel(law, el, &xe, &mut l.r, tangent.then_some(&mut l.k))
+                    .map_err(|(gp, source)| FemError::Material {
                         element: e,
                         gauss_point: gp,
                         source,
-                    }
-                })?;
+                    })?;
                 l.v = volume_kernel(&xe, &mut l.g, tangent.then_some(&mut l.h));
                 Ok(l)
             })
@@ -277,11 +286,21 @@ impl Model {
 
     /// Factorize K = K_int − p H (+ a diagonal shift if K is singular); returns (#neg, shift).
     fn factorize(&mut self, a: &Assembled, p: f64) -> Result<(usize, f64), FemError> {
-        let mut vals: Vec<f64> = a.k_int.iter().zip(&a.k_vol).map(|(k, h)| k - p * h).collect();
+        let mut vals: Vec<f64> = a
+            .k_int
+            .iter()
+            .zip(&a.k_vol)
+            .map(|(k, h)| k - p * h)
+            .collect();
         match self.ldlt.factorize(&vals) {
             Ok(neg) => Ok((neg, 0.0)),
             Err(first) => {
-                let scale = self.diag.iter().map(|&d| vals[d].abs()).fold(0.0, f64::max).max(1e-300);
+                let scale = self
+                    .diag
+                    .iter()
+                    .map(|&d| vals[d].abs())
+                    .fold(0.0, f64::max)
+                    .max(1e-300);
                 let mut applied = 0.0;
                 for rel in [1e-10, 1e-8, 1e-6, 1e-4] {
                     let s = rel * scale;
@@ -308,7 +327,11 @@ impl Model {
 
     /// Newton iterations at fixed control; `state` is the initial guess and, on success, the
     /// converged state.
-    pub fn solve(&mut self, state: &mut State, control: Control) -> Result<NewtonInfo, (usize, f64)> {
+    pub fn solve(
+        &mut self,
+        state: &mut State,
+        control: Control,
+    ) -> Result<NewtonInfo, (usize, f64)> {
         let m = self.multiplicity();
         let settings = self.settings;
         let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
@@ -328,7 +351,11 @@ impl Model {
             let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
             let (c, h): (f64, Option<Vec<f64>>) = match control {
                 Control::Volume(v) => (m * a.volume - v, Some(a.g.iter().map(|g| m * g).collect())),
-                Control::Node { node, component, target } => {
+                Control::Node {
+                    node,
+                    component,
+                    target,
+                } => {
                     let k = self.eq[3 * node + component].ok_or((it, f64::INFINITY))?;
                     let mut e = vec![0.0; self.n_eq];
                     e[k] = 1.0;
@@ -403,7 +430,11 @@ impl Model {
                         .sqrt()
                 })
                 .fold(0.0, f64::max);
-            let mut t = if maxd > settings.max_step { settings.max_step / maxd } else { 1.0 };
+            let mut t = if maxd > settings.max_step {
+                settings.max_step / maxd
+            } else {
+                1.0
+            };
             if !dx.iter().all(|v| v.is_finite()) || !dp.is_finite() {
                 return Err((it, last));
             }
@@ -419,7 +450,12 @@ impl Model {
                         Control::Gas { pv } => pv / (m * trial.volume),
                         _ => state.p,
                     };
-                    let rt: Vec<f64> = trial.f_int.iter().zip(&trial.g).map(|(f, g)| f - pt * g).collect();
+                    let rt: Vec<f64> = trial
+                        .f_int
+                        .iter()
+                        .zip(&trial.g)
+                        .map(|(f, g)| f - pt * g)
+                        .collect();
                     let reft = norm(&trial.f_int).max(pt.abs() * norm(&trial.g)).max(1e-12);
                     // bordered controls: accept full steps (the merit mixes R and c); else
                     // require a decrease of the residual
@@ -440,36 +476,55 @@ impl Model {
     }
 }
 
-/// How the control parameter of a stage runs, and what each converged step reports.
-pub struct Continuation {
+/// One stage of a run: its number (for messages), the control value at its start and end, and
+/// how to step between them.
+pub struct Stage {
+    pub index: usize,
+    pub from: f64,
+    pub to: f64,
     pub initial_steps: usize,
     pub max_cuts: usize,
 }
 
-impl Default for Continuation {
-    fn default() -> Self {
-        Self {
-            initial_steps: 10,
-            max_cuts: 12,
-        }
-    }
-}
-
-/// Run one stage: the control moves linearly from `from` to `to` (built by `control(value)`),
-/// with step cut-back on failure and growth after easy steps. `on_step(step, value, state,
-/// info)` is called for every converged step (so results can be written as the run goes).
+/// Run one stage: the control moves linearly from `stage.from` to `stage.to` (built by
+/// `control(value)`), with step cut-back on failure and growth after easy steps.
+/// `on_step(step, value, state, info)` is called for every converged step, so results can be
+/// written as the run goes; an error names the stage, the step, the iterations and the residual.
 pub fn run_stage(
     model: &mut Model,
     state: &mut State,
-    stage: usize,
-    from: f64,
-    to: f64,
+    stage: &Stage,
     control: impl Fn(f64) -> Control,
-    cont: &Continuation,
     mut on_step: impl FnMut(usize, f64, &State, &NewtonInfo),
 ) -> Result<(), FemError> {
+    let (from, to) = (stage.from, stage.to);
+    // A stress-free membrane has no stiffness against inextensional modes, and a bordered
+    // control (volume, node) amplifies them: from an unloaded state, first take a small
+    // pressure-controlled step (ϖ = 0.01, a hoop strain of about 0.25 %), which converges from
+    // the reference and gives the membrane its geometric stiffness.
+    if state.p == 0.0 && !matches!(control(from), Control::Pressure(_)) {
+        let mut p0 = 0.01;
+        loop {
+            let mut trial = state.clone();
+            if model.solve(&mut trial, Control::Pressure(p0)).is_ok() {
+                *state = trial;
+                break;
+            }
+            p0 *= 0.5;
+            if p0 < 1e-6 {
+                return Err(FemError::NoConvergence {
+                    stage: stage.index,
+                    step: 0,
+                    iterations: model.settings.max_iterations,
+                    residual: f64::NAN,
+                    tolerance: model.settings.rtol,
+                    cuts: 14,
+                });
+            }
+        }
+    }
     let mut lambda = 0.0;
-    let mut dl = 1.0 / cont.initial_steps.max(1) as f64;
+    let mut dl = 1.0 / stage.initial_steps.max(1) as f64;
     let mut step = 0;
     let mut cuts = 0;
     while lambda < 1.0 {
@@ -489,9 +544,9 @@ pub fn run_stage(
             Err((iterations, residual)) => {
                 cuts += 1;
                 dl *= 0.5;
-                if cuts > cont.max_cuts {
+                if cuts > stage.max_cuts {
                     return Err(FemError::NoConvergence {
-                        stage,
+                        stage: stage.index,
                         step: step + 1,
                         iterations,
                         residual,
@@ -509,7 +564,11 @@ pub fn run_stage(
 pub fn nearest_node(mesh: &Mesh, p: [f64; 3]) -> usize {
     (0..mesh.nodes.len())
         .min_by(|&a, &b| {
-            let d = |i: usize| (0..3).map(|k| (mesh.nodes[i][k] - p[k]).powi(2)).sum::<f64>();
+            let d = |i: usize| {
+                (0..3)
+                    .map(|k| (mesh.nodes[i][k] - p[k]).powi(2))
+                    .sum::<f64>()
+            };
             d(a).total_cmp(&d(b))
         })
         .unwrap_or(0)

@@ -141,11 +141,16 @@ impl Mesh {
     /// Gauss). For a symmetry-reduced mesh this is the volume of the reduced part: the missing
     /// closing faces lie on planes through the origin, where x·n = 0.
     pub fn volume(&self) -> f64 {
+        self.volume_at(&self.nodes)
+    }
+
+    /// The enclosed volume with the nodes at `x` (same connectivity).
+    pub fn volume_at(&self, x: &[[f64; 3]]) -> f64 {
         self.quads
             .iter()
             .map(|q| {
-                let x = q.map(|i| self.nodes[i]);
-                quad_volume(&x)
+                let xe = q.map(|i| x[i]);
+                quad_volume(&xe)
             })
             .sum()
     }

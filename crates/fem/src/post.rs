@@ -1,0 +1,124 @@
+//! Mid-span extraction at the cross-section Z = 0 (reference) of a capped tube.
+//!
+//! ```text
+//! λs   = (current length of the mid-span ring polygon) / (its reference length)
+//!        (the discrete analogue of L_γ/L_Γ, eq. 57: no chordal bias for a uniform state)
+//! λz   = mean over the ring of |x_j − x_i| / |X_j − X_i| for the meridian edges i → j that
+//!        leave the ring (both sides where both exist): the axial stretch at ±ΔZ/2
+//! N_s, N_z, N_sz = tᵀNt, aᵀNa, tᵀNa averaged over the Gauss points of the elements that touch
+//!        the ring, with t the current hoop tangent (image of the reference hoop direction,
+//!        made horizontal) and a the axial direction in the tangent plane
+//! ϖ    = the reduced pressure,  volume = total enclosed volume (all symmetry copies)
+//! ```
+use crate::element::point_state;
+use crate::model::{Model, State};
+use crate::FemError;
+use tubemem_mesh::{cross, dot};
+
+/// Mid-span values, dimensionless (resultants per μH).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MidSpan {
+    pub w: f64,
+    pub lambda_s: f64,
+    pub lambda_z: f64,
+    pub n_s: f64,
+    pub n_z: f64,
+    pub n_sz: f64,
+    pub volume: f64,
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt();
+    a.map(|v| v / n)
+}
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// The reference-ring nodes at Z = 0, sorted by angle.
+pub fn midspan_ring(model: &Model) -> Vec<usize> {
+    let tol = 1e-9 * model.mesh.scale();
+    let mut ring: Vec<usize> = (0..model.mesh.nodes.len())
+        .filter(|&i| model.mesh.nodes[i][2].abs() <= tol)
+        .collect();
+    ring.sort_by(|&a, &b| {
+        let ang = |i: usize| model.mesh.nodes[i][1].atan2(model.mesh.nodes[i][0]);
+        ang(a).total_cmp(&ang(b))
+    });
+    ring
+}
+
+pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
+    let mesh = &model.mesh;
+    let ring = midspan_ring(model);
+    let closed = mesh.symmetry.planes().len() <= 1; // None and Half keep the whole ring
+    let mut cur = 0.0;
+    let mut reference = 0.0;
+    let n = ring.len();
+    let segments = if closed { n } else { n - 1 };
+    for k in 0..segments {
+        let (a, b) = (ring[k], ring[(k + 1) % n]);
+        cur += dist(state.x[a], state.x[b]);
+        reference += dist(mesh.nodes[a], mesh.nodes[b]);
+    }
+    // meridian edges leaving the ring, and the elements touching it
+    let on_ring: std::collections::HashSet<usize> = ring.iter().copied().collect();
+    let mut lz_sum = 0.0;
+    let mut lz_n = 0usize;
+    let (mut ns, mut nz, mut nsz, mut ng) = (0.0, 0.0, 0.0, 0usize);
+    for (e, el) in model.elements.iter().enumerate() {
+        let q = el.nodes;
+        if !q.iter().any(|i| on_ring.contains(i)) {
+            continue;
+        }
+        for k in 0..4 {
+            let (a, b) = (q[k], q[(k + 1) % 4]);
+            if on_ring.contains(&a) != on_ring.contains(&b) {
+                // meridian edge: each is shared by two elements, so each is counted twice
+                lz_sum += dist(state.x[a], state.x[b]) / dist(mesh.nodes[a], mesh.nodes[b]);
+                lz_n += 1;
+            }
+        }
+        let xe = q.map(|i| state.x[i]);
+        for g in 0..4 {
+            let ps = point_state(model.law.as_ref(), el, g, &xe).map_err(|source| {
+                FemError::Material {
+                    element: e,
+                    gauss_point: g,
+                    source,
+                }
+            })?;
+            // reference hoop direction at the Gauss point and its image F T
+            let xr: [f64; 3] = (0..3)
+                .map(|c| (0..4).map(|a| el.n[g][a] * mesh.nodes[q[a]][c]).sum())
+                .collect::<Vec<_>>()
+                .try_into()
+                .unwrap_or([0.0; 3]);
+            let t_ref = unit([-xr[1], xr[0], 0.0]);
+            let f = el.gradient(g, &xe);
+            let [e1, e2] = el.frame[g];
+            let (c1, c2) = (dot(e1, t_ref), dot(e2, t_ref));
+            let ft = [0, 1, 2].map(|c| f[0][c] * c1 + f[1][c] * c2);
+            let t = unit([ft[0], ft[1], 0.0]);
+            let normal = unit(cross(f[0], f[1]));
+            let ez = [0.0, 0.0, 1.0];
+            let a = unit([0, 1, 2].map(|c| ez[c] - dot(ez, normal) * normal[c]));
+            let nt = [0, 1, 2].map(|r| dot(ps.cauchy[r], t));
+            let na = [0, 1, 2].map(|r| dot(ps.cauchy[r], a));
+            ns += dot(t, nt);
+            nz += dot(a, na);
+            nsz += dot(t, na);
+            ng += 1;
+        }
+    }
+    let ng = ng.max(1) as f64;
+    Ok(MidSpan {
+        w: state.p,
+        lambda_s: cur / reference,
+        lambda_z: lz_sum / lz_n.max(1) as f64,
+        n_s: ns / ng,
+        n_z: nz / ng,
+        n_sz: nsz / ng,
+        volume: model.multiplicity() * mesh.volume_at(&state.x),
+    })
+}
