@@ -3,9 +3,11 @@
 //! With no arguments it runs the main job: the closed-form GPS-versus-PS comparison for the
 //! paper's example (ABB law, 𝒩 = 30) and the figures, written to `tubemem-out/`.
 
+mod case;
 mod figures;
 mod gps_cmd;
 mod material_args;
+mod run_cmd;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -31,6 +33,14 @@ enum Command {
         #[command(subcommand)]
         command: gps_cmd::GpsCommand,
     },
+    /// Run a finite element case file; writes steps.csv, summary.json, profiles/ and a VTU series.
+    Run {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output folder (created if missing).
+        #[arg(long, default_value = "tubemem-out/run")]
+        out: PathBuf,
+    },
     /// Write PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure.
     Figures {
         /// Output folder (created if missing).
@@ -46,6 +56,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => gps_cmd::default_job(&PathBuf::from("tubemem-out")),
         Some(Command::Gps { command }) => gps_cmd::run(command),
+        Some(Command::Run { case, out }) => run_cmd::run(&case, &out),
         Some(Command::Figures { out, kuhn }) => {
             let written = figures::write_all(&out, kuhn)?;
             for p in written {

@@ -432,3 +432,123 @@ fn figures_writes_pngs_and_csvs() {
         );
     }
 }
+
+const SMALL_CASE: &str = r#"
+[geometry]
+radius = 1.0
+length = 8.0
+
+[material]
+model = "abb"
+shear_modulus = 1.0
+kuhn = 30
+
+[mesh]
+around = 16
+along = 24
+symmetry = "eighth"
+
+[[stage]]
+kind = "inflate"
+control = "volume"
+target_stretch = 1.2
+steps = 4
+"#;
+
+fn write_case(name: &str, text: &str) -> PathBuf {
+    let d = tmp(name);
+    let p = d.join("case.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A small FE run: the outputs exist, agree with each other and with GPS at the mid-span to
+/// the polygon (apothem) factor 1/cos(π/16) − 1 = 1.96e-2 in ϖ, and to 1e-4 in λz (a short
+/// tube, L/R = 8: the cap effect at mid-span is below 1e-5 there, measured 4e-7).
+#[test]
+fn run_writes_steps_summary_profiles_and_vtu() {
+    let case = write_case("run-ok", SMALL_CASE);
+    let out = case.parent().unwrap().join("out");
+    let o = tubemem(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let mut lines = steps.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots"
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.len() >= 3);
+    let last = rows.last().unwrap();
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let fin = &s["stages"][0]["final"];
+    assert_eq!(num(fin, "w"), last[2]);
+    assert!((num(fin, "lambda_s") - 1.2).abs() < 1e-9);
+    let gps = &s["stages"][0]["gps"];
+    let apothem = (std::f64::consts::PI / 16.0).cos();
+    assert!((num(fin, "w") * apothem / num(gps, "w") - 1.0).abs() < 1e-4);
+    assert!((num(fin, "lambda_z") / num(gps, "lambda_z") - 1.0).abs() < 1e-4);
+    assert_eq!(num(&s["stages"][0]["ps"], "lambda_z"), 1.0);
+    assert!(out.join("profiles/stage1_final.csv").exists());
+    let pvd = std::fs::read_to_string(out.join("tube.pvd")).unwrap();
+    assert_eq!(
+        pvd.matches("<DataSet").count(),
+        rows.len() + 1,
+        "one VTU per converged step plus the reference"
+    );
+    assert!(out.join("vtu/step_00000.vtu").exists());
+}
+
+#[test]
+fn malformed_case_files_name_the_key_and_line() {
+    let cases = [
+        (
+            SMALL_CASE.replace("kuhn = 30", "kuhn = 30\nkuhm = 2"),
+            "kuhm",
+        ),
+        (
+            SMALL_CASE.replace("around = 16", "around = \"many\""),
+            "line 12",
+        ),
+        (
+            SMALL_CASE.replace("target_stretch = 1.2", "target_pressure = 0.5"),
+            "target_stretch",
+        ),
+        (SMALL_CASE.replace("around = 16", "around = 12"), "around"),
+        (SMALL_CASE.replace("kuhn = 30", "kuhn = 0.5"), "kuhn"),
+        (
+            SMALL_CASE.replace("target_stretch = 1.2", "target_stretch = 0.9"),
+            "target_stretch",
+        ),
+        (
+            SMALL_CASE.replace("length = 8.0", "length = -8.0"),
+            "length",
+        ),
+        (
+            SMALL_CASE.replace("kind = \"inflate\"", "kind = \"inflat\""),
+            "inflat",
+        ),
+    ];
+    for (i, (text, needle)) in cases.iter().enumerate() {
+        let case = write_case(&format!("bad{i}"), text);
+        let out = case.parent().unwrap().join("out");
+        assert_clean_failure(
+            &[
+                "run",
+                case.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            needle,
+        );
+    }
+    assert_clean_failure(&["run", "/nonexistent/case.toml"], "cannot read case file");
+}

@@ -45,6 +45,13 @@ pub enum FemError {
         value: f64,
         requirement: &'static str,
     },
+    /// Writing the results of a converged step failed (the run stops; earlier steps are kept).
+    #[error("stage {stage}, step {step}: writing results failed: {reason}")]
+    Output {
+        stage: usize,
+        step: usize,
+        reason: String,
+    },
     #[error("stage {stage}, step {step}: Newton did not converge after {iterations} iterations (residual {residual:.3e}, tolerance {tolerance:.1e}) even with {cuts} step cut-backs")]
     NoConvergence {
         stage: usize,

@@ -488,14 +488,14 @@ pub struct Stage {
 
 /// Run one stage: the control moves linearly from `stage.from` to `stage.to` (built by
 /// `control(value)`), with step cut-back on failure and growth after easy steps.
-/// `on_step(step, value, state, info)` is called for every converged step, so results can be
+/// `on_step(model, step, value, state, info)` is called for every converged step, so results can be
 /// written as the run goes; an error names the stage, the step, the iterations and the residual.
 pub fn run_stage(
     model: &mut Model,
     state: &mut State,
     stage: &Stage,
     control: impl Fn(f64) -> Control,
-    mut on_step: impl FnMut(usize, f64, &State, &NewtonInfo),
+    mut on_step: impl FnMut(&Model, usize, f64, &State, &NewtonInfo) -> Result<(), String>,
 ) -> Result<(), FemError> {
     let (from, to) = (stage.from, stage.to);
     // A stress-free membrane has no stiffness against inextensional modes, and a bordered
@@ -536,7 +536,11 @@ pub fn run_stage(
                 step += 1;
                 lambda = next;
                 *state = trial;
-                on_step(step, value, state, &info);
+                on_step(model, step, value, state, &info).map_err(|reason| FemError::Output {
+                    stage: stage.index,
+                    step,
+                    reason,
+                })?;
                 if info.iterations <= 5 {
                     dl = (dl * 1.5).min(0.25);
                 }

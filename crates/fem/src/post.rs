@@ -122,3 +122,164 @@ pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
         volume: model.multiplicity() * mesh.volume_at(&state.x),
     })
 }
+
+/// Per-element output values (averaged over the four Gauss points).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CellValues {
+    /// stretch along the reference hoop direction (horizontal tangent)
+    pub hoop_stretch: f64,
+    /// stretch along the reference meridian (tangent ⟂ hoop)
+    pub axial_stretch: f64,
+    /// principal Cauchy resultants per μH (N1 ≥ N2)
+    pub n1: f64,
+    pub n2: f64,
+}
+
+impl CellValues {
+    /// A compressive principal resultant: the membrane would wrinkle there.
+    pub fn wrinkled(&self) -> bool {
+        self.n2 < 0.0
+    }
+}
+
+/// Element values for output (VTU cell data).
+pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemError> {
+    let mesh = &model.mesh;
+    model
+        .elements
+        .iter()
+        .enumerate()
+        .map(|(e, el)| {
+            let xe = el.nodes.map(|i| state.x[i]);
+            let mut c = CellValues::default();
+            for g in 0..4 {
+                let ps = point_state(model.law.as_ref(), el, g, &xe).map_err(|source| {
+                    FemError::Material {
+                        element: e,
+                        gauss_point: g,
+                        source,
+                    }
+                })?;
+                let xr = [0, 1, 2].map(|k| {
+                    (0..4)
+                        .map(|a| el.n[g][a] * mesh.nodes[el.nodes[a]][k])
+                        .sum::<f64>()
+                });
+                let [e1, e2] = el.frame[g];
+                let normal = cross(e1, e2);
+                let horizontal = [-xr[1], xr[0], 0.0];
+                let t = if dot(horizontal, horizontal) > 1e-20 {
+                    unit(horizontal)
+                } else {
+                    e1
+                };
+                // project onto the reference tangent plane
+                let t = unit([0, 1, 2].map(|k| t[k] - dot(t, normal) * normal[k]));
+                let m = cross(normal, t);
+                let f = el.gradient(g, &xe);
+                let image = |v: [f64; 3]| {
+                    let (c1, c2) = (dot(e1, v), dot(e2, v));
+                    let w = [0, 1, 2].map(|k| f[0][k] * c1 + f[1][k] * c2);
+                    dot(w, w).sqrt()
+                };
+                c.hoop_stretch += 0.25 * image(t);
+                c.axial_stretch += 0.25 * image(m);
+                c.n1 += 0.25 * ps.principal[0];
+                c.n2 += 0.25 * ps.principal[1];
+            }
+            Ok(c)
+        })
+        .collect()
+}
+
+/// One ring of the cylinder at reference height Z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RingValues {
+    /// reference height Z (in R)
+    pub z_ref: f64,
+    /// current mean height
+    pub z: f64,
+    /// ring perimeter ratio
+    pub lambda_s: f64,
+    /// mean meridian stretch of the edges leaving the ring (average of both sides)
+    pub lambda_z: f64,
+    /// mean radial distance from the axis
+    pub radius: f64,
+}
+
+/// Profiles along the cylinder: one entry per ring of nodes with the same reference Z (rings
+/// on the cylinder part only, |Z| ≤ L/2, where L/2 is the largest |Z| at reference radius R).
+pub fn ring_profile(model: &Model, state: &State) -> Vec<RingValues> {
+    let mesh = &model.mesh;
+    let tol = 1e-9 * mesh.scale();
+    let radius = mesh
+        .nodes
+        .iter()
+        .map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt())
+        .fold(0.0, f64::max);
+    let mut rings: std::collections::BTreeMap<i64, Vec<usize>> = Default::default();
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        if (r - radius).abs() <= 1e-9 * radius {
+            rings
+                .entry((p[2] / tol).round() as i64)
+                .or_default()
+                .push(i);
+        }
+    }
+    // the cylinder ends where rings of full size stop; the cap equator ring belongs to it
+    let closed = mesh.symmetry.planes().iter().all(|&ax| ax == 2);
+    let mut out = vec![];
+    let zs: Vec<i64> = rings.keys().copied().collect();
+    let edge_stretch = |a: &[usize], b: &[usize]| {
+        // pair the nodes of two neighbouring rings by reference angle
+        let mut s = 0.0;
+        let mut n = 0;
+        for &i in a {
+            let ang = mesh.nodes[i][1].atan2(mesh.nodes[i][0]);
+            if let Some(&j) = b.iter().min_by(|&&p, &&q| {
+                let d = |k: usize| (mesh.nodes[k][1].atan2(mesh.nodes[k][0]) - ang).abs();
+                d(p).total_cmp(&d(q))
+            }) {
+                s += dist(state.x[i], state.x[j]) / dist(mesh.nodes[i], mesh.nodes[j]);
+                n += 1;
+            }
+        }
+        s / n.max(1) as f64
+    };
+    for (k, z) in zs.iter().enumerate() {
+        let mut ring = rings[z].clone();
+        ring.sort_by(|&a, &b| {
+            mesh.nodes[a][1]
+                .atan2(mesh.nodes[a][0])
+                .total_cmp(&mesh.nodes[b][1].atan2(mesh.nodes[b][0]))
+        });
+        let n = ring.len();
+        let segs = if closed { n } else { n.saturating_sub(1) };
+        let (mut cur, mut refl) = (0.0, 0.0);
+        for s in 0..segs {
+            let (a, b) = (ring[s], ring[(s + 1) % n]);
+            cur += dist(state.x[a], state.x[b]);
+            refl += dist(mesh.nodes[a], mesh.nodes[b]);
+        }
+        let mut lz = vec![];
+        if k > 0 {
+            lz.push(edge_stretch(&ring, &rings[&zs[k - 1]]));
+        }
+        if k + 1 < zs.len() {
+            lz.push(edge_stretch(&ring, &rings[&zs[k + 1]]));
+        }
+        out.push(RingValues {
+            z_ref: mesh.nodes[ring[0]][2],
+            z: ring.iter().map(|&i| state.x[i][2]).sum::<f64>() / n as f64,
+            lambda_s: cur / refl.max(1e-300),
+            lambda_z: lz.iter().sum::<f64>() / lz.len().max(1) as f64,
+            radius: ring
+                .iter()
+                .map(|&i| (state.x[i][0].powi(2) + state.x[i][1].powi(2)).sqrt())
+                .sum::<f64>()
+                / n as f64,
+        });
+    }
+    out
+}

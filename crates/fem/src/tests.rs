@@ -185,7 +185,10 @@ mod solver {
             &mut st,
             &stage,
             Control::Volume,
-            |_, v, s, info| out.push(((v / v0).cbrt(), s.p, info.negative_pivots)),
+            |_, _, v, s, info| {
+                out.push(((v / v0).cbrt(), s.p, info.negative_pivots));
+                Ok(())
+            },
         )
         .unwrap();
         out
@@ -302,7 +305,10 @@ pub(crate) mod tube {
                 component: 0,
                 target: v,
             },
-            |_, _, _, _| steps += 1,
+            |_, _, _, _, _| {
+                steps += 1;
+                Ok(())
+            },
         )
         .unwrap();
         let ms = midspan(&model, &st).unwrap();

@@ -1,0 +1,194 @@
+//! The case file (TOML). Every table and key is checked: an unknown or misspelt key, a wrong
+//! type or a missing value is reported with its line and column by the TOML reader, and
+//! inconsistent values (a control without its target) name the stage and the key.
+//!
+//! ```toml
+//! [geometry]
+//! radius = 1.0          # reference radius R (results are per R)
+//! length = 20.0         # cylinder length L (between the cap junctions)
+//! thickness = 0.01      # undeformed thickness H (dimensional output only)
+//! caps = "hemisphere"   # "rigid-plug" is not implemented yet
+//!
+//! [material]
+//! model = "abb"         # "abb" | "mooney-rivlin" | "neo-hookean"
+//! shear_modulus = 1.0
+//! kuhn = 30             # abb only;  alpha = … for mooney-rivlin
+//!
+//! [mesh]
+//! around = 64           # elements around (multiple of 8)
+//! along = 160           # elements along the cylinder (even)
+//! symmetry = "eighth"   # "none" | "half" | "quarter" | "eighth"
+//!
+//! [[stage]]
+//! kind = "inflate"
+//! control = "volume"    # "pressure" (target_pressure) | "volume" (target_stretch or target_volume_ratio)
+//! target_stretch = 1.3  # mid-span hoop stretch λs*
+//! steps = 6             # initial number of load steps (adaptive afterwards)
+//! ```
+
+use anyhow::{bail, Context, Result};
+use serde::Deserialize;
+use std::path::Path;
+use tubemem_material::MaterialSpec;
+use tubemem_mesh::Symmetry;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    pub geometry: Geometry,
+    pub material: MaterialSpec,
+    pub mesh: MeshSpec,
+    #[serde(rename = "stage")]
+    pub stages: Vec<StageSpec>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Geometry {
+    pub radius: f64,
+    pub length: f64,
+    #[serde(default = "one")]
+    pub thickness: f64,
+    #[serde(default)]
+    pub caps: Caps,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[derive(Debug, Deserialize, Default, PartialEq, Eq, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+pub enum Caps {
+    #[default]
+    Hemisphere,
+    RigidPlug,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    pub around: usize,
+    pub along: usize,
+    #[serde(default)]
+    pub symmetry: Symmetry,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Kind {
+    Inflate,
+    Squeeze,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControlKind {
+    Pressure,
+    Volume,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageSpec {
+    pub kind: Kind,
+    pub control: ControlKind,
+    pub target_pressure: Option<f64>,
+    pub target_stretch: Option<f64>,
+    pub target_volume_ratio: Option<f64>,
+    #[serde(default = "default_steps")]
+    pub steps: usize,
+}
+
+fn default_steps() -> usize {
+    8
+}
+
+/// What a stage drives, once validated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Target {
+    /// reduced pressure ϖ, pressure control
+    Pressure(f64),
+    /// mid-span hoop stretch λs*, reached with the pressure as a Lagrange multiplier
+    Stretch(f64),
+    /// total enclosed volume over its reference value, volume control
+    VolumeRatio(f64),
+}
+
+impl StageSpec {
+    pub fn target(&self, i: usize) -> Result<Target> {
+        let which = (
+            self.target_pressure,
+            self.target_stretch,
+            self.target_volume_ratio,
+        );
+        let t = match (self.control, which) {
+            (ControlKind::Pressure, (Some(p), None, None)) => Target::Pressure(p),
+            (ControlKind::Volume, (None, Some(s), None)) => Target::Stretch(s),
+            (ControlKind::Volume, (None, None, Some(v))) => Target::VolumeRatio(v),
+            (ControlKind::Pressure, _) => {
+                bail!("[[stage]] {}: control = \"pressure\" takes exactly one target, `target_pressure`", i + 1)
+            }
+            (ControlKind::Volume, _) => bail!(
+                "[[stage]] {}: control = \"volume\" takes exactly one target, `target_stretch` (mid-span λs*) or `target_volume_ratio`",
+                i + 1
+            ),
+        };
+        let (name, v, ok) = match t {
+            Target::Pressure(p) => ("target_pressure", p, p.is_finite() && p >= 0.0),
+            Target::Stretch(s) => ("target_stretch", s, s.is_finite() && s >= 1.0),
+            Target::VolumeRatio(r) => ("target_volume_ratio", r, r.is_finite() && r >= 1.0),
+        };
+        if !ok {
+            bail!("[[stage]] {}: `{name}` = {v} is out of range (pressure ≥ 0, stretch ≥ 1, volume ratio ≥ 1)", i + 1);
+        }
+        if self.steps == 0 {
+            bail!("[[stage]] {}: `steps` must be ≥ 1", i + 1);
+        }
+        Ok(t)
+    }
+}
+
+impl Case {
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read case file {}", path.display()))?;
+        Self::parse(&text).with_context(|| format!("in case file {}", path.display()))
+    }
+
+    pub fn parse(text: &str) -> Result<Self> {
+        let case: Case = toml::from_str(text).map_err(|e| anyhow::anyhow!("{e}"))?;
+        case.validate()?;
+        Ok(case)
+    }
+
+    fn validate(&self) -> Result<()> {
+        let g = &self.geometry;
+        for (k, v) in [
+            ("radius", g.radius),
+            ("length", g.length),
+            ("thickness", g.thickness),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("[geometry] `{k}` = {v}: must be finite and > 0");
+            }
+        }
+        if g.caps == Caps::RigidPlug {
+            bail!("[geometry] caps = \"rigid-plug\" is not implemented yet; use \"hemisphere\"");
+        }
+        if self.stages.is_empty() {
+            bail!("the case has no [[stage]]");
+        }
+        for (i, s) in self.stages.iter().enumerate() {
+            if s.kind == Kind::Squeeze {
+                bail!(
+                    "[[stage]] {}: kind = \"squeeze\" (contact with plates) is not implemented yet",
+                    i + 1
+                );
+            }
+            s.target(i)?;
+        }
+        self.material.build().context("[material]")?;
+        Ok(())
+    }
+}

@@ -1,0 +1,355 @@
+//! `tubemem run CASE.toml --out DIR`: the FE run of a case file.
+//!
+//! Every converged step is written as it comes: a row of `steps.csv` (flushed), a VTU file and
+//! the `.pvd` index. `summary.json` is rewritten after every stage (and on failure, with the
+//! error), so a run that fails midway loses nothing that had converged.
+
+use crate::case::{Case, Target};
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::{json, Value};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use tubemem_fem::model::{nearest_node, run_stage, Control, Model, Stage, State};
+use tubemem_fem::post::{cell_values, midspan, ring_profile, MidSpan, RingValues};
+use tubemem_gps::{inflate, Hypothesis};
+use tubemem_mesh::tube::capped_tube;
+use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
+
+const STEPS_HEADER: &str =
+    "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots";
+
+struct Output {
+    dir: PathBuf,
+    steps: BufWriter<File>,
+    pvd: Vec<(f64, String)>,
+    frames: usize,
+}
+
+impl Output {
+    fn new(dir: &Path) -> Result<Self> {
+        for sub in ["vtu", "profiles"] {
+            std::fs::create_dir_all(dir.join(sub))
+                .with_context(|| format!("cannot create {}", dir.join(sub).display()))?;
+        }
+        let path = dir.join("steps.csv");
+        let mut steps = BufWriter::new(
+            File::create(&path).with_context(|| format!("cannot create {}", path.display()))?,
+        );
+        writeln!(steps, "{STEPS_HEADER}")?;
+        steps.flush()?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            steps,
+            pvd: vec![],
+            frames: 0,
+        })
+    }
+
+    fn row(
+        &mut self,
+        stage: usize,
+        step: usize,
+        m: &MidSpan,
+        iterations: usize,
+        negative: usize,
+    ) -> std::io::Result<()> {
+        writeln!(
+            self.steps,
+            "{stage},{step},{},{},{},{},{},{},{},{iterations},{negative}",
+            m.w, m.lambda_s, m.lambda_z, m.n_s, m.n_z, m.n_sz, m.volume
+        )?;
+        self.steps.flush()
+    }
+
+    fn frame(&mut self, model: &Model, state: &State) -> Result<(), String> {
+        let cells = cell_values(model, state).map_err(|e| e.to_string())?;
+        let disp: Vec<f64> = state
+            .x
+            .iter()
+            .zip(&model.mesh.nodes)
+            .flat_map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]])
+            .collect();
+        let pick = |f: fn(&tubemem_fem::post::CellValues) -> f64| {
+            cells.iter().map(f).collect::<Vec<f64>>()
+        };
+        let (hoop, axial, n1, n2) = (
+            pick(|c| c.hoop_stretch),
+            pick(|c| c.axial_stretch),
+            pick(|c| c.n1),
+            pick(|c| c.n2),
+        );
+        let wrinkled = pick(|c| if c.wrinkled() { 1.0 } else { 0.0 });
+        let name = format!("step_{:05}.vtu", self.frames);
+        write_vtu(
+            &self.dir.join("vtu").join(&name),
+            &state.x,
+            &model.mesh.quads,
+            &[Field {
+                name: "displacement",
+                components: 3,
+                values: &disp,
+            }],
+            &[
+                Field {
+                    name: "hoop_stretch",
+                    components: 1,
+                    values: &hoop,
+                },
+                Field {
+                    name: "axial_stretch",
+                    components: 1,
+                    values: &axial,
+                },
+                Field {
+                    name: "N1",
+                    components: 1,
+                    values: &n1,
+                },
+                Field {
+                    name: "N2",
+                    components: 1,
+                    values: &n2,
+                },
+                Field {
+                    name: "wrinkled",
+                    components: 1,
+                    values: &wrinkled,
+                },
+            ],
+        )
+        .map_err(|e| e.to_string())?;
+        self.pvd.push((self.frames as f64, format!("vtu/{name}")));
+        self.frames += 1;
+        write_pvd(&self.dir.join("tube.pvd"), &self.pvd).map_err(|e| e.to_string())
+    }
+}
+
+fn midspan_json(m: &MidSpan) -> Value {
+    json!({"w": m.w, "lambda_s": m.lambda_s, "lambda_z": m.lambda_z, "n_s": m.n_s, "n_z": m.n_z, "n_sz": m.n_sz, "volume": m.volume})
+}
+
+fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
+    let mut f = BufWriter::new(
+        File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+    );
+    writeln!(f, "z_ref,z,lambda_s,lambda_z,radius")?;
+    for r in rings {
+        writeln!(
+            f,
+            "{},{},{},{},{}",
+            r.z_ref, r.z, r.lambda_s, r.lambda_z, r.radius
+        )?;
+    }
+    Ok(())
+}
+
+/// Distance (in R) from the cap junction at which λs stays within `tol` of its mid-span value
+/// all the way to mid-span; `None` if it never does.
+pub fn boundary_layer(rings: &[RingValues], half_length: f64, mid: f64, tol: f64) -> Option<f64> {
+    let mut side: Vec<&RingValues> = rings.iter().filter(|r| r.z_ref >= -1e-12).collect();
+    side.sort_by(|a, b| b.z_ref.total_cmp(&a.z_ref)); // from the junction inwards
+    let first_inside = side
+        .iter()
+        .position(|r| ((r.lambda_s - mid) / mid).abs() <= tol)?;
+    if side[first_inside..]
+        .iter()
+        .all(|r| ((r.lambda_s - mid) / mid).abs() <= tol)
+    {
+        Some(half_length - side[first_inside].z_ref)
+    } else {
+        None
+    }
+}
+
+fn rel(fe: f64, cf: f64) -> f64 {
+    (fe - cf) / cf.abs().max(1e-300)
+}
+
+pub fn run(case_path: &Path, out: &Path) -> Result<()> {
+    let case = Case::read(case_path)?;
+    let g = &case.geometry;
+    let half = 0.5 * g.length / g.radius;
+    let mesh = capped_tube(
+        1.0,
+        g.length / g.radius,
+        case.mesh.around,
+        case.mesh.along,
+        case.mesh.symmetry,
+    )
+    .context("[mesh]")?;
+    let law = case.material.build()?;
+    let closed_form_law = case.material.build()?;
+    let mut model = Model::new(mesh, law)?;
+    let mut o = Output::new(out)?;
+    let mut state = model.reference_state();
+    o.frame(&model, &state).map_err(anyhow::Error::msg)?;
+    let v0 = model.multiplicity() * model.mesh.volume();
+    let node = nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
+    let mut summary = json!({
+        "case": case_path.display().to_string(),
+        "mesh": {"nodes": model.mesh.nodes.len(), "elements": model.mesh.quads.len(), "equations": model.n_eq,
+                 "symmetry": format!("{:?}", case.mesh.symmetry).to_lowercase()},
+        "material": closed_form_law.name(),
+        "units": "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH)",
+        "stages": [],
+    });
+    let write_summary = |summary: &Value| -> Result<()> {
+        let p = out.join("summary.json");
+        std::fs::write(&p, serde_json::to_string_pretty(summary)?)
+            .with_context(|| format!("cannot write {}", p.display()))
+    };
+    println!(
+        "tubemem run: {} — {} elements, {} equations ({:?} model), {}",
+        case_path.display(),
+        model.mesh.quads.len(),
+        model.n_eq,
+        case.mesh.symmetry,
+        closed_form_law.name()
+    );
+    for (i, spec) in case.stages.iter().enumerate() {
+        let target = spec.target(i)?;
+        let (from, to, control): (f64, f64, Box<dyn Fn(f64) -> Control>) = match target {
+            Target::Pressure(p) => (state.p, p, Box::new(Control::Pressure)),
+            Target::Stretch(s) => (
+                state.x[node][0],
+                s,
+                Box::new(move |v| Control::Node {
+                    node,
+                    component: 0,
+                    target: v,
+                }),
+            ),
+            Target::VolumeRatio(r) => (
+                model.multiplicity() * model.mesh.volume_at(&state.x),
+                r * v0,
+                Box::new(Control::Volume),
+            ),
+        };
+        let bar = ProgressBar::new(1000);
+        bar.set_style(
+            ProgressStyle::with_template("stage {prefix} [{bar:40}] {percent:>3}% {msg}")
+                .expect("a valid progress template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(format!("{}/{} ({:?})", i + 1, case.stages.len(), target));
+        let stage = Stage {
+            index: i + 1,
+            from,
+            to,
+            initial_steps: spec.steps,
+            max_cuts: 12,
+        };
+        let mut last: Option<(MidSpan, usize, usize)> = None;
+        let result = run_stage(
+            &mut model,
+            &mut state,
+            &stage,
+            control,
+            |m, step, value, st, info| {
+                let ms = midspan(m, st).map_err(|e| e.to_string())?;
+                let vals = [
+                    ms.w,
+                    ms.lambda_s,
+                    ms.lambda_z,
+                    ms.n_s,
+                    ms.n_z,
+                    ms.n_sz,
+                    ms.volume,
+                ];
+                if vals.iter().any(|v| !v.is_finite()) {
+                    return Err(format!(
+                        "a non-finite mid-span value was computed: {vals:?}"
+                    ));
+                }
+                o.row(i + 1, step, &ms, info.iterations, info.negative_pivots)
+                    .map_err(|e| e.to_string())?;
+                o.frame(m, st)?;
+                let frac = if to != from {
+                    ((value - from) / (to - from)).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                bar.set_position((1000.0 * frac) as u64);
+                bar.set_message(format!(
+                    "step {step}: ϖ = {:.5}, λs = {:.5}, {} its",
+                    ms.w, ms.lambda_s, info.iterations
+                ));
+                last = Some((ms, info.iterations, info.negative_pivots));
+                Ok(())
+            },
+        );
+        bar.finish_and_clear();
+        if let Err(e) = result {
+            summary["stages"]
+                .as_array_mut()
+                .expect("stages is an array")
+                .push(json!({"index": i + 1, "error": e.to_string(),
+                "last_converged": last.map(|(m, _, _)| midspan_json(&m))}));
+            write_summary(&summary)?;
+            return Err(e).with_context(|| {
+                format!(
+                    "stage {} of {} failed; converged steps are in {}",
+                    i + 1,
+                    case.stages.len(),
+                    out.display()
+                )
+            });
+        }
+        let ms = midspan(&model, &state)?;
+        let gps = inflate(closed_form_law.as_ref(), Hypothesis::Gps, ms.lambda_s)?;
+        let ps = inflate(closed_form_law.as_ref(), Hypothesis::Ps, ms.lambda_s)?;
+        let rings = ring_profile(&model, &state);
+        let profile = out
+            .join("profiles")
+            .join(format!("stage{}_final.csv", i + 1));
+        write_profile(&profile, &rings)?;
+        let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
+        let (_, its, neg) = last.unwrap_or((ms, 0, 0));
+        let cf = |s: &tubemem_gps::InflationState| json!({"w": s.w, "lambda_s": s.lambda_s, "lambda_z": s.lambda_z, "n_s": s.n_s, "n_z": s.n_z});
+        let errs = |s: &tubemem_gps::InflationState| json!({"w": rel(ms.w, s.w), "lambda_z": rel(ms.lambda_z, s.lambda_z), "n_s": rel(ms.n_s, s.n_s), "n_z": rel(ms.n_z, s.n_z)});
+        let mut fin = midspan_json(&ms);
+        fin["newton_iterations"] = json!(its);
+        fin["negative_pivots"] = json!(neg);
+        summary["stages"]
+            .as_array_mut()
+            .expect("stages is an array")
+            .push(json!({
+                "index": i + 1,
+                "kind": "inflate",
+                "target": format!("{target:?}"),
+                "final": fin,
+                "gps": cf(&gps),
+                "ps": cf(&ps),
+                "relative_error_vs_gps": errs(&gps),
+                "relative_error_vs_ps": errs(&ps),
+                "cap_boundary_layer_0.1pct": layer,
+                "profile": profile.display().to_string(),
+            }));
+        write_summary(&summary)?;
+        println!(
+            "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6}, λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
+            i + 1,
+            ms.w,
+            gps.w,
+            100.0 * rel(ms.w, gps.w),
+            ps.w,
+            ms.lambda_s,
+            ms.lambda_z,
+            gps.lambda_z,
+            ms.n_s,
+            ms.n_z,
+            ms.n_sz
+        );
+        if let Some(d) = layer {
+            println!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction");
+        }
+    }
+    println!(
+        "wrote {}/steps.csv, summary.json, profiles/, tube.pvd ({} VTU frames)",
+        out.display(),
+        o.frames
+    );
+    Ok(())
+}
