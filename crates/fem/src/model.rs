@@ -476,6 +476,42 @@ impl Model {
     }
 }
 
+/// Wall-clock seconds of the three parts of one Newton iteration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationTiming {
+    pub assembly: f64,
+    pub factorization: f64,
+    pub solve: f64,
+    pub negative_pivots: usize,
+    pub factor_nnz: usize,
+}
+
+impl Model {
+    /// Time one Newton iteration at `state` under pressure control (for benchmarks).
+    pub fn time_iteration(&mut self, state: &State) -> Result<IterationTiming, FemError> {
+        let t0 = std::time::Instant::now();
+        let a = self.assemble(&state.x, true)?;
+        let t1 = std::time::Instant::now();
+        let (neg, _) = self.factorize(&a, state.p)?;
+        let t2 = std::time::Instant::now();
+        let mut dx: Vec<f64> = a
+            .f_int
+            .iter()
+            .zip(&a.g)
+            .map(|(f, g)| state.p * g - f)
+            .collect();
+        self.ldlt.solve(&mut dx);
+        let t3 = std::time::Instant::now();
+        Ok(IterationTiming {
+            assembly: (t1 - t0).as_secs_f64(),
+            factorization: (t2 - t1).as_secs_f64(),
+            solve: (t3 - t2).as_secs_f64(),
+            negative_pivots: neg,
+            factor_nnz: self.ldlt.factor_nnz(),
+        })
+    }
+}
+
 /// One stage of a run: its number (for messages), the control value at its start and end, and
 /// how to step between them.
 pub struct Stage {

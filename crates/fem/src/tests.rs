@@ -462,3 +462,32 @@ fn tube_explore() {
         );
     }
 }
+
+/// Deterministic whatever the thread count: element kernels run in parallel, but every sum is
+/// taken in element order, so 1 and 2 threads give bitwise-identical results.
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    use tubemem_mesh::Symmetry;
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| tube::inflate(6.0, 16, 24, Symmetry::Quarter, 1.25))
+    };
+    let (m1, a, _) = run(1);
+    let (_, b, _) = run(2);
+    assert_eq!(a, b, "mid-span values differ between 1 and 2 threads");
+    let st = m1.reference_state();
+    let x1 = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| m1.assemble(&st.x, false).unwrap().f_int);
+    let x2 = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| m1.assemble(&st.x, false).unwrap().f_int);
+    assert!(x1.iter().zip(&x2).all(|(p, q)| p.to_bits() == q.to_bits()));
+}
