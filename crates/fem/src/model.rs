@@ -476,6 +476,54 @@ impl Model {
     }
 }
 
+impl Model {
+    /// The residual R = f_int − p ∂V/∂x on the free dofs, with p = `p` or, for closed gas,
+    /// p = pv/(m V_part) (for tests and diagnostics).
+    pub fn residual(&self, x: &[[f64; 3]], control: Control, p: f64) -> Result<Vec<f64>, FemError> {
+        let a = self.assemble(x, false)?;
+        let p = match control {
+            Control::Gas { pv } => pv / (self.multiplicity() * a.volume),
+            _ => p,
+        };
+        Ok(a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect())
+    }
+
+    /// The product of the consistent tangent with `v` (free dofs), computed from the element
+    /// matrices without factorizing: (K_int − p H) v, plus (p/V_part) g (gᵀv) for closed gas.
+    pub fn tangent_times(&self, x: &[[f64; 3]], control: Control, p: f64, v: &[f64]) -> Result<Vec<f64>, FemError> {
+        let a = self.assemble(x, true)?;
+        let p = match control {
+            Control::Gas { pv } => pv / (self.multiplicity() * a.volume),
+            _ => p,
+        };
+        let mut out = vec![0.0; self.n_eq];
+        let mut k = 0;
+        for (e, list) in self.entries.iter().enumerate() {
+            let el = &self.elements[e];
+            for &(i, j) in list {
+                let (i, j) = (i as usize, j as usize);
+                let ra = self.eq[3 * el.nodes[i / 3] + i % 3].expect("entries hold free dofs");
+                let cb = self.eq[3 * el.nodes[j / 3] + j % 3].expect("entries hold free dofs");
+                let val = a.k_int[k] - p * a.k_vol[k];
+                out[ra] += val * v[cb];
+                if i != j && ra == cb {
+                    // both (i, j) and (j, i) are stored when they share an equation
+                } else if ra != cb {
+                    out[cb] += val * v[ra];
+                }
+                k += 1;
+            }
+        }
+        if let Control::Gas { .. } = control {
+            let gv: f64 = a.g.iter().zip(v).map(|(g, v)| g * v).sum();
+            for (o, g) in out.iter_mut().zip(&a.g) {
+                *o += p / a.volume * g * gv;
+            }
+        }
+        Ok(out)
+    }
+}
+
 /// Wall-clock seconds of the three parts of one Newton iteration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IterationTiming {
