@@ -19,6 +19,11 @@
 //! along = 160           # elements along the cylinder (even)
 //! symmetry = "eighth"   # "none" | "half" | "quarter" | "eighth"
 //!
+//! [solver]              # optional
+//! wrinkling = "relaxed" # tension-field relaxation (default) | "none"
+//! rtol = 1e-9           # Newton tolerance on ‖R‖/‖f‖
+//! max_iterations = 30
+//!
 //! [[stage]]
 //! kind = "inflate"
 //! control = "volume"    # "pressure" (target_pressure) | "volume" (target_stretch or target_volume_ratio)
@@ -29,7 +34,7 @@
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 use std::path::Path;
-use tubemem_material::MaterialSpec;
+use tubemem_material::{MaterialSpec, Wrinkling};
 use tubemem_mesh::Symmetry;
 
 #[derive(Debug, Deserialize)]
@@ -38,8 +43,41 @@ pub struct Case {
     pub geometry: Geometry,
     pub material: MaterialSpec,
     pub mesh: MeshSpec,
+    #[serde(default)]
+    pub solver: SolverSpec,
     #[serde(rename = "stage")]
     pub stages: Vec<StageSpec>,
+}
+
+/// `[solver]`: optional.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// "relaxed" (tension-field theory, default) or "none"
+    #[serde(default)]
+    pub wrinkling: Wrinkling,
+    /// Newton tolerance on ‖R‖/‖f‖
+    #[serde(default = "default_rtol")]
+    pub rtol: f64,
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: usize,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        Self {
+            wrinkling: Wrinkling::default(),
+            rtol: default_rtol(),
+            max_iterations: default_max_iterations(),
+        }
+    }
+}
+
+fn default_rtol() -> f64 {
+    1e-9
+}
+fn default_max_iterations() -> usize {
+    30
 }
 
 #[derive(Debug, Deserialize)]
@@ -189,6 +227,15 @@ impl Case {
             s.target(i)?;
         }
         self.material.build().context("[material]")?;
+        if !(self.solver.rtol > 0.0 && self.solver.rtol < 1e-2) {
+            bail!(
+                "[solver] `rtol` = {}: must be in (0, 1e-2)",
+                self.solver.rtol
+            );
+        }
+        if self.solver.max_iterations == 0 {
+            bail!("[solver] `max_iterations` must be ≥ 1");
+        }
         Ok(())
     }
 }

@@ -179,9 +179,11 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
         case.mesh.symmetry,
     )
     .context("[mesh]")?;
-    let law = case.material.build()?;
+    let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;
     let mut model = Model::new(mesh, law)?;
+    model.settings.rtol = case.solver.rtol;
+    model.settings.max_iterations = case.solver.max_iterations;
     let mut o = Output::new(out)?;
     let mut state = model.reference_state();
     o.frame(&model, &state).map_err(anyhow::Error::msg)?;
@@ -191,7 +193,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
         "case": case_path.display().to_string(),
         "mesh": {"nodes": model.mesh.nodes.len(), "elements": model.mesh.quads.len(), "equations": model.n_eq,
                  "symmetry": format!("{:?}", case.mesh.symmetry).to_lowercase()},
-        "material": closed_form_law.name(),
+        "material": model.law.name(),
         "units": "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH)",
         "stages": [],
     });

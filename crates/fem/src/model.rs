@@ -490,7 +490,13 @@ impl Model {
 
     /// The product of the consistent tangent with `v` (free dofs), computed from the element
     /// matrices without factorizing: (K_int − p H) v, plus (p/V_part) g (gᵀv) for closed gas.
-    pub fn tangent_times(&self, x: &[[f64; 3]], control: Control, p: f64, v: &[f64]) -> Result<Vec<f64>, FemError> {
+    pub fn tangent_times(
+        &self,
+        x: &[[f64; 3]],
+        control: Control,
+        p: f64,
+        v: &[f64],
+    ) -> Result<Vec<f64>, FemError> {
         let a = self.assemble(x, true)?;
         let p = match control {
             Control::Gas { pv } => pv / (self.multiplicity() * a.volume),

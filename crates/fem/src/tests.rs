@@ -503,7 +503,11 @@ fn assembled_tangents_match_finite_differences_including_gas() {
     use tubemem_mesh::{tube::capped_tube, Symmetry};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
     let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
-    let mut model = Model::new(capped_tube(1.0, 3.0, 8, 6, Symmetry::Quarter).unwrap(), Box::new(law)).unwrap();
+    let mut model = Model::new(
+        capped_tube(1.0, 3.0, 8, 6, Symmetry::Quarter).unwrap(),
+        Box::new(law),
+    )
+    .unwrap();
     let mut st = model.reference_state();
     model.solve(&mut st, Control::Pressure(0.4)).unwrap();
     // move off equilibrium a little, so that every term is exercised
@@ -521,9 +525,16 @@ fn assembled_tangents_match_finite_differences_including_gas() {
         }
     }
     let v_part = model.mesh.volume_at(&st.x);
-    for control in [Control::Pressure(0.4), Control::Gas { pv: 0.4 * model.multiplicity() * v_part }] {
+    for control in [
+        Control::Pressure(0.4),
+        Control::Gas {
+            pv: 0.4 * model.multiplicity() * v_part,
+        },
+    ] {
         for _ in 0..3 {
-            let v: Vec<f64> = (0..model.n_eq).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let v: Vec<f64> = (0..model.n_eq)
+                .map(|_| rng.random_range(-1.0..1.0))
+                .collect();
             let av = model.tangent_times(&st.x, control, 0.4, &v).unwrap();
             let h = 1e-6;
             let shifted = |t: f64| {
@@ -539,7 +550,11 @@ fn assembled_tangents_match_finite_differences_including_gas() {
             let scale = av.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
             for i in 0..model.n_eq {
                 let fd = (rp[i] - rm[i]) / (2.0 * h);
-                assert!((fd - av[i]).abs() <= 1e-6 * scale, "{control:?} row {i}: {} vs {fd}", av[i]);
+                assert!(
+                    (fd - av[i]).abs() <= 1e-6 * scale,
+                    "{control:?} row {i}: {} vs {fd}",
+                    av[i]
+                );
             }
         }
     }

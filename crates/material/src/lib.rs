@@ -38,6 +38,7 @@
 pub mod dual;
 mod error;
 pub mod laws;
+pub mod relaxed;
 
 pub use error::MaterialError;
 use serde::{Deserialize, Serialize};
@@ -356,7 +357,7 @@ pub mod energies {
 }
 
 /// A typed, validated material description (what case files and the CLI name).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum MaterialSpec {
     /// Anssari-Benam & Bucchi generalized neo-Hookean (paper eqs. 19–23).
@@ -367,7 +368,48 @@ pub enum MaterialSpec {
     NeoHookean { shear_modulus: f64 },
 }
 
+/// Whether compressive states are relaxed (tension-field theory) or kept as computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Wrinkling {
+    /// Pipkin's relaxed energy: no compressive resultant (the default for finite elements).
+    #[default]
+    Relaxed,
+    /// The law as it is (compressive resultants allowed).
+    None,
+}
+
 impl MaterialSpec {
+    /// The law with the chosen wrinkling model.
+    pub fn build_with(&self, wrinkling: Wrinkling) -> Result<Box<dyn MembraneLaw>, MaterialError> {
+        Ok(match (wrinkling, *self) {
+            (Wrinkling::None, _) => self.build()?,
+            (
+                Wrinkling::Relaxed,
+                MaterialSpec::Abb {
+                    shear_modulus,
+                    kuhn,
+                },
+            ) => Box::new(relaxed::Relaxed::new(laws::AnssariBenamBucchi::new(
+                shear_modulus,
+                kuhn,
+            )?)),
+            (
+                Wrinkling::Relaxed,
+                MaterialSpec::MooneyRivlin {
+                    shear_modulus,
+                    alpha,
+                },
+            ) => Box::new(relaxed::Relaxed::new(laws::MooneyRivlin::new(
+                shear_modulus,
+                alpha,
+            )?)),
+            (Wrinkling::Relaxed, MaterialSpec::NeoHookean { shear_modulus }) => {
+                Box::new(relaxed::Relaxed::new(laws::neo_hookean(shear_modulus)?))
+            }
+        })
+    }
+
     /// Validate the parameters and build the law.
     pub fn build(&self) -> Result<Box<dyn MembraneLaw>, MaterialError> {
         Ok(match *self {
