@@ -50,7 +50,7 @@ impl<L: MembraneLaw> Relaxed<L> {
             let p = self.law.principal(l1, mu)?;
             let step = p.grad[1] / p.hess[1][1];
             let mut next = mu - step;
-            if !(next > 0.0) {
+            if next.is_nan() || next <= 0.0 {
                 next = 0.5 * mu;
             }
             let done = (next - mu).abs() <= 1e-15 * mu;
