@@ -7,7 +7,7 @@
 //! radius = 1.0          # reference radius R (results are per R)
 //! length = 20.0         # cylinder length L (between the cap junctions)
 //! thickness = 0.01      # undeformed thickness H (dimensional output only)
-//! caps = "hemisphere"   # "rigid-plug" is not implemented yet
+//! caps = "hemisphere"   # or "rigid-plug": open tube tied to two rigid discs
 //!
 //! [material]
 //! model = "abb"         # "abb" | "mooney-rivlin" | "neo-hookean"
@@ -210,9 +210,6 @@ impl Case {
             if !(v.is_finite() && v > 0.0) {
                 bail!("[geometry] `{k}` = {v}: must be finite and > 0");
             }
-        }
-        if g.caps == Caps::RigidPlug {
-            bail!("[geometry] caps = \"rigid-plug\" is not implemented yet; use \"hemisphere\"");
         }
         if self.stages.is_empty() {
             bail!("the case has no [[stage]]");

@@ -4,7 +4,7 @@
 //! the `.pvd` index. `summary.json` is rewritten after every stage (and on failure, with the
 //! error), so a run that fails midway loses nothing that had converged.
 
-use crate::case::{Case, Target};
+use crate::case::{Caps, Case, Target};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Value};
@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use tubemem_fem::model::{nearest_node, run_stage, Control, Model, Stage, State};
 use tubemem_fem::post::{cell_values, midspan, ring_profile, MidSpan, RingValues};
 use tubemem_gps::{inflate, Hypothesis};
-use tubemem_mesh::tube::capped_tube;
+use tubemem_mesh::tube::{capped_tube, plugged_tube};
 use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 
 const STEPS_HEADER: &str =
@@ -171,7 +171,11 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     let case = Case::read(case_path)?;
     let g = &case.geometry;
     let half = 0.5 * g.length / g.radius;
-    let mesh = capped_tube(
+    let build = match g.caps {
+        Caps::Hemisphere => capped_tube,
+        Caps::RigidPlug => plugged_tube,
+    };
+    let mesh = build(
         1.0,
         g.length / g.radius,
         case.mesh.around,
@@ -345,7 +349,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
             ms.n_sz
         );
         if let Some(d) = layer {
-            println!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction");
+            println!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)");
         }
     }
     println!(

@@ -112,6 +112,8 @@ pub struct Model {
     /// per element: (local row, local col) of each matrix entry, in pattern order
     entries: Vec<Vec<(u8, u8)>>,
     diag: Vec<usize>,
+    /// equation of each rigid plug's axial translation (None if fixed)
+    plug_eq: Vec<Option<usize>>,
     ldlt: SparseLdlt,
     pub settings: NewtonSettings,
 }
@@ -158,10 +160,31 @@ impl Model {
                 fixed[3 * i + 2] = true;
             }
         }
+        // Rigid plugs: the ring nodes keep x and y (tied to the disc) and share one axial dof,
+        // the disc's translation.
+        let mut plug_of = vec![usize::MAX; nn];
+        for (k, ring) in mesh.plugs.iter().enumerate() {
+            for &i in ring {
+                fixed[3 * i] = true;
+                fixed[3 * i + 1] = true;
+                plug_of[i] = k;
+            }
+        }
         let mut eq = vec![None; 3 * nn];
+        let mut plug_eq = vec![None; mesh.plugs.len()];
         let mut n_eq = 0;
         for (d, f) in fixed.iter().enumerate() {
-            if !f {
+            if *f {
+                continue;
+            }
+            let node = d / 3;
+            if d % 3 == 2 && plug_of[node] != usize::MAX {
+                let k = plug_of[node];
+                eq[d] = Some(*plug_eq[k].get_or_insert_with(|| {
+                    n_eq += 1;
+                    n_eq - 1
+                }));
+            } else {
                 eq[d] = Some(n_eq);
                 n_eq += 1;
             }
@@ -202,6 +225,7 @@ impl Model {
             n_eq,
             entries,
             diag,
+            plug_eq,
             ldlt,
             settings: NewtonSettings::default(),
         })
@@ -279,6 +303,15 @@ impl Model {
                     out.k_int.push(l.k[idx]);
                     out.k_vol.push(l.h[idx]);
                 }
+            }
+        }
+        // Rigid plug faces close the surface: V_face = (1/3) z_d A sign, linear in the disc
+        // translation z_d (A is fixed, the ring being tied to the disc), so no Hessian term.
+        for (ring, eq) in self.mesh.plugs.iter().zip(&self.plug_eq) {
+            let face = tubemem_mesh::plug_face(x, ring);
+            out.volume += face.volume();
+            if let Some(k) = eq {
+                out.g[*k] += face.area * face.sign / 3.0;
             }
         }
         Ok(out)

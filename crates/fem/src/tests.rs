@@ -283,7 +283,11 @@ pub(crate) mod tube {
         sym: Symmetry,
         target: f64,
     ) -> (Model, MidSpan, usize) {
-        let mesh = capped_tube(1.0, l, around, along, sym).unwrap();
+        inflate_mesh(capped_tube(1.0, l, around, along, sym).unwrap(), target)
+    }
+
+    /// The same for any tube mesh.
+    pub fn inflate_mesh(mesh: tubemem_mesh::Mesh, target: f64) -> (Model, MidSpan, usize) {
         let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
         let mut model = Model::new(mesh, Box::new(law)).unwrap();
         let node = nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
@@ -556,6 +560,89 @@ fn assembled_tangents_match_finite_differences_including_gas() {
                     av[i]
                 );
             }
+        }
+    }
+}
+
+/// Rigid plugs instead of caps (an open cylinder tied to two rigid discs that translate
+/// axially and carry p·A): far from the plugs the tube is the same n-gon prism, so the
+/// mid-span matches GPS exactly as for the capped tube (same tolerances and reasons as
+/// `capped_tube_midspan_matches_gps_at_ls_1_3`). The ring at the plug keeps radius R, so the
+/// boundary layer is longer than with caps.
+#[test]
+fn plugged_tube_midspan_matches_gps() {
+    use tubemem_gps::{inflate, Hypothesis};
+    use tubemem_mesh::{tube::plugged_tube, Symmetry};
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let n = 32;
+    let (model, ms, _) = tube::inflate_mesh(
+        plugged_tube(1.0, 20.0, n, 80, Symmetry::Eighth).unwrap(),
+        1.3,
+    );
+    assert_eq!(model.mesh.plugs.len(), 1);
+    let g = inflate(&law, Hypothesis::Gps, ms.lambda_s).unwrap();
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    assert!(
+        rel(ms.lambda_z, g.lambda_z) < 1e-6,
+        "λz {} vs {}",
+        ms.lambda_z,
+        g.lambda_z
+    );
+    assert!(rel(ms.n_s, g.n_s) < 1e-6 && rel(ms.n_z, g.n_z) < 1e-6);
+    let apothem = (std::f64::consts::PI / n as f64).cos();
+    assert!(
+        rel(ms.w * apothem, g.w) < 1e-6,
+        "ϖ cos(π/n) {} vs {}",
+        ms.w * apothem,
+        g.w
+    );
+    // the ring at the plug stays at radius R
+    let ring = &model.mesh.plugs[0];
+    let st = model.reference_state();
+    assert!(ring
+        .iter()
+        .all(|&i| (st.x[i][0].hypot(st.x[i][1]) - 1.0).abs() < 1e-12));
+}
+
+/// The assembled tangent of a plugged tube (shared plug equations, disc face volume) against
+/// finite differences, as in `assembled_tangents_match_finite_differences_including_gas`.
+#[test]
+fn plugged_tube_tangent_matches_finite_differences() {
+    use crate::model::{Control, Model};
+    use rand::{Rng, SeedableRng};
+    use tubemem_mesh::{tube::plugged_tube, Symmetry};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(22);
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let mut model = Model::new(
+        plugged_tube(1.0, 3.0, 8, 6, Symmetry::None).unwrap(),
+        Box::new(law),
+    )
+    .unwrap();
+    let mut st = model.reference_state();
+    model.solve(&mut st, Control::Pressure(0.3)).unwrap();
+    let v_total = model.mesh.volume_at(&st.x);
+    for control in [Control::Pressure(0.3), Control::Gas { pv: 0.3 * v_total }] {
+        let v: Vec<f64> = (0..model.n_eq)
+            .map(|_| rng.random_range(-1.0..1.0))
+            .collect();
+        let av = model.tangent_times(&st.x, control, 0.3, &v).unwrap();
+        let h = 1e-6;
+        let shifted = |t: f64| {
+            let mut x = st.x.clone();
+            for (d, e) in model.eq.iter().enumerate() {
+                if let Some(k) = e {
+                    x[d / 3][d % 3] += t * v[*k];
+                }
+            }
+            model.residual(&x, control, 0.3).unwrap()
+        };
+        let (rp, rm) = (shifted(h), shifted(-h));
+        let scale = av.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+        for i in 0..model.n_eq {
+            assert!(
+                ((rp[i] - rm[i]) / (2.0 * h) - av[i]).abs() <= 1e-6 * scale,
+                "{control:?} row {i}"
+            );
         }
     }
 }

@@ -116,6 +116,9 @@ pub struct Mesh {
     pub nodes: Vec<[f64; 3]>,
     pub quads: Vec<[usize; 4]>,
     pub symmetry: Symmetry,
+    /// Rigid end plugs: each is a ring of nodes (sorted by angle) tied to a rigid disc that may
+    /// translate axially. The surface may be open along a plug ring; the disc face closes it.
+    pub plugs: Vec<Vec<usize>>,
 }
 
 /// Distance below which a node counts as lying on a symmetry plane, relative to the mesh size.
@@ -144,8 +147,18 @@ impl Mesh {
         self.volume_at(&self.nodes)
     }
 
-    /// The enclosed volume with the nodes at `x` (same connectivity).
+    /// The enclosed volume with the nodes at `x` (same connectivity), plug faces included.
     pub fn volume_at(&self, x: &[[f64; 3]]) -> f64 {
+        self.membrane_volume_at(x)
+            + self
+                .plugs
+                .iter()
+                .map(|r| plug_face(x, r).volume())
+                .sum::<f64>()
+    }
+
+    /// (1/3) Σ ∫ x·(g1 × g2) over the membrane elements only.
+    pub fn membrane_volume_at(&self, x: &[[f64; 3]]) -> f64 {
         self.quads
             .iter()
             .map(|q| {
@@ -227,7 +240,11 @@ impl Mesh {
                         .planes()
                         .iter()
                         .any(|&ax| on[ax][key.0] && on[ax][key.1]);
-                    if !on_sym {
+                    let on_plug = self
+                        .plugs
+                        .iter()
+                        .any(|r| r.contains(&key.0) && r.contains(&key.1));
+                    if !on_sym && !on_plug {
                         return Err(MeshError::Open {
                             a: key.0,
                             b: key.1,
@@ -267,6 +284,47 @@ impl Mesh {
             return Err(MeshError::InwardNormals { volume: v });
         }
         Ok(())
+    }
+}
+
+/// The flat face of a rigid plug: its height z_d (mean z of the ring), its area (fan of
+/// triangles from the axis point (0, 0, z_d), so a ring cut by symmetry planes through the axis
+/// gives the matching sector) and its outward normal sign (+1 for the plug at z > 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlugFace {
+    pub z: f64,
+    pub area: f64,
+    pub sign: f64,
+}
+
+impl PlugFace {
+    /// (1/3) ∫ x·n dA over the face: (1/3) z_d · area · sign.
+    pub fn volume(&self) -> f64 {
+        self.z * self.area * self.sign / 3.0
+    }
+}
+
+/// The face of the plug whose ring is `ring` (sorted by angle), at positions `x`.
+pub fn plug_face(x: &[[f64; 3]], ring: &[usize]) -> PlugFace {
+    let z = ring.iter().map(|&i| x[i][2]).sum::<f64>() / ring.len().max(1) as f64;
+    let closed = {
+        // a full ring closes on itself: its first and last nodes are neighbours
+        let (a, b) = (x[ring[0]], x[ring[ring.len() - 1]]);
+        let ang = |p: [f64; 3]| p[1].atan2(p[0]);
+        let gap = (ang(a) - ang(b)).rem_euclid(std::f64::consts::TAU);
+        ring.len() > 2 && gap < 1.5 * std::f64::consts::TAU / ring.len() as f64
+    };
+    let n = ring.len();
+    let segs = if closed { n } else { n - 1 };
+    let mut area = 0.0;
+    for k in 0..segs {
+        let (p, q) = (x[ring[k]], x[ring[(k + 1) % n]]);
+        area += 0.5 * (p[0] * q[1] - p[1] * q[0]);
+    }
+    PlugFace {
+        z,
+        area: area.abs(),
+        sign: if z >= 0.0 { 1.0 } else { -1.0 },
     }
 }
 

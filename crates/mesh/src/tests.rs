@@ -3,7 +3,7 @@
 //! polyhedral volume converges at second order in the element size (chordal error O(h²)).
 
 use super::*;
-use crate::tube::{capped_tube, sphere};
+use crate::tube::{capped_tube, plugged_tube, sphere};
 use std::collections::HashSet;
 use std::f64::consts::PI;
 
@@ -210,4 +210,25 @@ fn vtu_writer_works_and_rejects_non_finite_fields() {
         &[],
     );
     assert!(e.unwrap_err().to_string().contains("non-finite"));
+}
+
+/// The plugged tube closes exactly with its disc faces: at reference its volume is the n-gon
+/// prism's, (n/2) R² sin(2π/n) · L, for the full tube and for the eighth (× 8).
+#[test]
+fn plugged_tube_works() {
+    let (r, l, n) = (1.0, 6.0, 16);
+    let exact = 0.5 * n as f64 * r * r * (2.0 * PI / n as f64).sin() * l;
+    let full = plugged_tube(r, l, n, 12, Symmetry::None).unwrap();
+    assert_eq!(full.quads.len(), n * 12);
+    assert_eq!(full.plugs.len(), 2);
+    assert!(full.plugs.iter().all(|p| p.len() == n));
+    assert!((full.volume() - exact).abs() < 1e-12 * exact);
+    let eighth = plugged_tube(r, l, n, 12, Symmetry::Eighth).unwrap();
+    assert_eq!(eighth.plugs.len(), 1);
+    assert_eq!(eighth.plugs[0].len(), n / 4 + 1);
+    assert!((8.0 * eighth.volume() - exact).abs() < 1e-12 * exact);
+    // open along the plug rings is allowed, elsewhere it is not
+    let mut broken = full.clone();
+    broken.plugs.pop();
+    assert!(matches!(broken.check(), Err(MeshError::Open { .. })));
 }

@@ -195,11 +195,80 @@ pub fn capped_tube(
             nodes,
             quads,
             symmetry: Symmetry::None,
+            plugs: vec![],
         },
         symmetry,
     );
     mesh.check()?;
     Ok(mesh)
+}
+
+/// An open cylinder of radius `radius` and length `length` whose end rings are tied to rigid
+/// discs (plugs) that may translate axially: the variant of the capped tube that matches how
+/// many actuators are built. Same `around`/`along` rules as [`capped_tube`].
+pub fn plugged_tube(
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
+    let capped = capped_tube(radius, length, around, along, Symmetry::None)?;
+    let half = 0.5 * length;
+    let tol = 1e-12 * (radius + length);
+    // keep the cylinder elements: every node within the cylinder's z range
+    let quads: Vec<[usize; 4]> = capped
+        .quads
+        .iter()
+        .filter(|q| q.iter().all(|&i| capped.nodes[i][2].abs() <= half + tol))
+        .copied()
+        .collect();
+    let mesh = renumber(Mesh { quads, ..capped });
+    let ring = |sign: f64| {
+        let mut r: Vec<usize> = (0..mesh.nodes.len())
+            .filter(|&i| (mesh.nodes[i][2] - sign * half).abs() <= tol)
+            .collect();
+        r.sort_by(|&a, &b| {
+            mesh.nodes[a][1]
+                .atan2(mesh.nodes[a][0])
+                .total_cmp(&mesh.nodes[b][1].atan2(mesh.nodes[b][0]))
+        });
+        r
+    };
+    let plugs = vec![ring(1.0), ring(-1.0)];
+    let mut mesh = reduce(Mesh { plugs, ..mesh }, symmetry);
+    mesh.plugs.retain(|r| !r.is_empty());
+    mesh.check()?;
+    Ok(mesh)
+}
+
+/// Drop unused nodes and renumber (in the original order, so numbering is deterministic);
+/// plug rings keep their used nodes.
+fn renumber(mesh: Mesh) -> Mesh {
+    let mut used = vec![false; mesh.nodes.len()];
+    for q in &mesh.quads {
+        for &i in q {
+            used[i] = true;
+        }
+    }
+    let mut new_id = vec![usize::MAX; mesh.nodes.len()];
+    let mut nodes = vec![];
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        if used[i] {
+            new_id[i] = nodes.len();
+            nodes.push(*p);
+        }
+    }
+    Mesh {
+        nodes,
+        quads: mesh.quads.iter().map(|q| q.map(|i| new_id[i])).collect(),
+        symmetry: mesh.symmetry,
+        plugs: mesh
+            .plugs
+            .iter()
+            .map(|r| r.iter().filter(|&&i| used[i]).map(|&i| new_id[i]).collect())
+            .collect(),
+    }
 }
 
 /// A sphere of radius `radius` centred at the origin: the equiangular cube-sphere with
@@ -228,6 +297,7 @@ pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshErr
             nodes,
             quads,
             symmetry: Symmetry::None,
+            plugs: vec![],
         },
         symmetry,
     );
@@ -241,7 +311,7 @@ pub fn reduce(mesh: Mesh, symmetry: Symmetry) -> Mesh {
     if symmetry == Symmetry::None {
         return mesh;
     }
-    let keep: Vec<[usize; 4]> = mesh
+    let quads: Vec<[usize; 4]> = mesh
         .quads
         .iter()
         .filter(|q| {
@@ -253,23 +323,9 @@ pub fn reduce(mesh: Mesh, symmetry: Symmetry) -> Mesh {
         })
         .copied()
         .collect();
-    let mut used = vec![false; mesh.nodes.len()];
-    for q in &keep {
-        for &i in q {
-            used[i] = true;
-        }
-    }
-    let mut new_id = vec![usize::MAX; mesh.nodes.len()];
-    let mut nodes = vec![];
-    for (i, p) in mesh.nodes.iter().enumerate() {
-        if used[i] {
-            new_id[i] = nodes.len();
-            nodes.push(*p);
-        }
-    }
-    Mesh {
-        nodes,
-        quads: keep.iter().map(|q| q.map(|i| new_id[i])).collect(),
+    renumber(Mesh {
+        quads,
         symmetry,
-    }
+        ..mesh
+    })
 }
