@@ -552,3 +552,64 @@ fn malformed_case_files_name_the_key_and_line() {
     }
     assert_clean_failure(&["run", "/nonexistent/case.toml"], "cannot read case file");
 }
+
+/// A run that cannot finish (𝒩 = 3 locks near λs ≈ 2.4 on the GPS path; the case asks for 3.0)
+/// fails with an error naming the stage, the step, the iterations and the residual, after every
+/// converged step is already on disk (steps.csv rows, their VTU frames, summary.json with the
+/// error and the last converged state).
+#[test]
+fn a_failing_run_keeps_every_converged_step() {
+    let text = SMALL_CASE
+        .replace("kuhn = 30", "kuhn = 3")
+        .replace("target_stretch = 1.2", "target_stretch = 3.0");
+    let case = write_case("run-fail", &text);
+    let out = case.parent().unwrap().join("out");
+    let o = tubemem(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(!err.contains("panicked"), "{err}");
+    for needle in [
+        "stage 1",
+        "step",
+        "iterations",
+        "residual",
+        "converged steps are in",
+    ] {
+        assert!(err.contains(needle), "`{needle}` missing from: {err}");
+    }
+    let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let rows = steps.lines().count() - 1;
+    assert!(
+        rows >= 2,
+        "converged steps were written before the failure:\n{steps}"
+    );
+    let last_ls: f64 = steps
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(3)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(last_ls > 1.5 && last_ls < 3.0, "{last_ls}");
+    let pvd = std::fs::read_to_string(out.join("tube.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), rows + 1);
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(s["stages"][0]["error"]
+        .as_str()
+        .unwrap()
+        .contains("did not converge"));
+    assert!(
+        s["stages"][0]["last_converged"]["lambda_s"]
+            .as_f64()
+            .unwrap()
+            > 1.5
+    );
+}
