@@ -17,6 +17,7 @@
 //! [mesh]
 //! around = 64           # elements around (multiple of 8)
 //! along = 160           # elements along the cylinder (even)
+//! cap_rows = 8          # optional: rows in each cap from equator to top face (default around/8)
 //! symmetry = "eighth"   # "none" | "half" | "quarter" | "eighth"
 //!
 //! [solver]              # optional
@@ -108,6 +109,8 @@ pub enum Caps {
 pub struct MeshSpec {
     pub around: usize,
     pub along: usize,
+    /// rows of elements in each cap between its equator and its top face (default around/8)
+    pub cap_rows: Option<usize>,
     #[serde(default)]
     pub symmetry: Symmetry,
 }

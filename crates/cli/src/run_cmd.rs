@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use tubemem_fem::model::{nearest_node, run_stage, Control, Model, Stage, State};
 use tubemem_fem::post::{cell_values, midspan, ring_profile, MidSpan, RingValues};
 use tubemem_gps::{inflate, Hypothesis};
-use tubemem_mesh::tube::{capped_tube, plugged_tube};
+use tubemem_mesh::tube::{capped_tube_with_cap_rows, plugged_tube};
 use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 
 const STEPS_HEADER: &str =
@@ -171,17 +171,14 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     let case = Case::read(case_path)?;
     let g = &case.geometry;
     let half = 0.5 * g.length / g.radius;
-    let build = match g.caps {
-        Caps::Hemisphere => capped_tube,
-        Caps::RigidPlug => plugged_tube,
-    };
-    let mesh = build(
-        1.0,
-        g.length / g.radius,
-        case.mesh.around,
-        case.mesh.along,
-        case.mesh.symmetry,
-    )
+    let (ll, around, along) = (g.length / g.radius, case.mesh.around, case.mesh.along);
+    let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
+    let mesh = match g.caps {
+        Caps::Hemisphere => {
+            capped_tube_with_cap_rows(1.0, ll, around, along, cap_rows, case.mesh.symmetry)
+        }
+        Caps::RigidPlug => plugged_tube(1.0, ll, around, along, case.mesh.symmetry),
+    }
     .context("[mesh]")?;
     let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;

@@ -432,12 +432,14 @@ fn closed_gas_equilibrium_matches_volume_control() {
     assert!(dx < 1e-8, "positions differ by {dx}");
 }
 
+/// Refinement table for the README (a documented command, not a check):
+/// `cargo test --release -p tubemem-fem tube_refinement_table -- --ignored --nocapture`
 #[test]
 #[ignore]
-fn tube_explore() {
+fn tube_refinement_table() {
     use tubemem_gps::{inflate, Hypothesis};
     let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
-    for (around, along) in [(32, 80), (64, 160)] {
+    for (around, along) in [(32, 80), (64, 160), (96, 240), (128, 320)] {
         let t = std::time::Instant::now();
         let (model, ms, steps) =
             tube::inflate(20.0, around, along, tubemem_mesh::Symmetry::Eighth, 1.3);

@@ -3,7 +3,7 @@
 //! polyhedral volume converges at second order in the element size (chordal error O(h²)).
 
 use super::*;
-use crate::tube::{capped_tube, plugged_tube, sphere};
+use crate::tube::{capped_tube, capped_tube_with_cap_rows, plugged_tube, sphere};
 use std::collections::HashSet;
 use std::f64::consts::PI;
 
@@ -231,4 +231,31 @@ fn plugged_tube_works() {
     let mut broken = full.clone();
     broken.plugs.pop();
     assert!(matches!(broken.check(), Err(MeshError::Open { .. })));
+}
+
+/// Cap resolution: `cap_rows` rows on the side faces of each half cube-sphere; the top face
+/// stays m × m. Element count m² + 4·m·rows per cap; more rows bring the cap's inscribed
+/// polyhedron closer to the hemisphere, so the volume error falls.
+#[test]
+fn cap_rows_refine_the_caps() {
+    let (r, l, around) = (1.0, 4.0, 16);
+    let m = around / 4;
+    let exact = PI * r * r * l + 4.0 / 3.0 * PI * r.powi(3);
+    let mut last = f64::INFINITY;
+    for rows in [1, 2, 4, 8] {
+        let mesh = capped_tube_with_cap_rows(r, l, around, 8, rows, Symmetry::None).unwrap();
+        assert_eq!(mesh.quads.len(), around * 8 + 2 * (m * m + 4 * m * rows));
+        assert_eq!(euler(&mesh), 2);
+        let e = (mesh.volume() - exact).abs();
+        assert!(e < last, "rows {rows}: {e} ≥ {last}");
+        last = e;
+        let eighth = capped_tube_with_cap_rows(r, l, around, 8, rows, Symmetry::Eighth).unwrap();
+        assert!((8.0 * eighth.volume() - mesh.volume()).abs() < 1e-12 * exact);
+    }
+    // the default is around/8 rows: the previous meshes
+    assert_eq!(
+        capped_tube(r, l, around, 8, Symmetry::None).unwrap(),
+        capped_tube_with_cap_rows(r, l, around, 8, 2, Symmetry::None).unwrap()
+    );
+    assert!(capped_tube_with_cap_rows(r, l, around, 8, 0, Symmetry::None).is_err());
 }

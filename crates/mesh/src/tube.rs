@@ -31,13 +31,12 @@ fn unit(c: [f64; 3]) -> [f64; 3] {
     [c[0] / n, c[1] / n, c[2] / n]
 }
 
-/// The lattice points and quads of the cube surface with k ≥ `k_min` (0: whole cube,
-/// m/2: upper half).
-fn cube_surface(m: usize, k_min: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
+/// The lattice points and quads of the whole cube surface (for the sphere).
+fn cube_surface(m: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
     let mut points = vec![];
     for i in 0..=m {
         for j in 0..=m {
-            for k in k_min..=m {
+            for k in 0..=m {
                 if i == 0 || i == m || j == 0 || j == m || k == 0 || k == m {
                     points.push([i, j, k]);
                 }
@@ -45,12 +44,7 @@ fn cube_surface(m: usize, k_min: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]
         }
     }
     let mut quads = vec![];
-    // Faces k = m and (whole cube only) k = 0: cells in (i, j).
-    let mut kfaces = vec![m];
-    if k_min == 0 {
-        kfaces.push(0);
-    }
-    for &k in &kfaces {
+    for k in [0, m] {
         for i in 0..m {
             for j in 0..m {
                 quads.push([[i, j, k], [i + 1, j, k], [i + 1, j + 1, k], [i, j + 1, k]]);
@@ -59,14 +53,67 @@ fn cube_surface(m: usize, k_min: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]
     }
     for i in [0, m] {
         for j in 0..m {
-            for k in k_min..m {
+            for k in 0..m {
                 quads.push([[i, j, k], [i, j + 1, k], [i, j + 1, k + 1], [i, j, k + 1]]);
             }
         }
     }
     for j in [0, m] {
         for i in 0..m {
-            for k in k_min..m {
+            for k in 0..m {
+                quads.push([[i, j, k], [i + 1, j, k], [i + 1, j, k + 1], [i, j, k + 1]]);
+            }
+        }
+    }
+    (points, quads)
+}
+
+/// Cube coordinate of row `k` of `rows` on a side face of the half cube: 0 at the equator,
+/// exactly 1 at the top face, equiangular in between.
+fn latitude(k: usize, rows: usize) -> f64 {
+    if k == 0 {
+        0.0
+    } else if k == rows {
+        1.0
+    } else {
+        (FRAC_PI_4 * k as f64 / rows as f64).tan()
+    }
+}
+
+/// The upper half of the cube surface for a cap: lattice points (i, j, k) with k the row on the
+/// side faces (0 = equator, `rows` = the top face), and its quads.
+fn half_cube(m: usize, rows: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
+    let mut points = vec![];
+    for i in 0..=m {
+        for j in 0..=m {
+            for k in 0..=rows {
+                if (k == rows) || i == 0 || i == m || j == 0 || j == m {
+                    points.push([i, j, k]);
+                }
+            }
+        }
+    }
+    let mut quads = vec![];
+    for i in 0..m {
+        for j in 0..m {
+            quads.push([
+                [i, j, rows],
+                [i + 1, j, rows],
+                [i + 1, j + 1, rows],
+                [i, j + 1, rows],
+            ]);
+        }
+    }
+    for i in [0, m] {
+        for j in 0..m {
+            for k in 0..rows {
+                quads.push([[i, j, k], [i, j + 1, k], [i, j + 1, k + 1], [i, j, k + 1]]);
+            }
+        }
+    }
+    for j in [0, m] {
+        for i in 0..m {
+            for k in 0..rows {
                 quads.push([[i, j, k], [i + 1, j, k], [i + 1, j, k + 1], [i, j, k + 1]]);
             }
         }
@@ -119,7 +166,9 @@ fn check_positive(name: &'static str, v: f64) -> Result<(), MeshError> {
 
 /// A capped tube: cylinder radius `radius`, cylinder length `length` (along z, centred at the
 /// origin), hemispherical caps, `around` elements around (multiple of 8, ≥ 8) and `along`
-/// elements along the cylinder (even, ≥ 2), reduced by `symmetry`.
+/// elements along the cylinder (even, ≥ 2), reduced by `symmetry`. The caps have the default
+/// `around/8` rows of elements between the equator and the top face (see
+/// [`capped_tube_with_cap_rows`]).
 pub fn capped_tube(
     radius: f64,
     length: f64,
@@ -127,6 +176,29 @@ pub fn capped_tube(
     along: usize,
     symmetry: Symmetry,
 ) -> Result<Mesh, MeshError> {
+    capped_tube_with_cap_rows(radius, length, around, along, around / 8, symmetry)
+}
+
+/// As [`capped_tube`], with `cap_rows` rows of elements (≥ 1) on the side faces of each half
+/// cube-sphere, between the equator and the edge of the top face (latitudes 0 to 45°); the top
+/// face keeps (around/4)² elements, as conformity with the side faces requires. The rows are
+/// equiangular in latitude: z = tan(π/4 · k/cap_rows) on the cube.
+pub fn capped_tube_with_cap_rows(
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    cap_rows: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
+    if cap_rows == 0 {
+        return Err(MeshError::InvalidParameter {
+            name: "cap_rows",
+            value: 0.0,
+            requirement:
+                "a cap needs at least one row of elements between its equator and its top face",
+        });
+    }
     check_positive("radius", radius)?;
     check_positive("length", length)?;
     if around < 8 || around % 8 != 0 {
@@ -168,14 +240,18 @@ pub fn capped_tube(
     }
     let ring_of: HashMap<(usize, usize), usize> =
         per.iter().enumerate().map(|(p, &ij)| (ij, p)).collect();
-    let (points, cells) = cube_surface(m, m / 2);
+    let (points, cells) = half_cube(m, cap_rows);
     for (sign, ring) in [(1.0, along), (-1.0, 0)] {
         let mut id: HashMap<[usize; 3], usize> = HashMap::new();
         for pt in &points {
-            if 2 * pt[2] == m {
+            if pt[2] == 0 {
                 id.insert(*pt, ring * np + ring_of[&(pt[0], pt[1])]);
             } else {
-                let d = unit([lattice(pt[0], m), lattice(pt[1], m), lattice(pt[2], m)]);
+                let d = unit([
+                    lattice(pt[0], m),
+                    lattice(pt[1], m),
+                    latitude(pt[2], cap_rows),
+                ]);
                 id.insert(*pt, nodes.len());
                 nodes.push([
                     radius * d[0],
@@ -282,7 +358,7 @@ pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshErr
             requirement: "elements per cube-face edge must be even (≥ 2)",
         });
     }
-    let (points, cells) = cube_surface(m, 0);
+    let (points, cells) = cube_surface(m);
     let mut id = HashMap::new();
     let mut nodes = vec![];
     for pt in &points {
