@@ -134,29 +134,26 @@ fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
     let mut f = BufWriter::new(
         File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
     );
-    writeln!(f, "z_ref,z,lambda_s,lambda_z,radius")?;
+    writeln!(f, "z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz")?;
     for r in rings {
+        let v = &r.values;
         writeln!(
             f,
-            "{},{},{},{},{}",
-            r.z_ref, r.z, r.lambda_s, r.lambda_z, r.radius
+            "{},{},{},{},{},{},{},{}",
+            r.z_ref, r.z, r.radius, v.lambda_s, v.lambda_z, v.n_s, v.n_z, v.n_sz
         )?;
     }
     Ok(())
 }
 
-/// Distance (in R) from the cap junction at which λs stays within `tol` of its mid-span value
-/// all the way to mid-span; `None` if it never does.
+/// Distance (in R) from the cap junction (or plug) at which λs comes within `tol` of its
+/// mid-span value and stays there all the way to mid-span; `None` if it never does.
 pub fn boundary_layer(rings: &[RingValues], half_length: f64, mid: f64, tol: f64) -> Option<f64> {
     let mut side: Vec<&RingValues> = rings.iter().filter(|r| r.z_ref >= -1e-12).collect();
     side.sort_by(|a, b| b.z_ref.total_cmp(&a.z_ref)); // from the junction inwards
-    let first_inside = side
-        .iter()
-        .position(|r| ((r.lambda_s - mid) / mid).abs() <= tol)?;
-    if side[first_inside..]
-        .iter()
-        .all(|r| ((r.lambda_s - mid) / mid).abs() <= tol)
-    {
+    let within = |r: &&RingValues| ((r.values.lambda_s - mid) / mid).abs() <= tol;
+    let first_inside = side.iter().position(within)?;
+    if side[first_inside..].iter().all(within) {
         Some(half_length - side[first_inside].z_ref)
     } else {
         None
@@ -303,7 +300,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
         let ms = midspan(&model, &state)?;
         let gps = inflate(closed_form_law.as_ref(), Hypothesis::Gps, ms.lambda_s)?;
         let ps = inflate(closed_form_law.as_ref(), Hypothesis::Ps, ms.lambda_s)?;
-        let rings = ring_profile(&model, &state);
+        let rings = ring_profile(&model, &state)?;
         let profile = out
             .join("profiles")
             .join(format!("stage{}_final.csv", i + 1));

@@ -35,11 +35,11 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
-/// The reference-ring nodes at Z = 0, sorted by angle.
-pub fn midspan_ring(model: &Model) -> Vec<usize> {
+/// The nodes of the reference ring at height `z` (on the cylinder), sorted by angle.
+pub fn ring_at(model: &Model, z: f64) -> Vec<usize> {
     let tol = 1e-9 * model.mesh.scale();
     let mut ring: Vec<usize> = (0..model.mesh.nodes.len())
-        .filter(|&i| model.mesh.nodes[i][2].abs() <= tol)
+        .filter(|&i| (model.mesh.nodes[i][2] - z).abs() <= tol)
         .collect();
     ring.sort_by(|&a, &b| {
         let ang = |i: usize| model.mesh.nodes[i][1].atan2(model.mesh.nodes[i][0]);
@@ -48,20 +48,31 @@ pub fn midspan_ring(model: &Model) -> Vec<usize> {
     ring
 }
 
+/// The reference-ring nodes at Z = 0, sorted by angle.
+pub fn midspan_ring(model: &Model) -> Vec<usize> {
+    ring_at(model, 0.0)
+}
+
+/// Mid-span values: [`ring_state`] at Z = 0.
 pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
+    ring_state(model, state, &midspan_ring(model))
+}
+
+/// The values of the module header at one ring of nodes (sorted by angle): perimeter ratio,
+/// meridian stretch of the edges leaving the ring, and resultants averaged over the Gauss
+/// points of the elements that touch it. `volume` is the total enclosed volume.
+pub fn ring_state(model: &Model, state: &State, ring: &[usize]) -> Result<MidSpan, FemError> {
     let mesh = &model.mesh;
-    let ring = midspan_ring(model);
-    let closed = mesh.symmetry.planes().len() <= 1; // None and Half keep the whole ring
+    let closed = mesh.symmetry.planes().iter().all(|&ax| ax == 2); // x = 0 / y = 0 cut the ring
     let mut cur = 0.0;
     let mut reference = 0.0;
     let n = ring.len();
-    let segments = if closed { n } else { n - 1 };
+    let segments = if closed { n } else { n.saturating_sub(1) };
     for k in 0..segments {
         let (a, b) = (ring[k], ring[(k + 1) % n]);
         cur += dist(state.x[a], state.x[b]);
         reference += dist(mesh.nodes[a], mesh.nodes[b]);
     }
-    // meridian edges leaving the ring, and the elements touching it
     let on_ring: std::collections::HashSet<usize> = ring.iter().copied().collect();
     let mut lz_sum = 0.0;
     let mut lz_n = 0usize;
@@ -89,11 +100,11 @@ pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
                 }
             })?;
             // reference hoop direction at the Gauss point and its image F T
-            let xr: [f64; 3] = (0..3)
-                .map(|c| (0..4).map(|a| el.n[g][a] * mesh.nodes[q[a]][c]).sum())
-                .collect::<Vec<_>>()
-                .try_into()
-                .unwrap_or([0.0; 3]);
+            let xr = [0, 1, 2].map(|c| {
+                (0..4)
+                    .map(|a| el.n[g][a] * mesh.nodes[q[a]][c])
+                    .sum::<f64>()
+            });
             let t_ref = unit([-xr[1], xr[0], 0.0]);
             let f = el.gradient(g, &xe);
             let [e1, e2] = el.frame[g];
@@ -114,7 +125,7 @@ pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
     let ng = ng.max(1) as f64;
     Ok(MidSpan {
         w: state.p,
-        lambda_s: cur / reference,
+        lambda_s: cur / reference.max(1e-300),
         lambda_z: lz_sum / lz_n.max(1) as f64,
         n_s: ns / ng,
         n_z: nz / ng,
@@ -192,94 +203,51 @@ pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemE
         .collect()
 }
 
-/// One ring of the cylinder at reference height Z.
+/// One ring of the cylinder at reference height Z: the [`ring_state`] values there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RingValues {
     /// reference height Z (in R)
     pub z_ref: f64,
     /// current mean height
     pub z: f64,
-    /// ring perimeter ratio
-    pub lambda_s: f64,
-    /// mean meridian stretch of the edges leaving the ring (average of both sides)
-    pub lambda_z: f64,
-    /// mean radial distance from the axis
+    /// mean distance from the axis
     pub radius: f64,
+    pub values: MidSpan,
 }
 
-/// Profiles along the cylinder: one entry per ring of nodes with the same reference Z (rings
-/// on the cylinder part only, |Z| ≤ L/2, where L/2 is the largest |Z| at reference radius R).
-pub fn ring_profile(model: &Model, state: &State) -> Vec<RingValues> {
+/// Profiles along the cylinder: one entry per ring of nodes at the reference radius (the
+/// cylinder and the cap equators), from the lowest Z to the highest.
+pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, FemError> {
     let mesh = &model.mesh;
     let tol = 1e-9 * mesh.scale();
     let radius = mesh
         .nodes
         .iter()
-        .map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt())
+        .map(|p| p[0].hypot(p[1]))
         .fold(0.0, f64::max);
-    let mut rings: std::collections::BTreeMap<i64, Vec<usize>> = Default::default();
-    for (i, p) in mesh.nodes.iter().enumerate() {
-        let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
-        if (r - radius).abs() <= 1e-9 * radius {
-            rings
-                .entry((p[2] / tol).round() as i64)
-                .or_default()
-                .push(i);
-        }
-    }
-    // the cylinder ends where rings of full size stop; the cap equator ring belongs to it
-    let closed = mesh.symmetry.planes().iter().all(|&ax| ax == 2);
-    let mut out = vec![];
-    let zs: Vec<i64> = rings.keys().copied().collect();
-    let edge_stretch = |a: &[usize], b: &[usize]| {
-        // pair the nodes of two neighbouring rings by reference angle
-        let mut s = 0.0;
-        let mut n = 0;
-        for &i in a {
-            let ang = mesh.nodes[i][1].atan2(mesh.nodes[i][0]);
-            if let Some(&j) = b.iter().min_by(|&&p, &&q| {
-                let d = |k: usize| (mesh.nodes[k][1].atan2(mesh.nodes[k][0]) - ang).abs();
-                d(p).total_cmp(&d(q))
-            }) {
-                s += dist(state.x[i], state.x[j]) / dist(mesh.nodes[i], mesh.nodes[j]);
-                n += 1;
-            }
-        }
-        s / n.max(1) as f64
-    };
-    for (k, z) in zs.iter().enumerate() {
-        let mut ring = rings[z].clone();
-        ring.sort_by(|&a, &b| {
-            mesh.nodes[a][1]
-                .atan2(mesh.nodes[a][0])
-                .total_cmp(&mesh.nodes[b][1].atan2(mesh.nodes[b][0]))
-        });
-        let n = ring.len();
-        let segs = if closed { n } else { n.saturating_sub(1) };
-        let (mut cur, mut refl) = (0.0, 0.0);
-        for s in 0..segs {
-            let (a, b) = (ring[s], ring[(s + 1) % n]);
-            cur += dist(state.x[a], state.x[b]);
-            refl += dist(mesh.nodes[a], mesh.nodes[b]);
-        }
-        let mut lz = vec![];
-        if k > 0 {
-            lz.push(edge_stretch(&ring, &rings[&zs[k - 1]]));
-        }
-        if k + 1 < zs.len() {
-            lz.push(edge_stretch(&ring, &rings[&zs[k + 1]]));
-        }
-        out.push(RingValues {
-            z_ref: mesh.nodes[ring[0]][2],
-            z: ring.iter().map(|&i| state.x[i][2]).sum::<f64>() / n as f64,
-            lambda_s: cur / refl.max(1e-300),
-            lambda_z: lz.iter().sum::<f64>() / lz.len().max(1) as f64,
-            radius: ring
-                .iter()
-                .map(|&i| (state.x[i][0].powi(2) + state.x[i][1].powi(2)).sqrt())
-                .sum::<f64>()
-                / n as f64,
-        });
-    }
-    out
+    let mut heights: Vec<f64> = mesh
+        .nodes
+        .iter()
+        .filter(|p| (p[0].hypot(p[1]) - radius).abs() <= 1e-9 * radius)
+        .map(|p| p[2])
+        .collect();
+    heights.sort_by(f64::total_cmp);
+    heights.dedup_by(|a, b| (*a - *b).abs() <= tol);
+    heights
+        .into_iter()
+        .map(|z| {
+            let ring = ring_at(model, z);
+            let n = ring.len() as f64;
+            Ok(RingValues {
+                z_ref: z,
+                z: ring.iter().map(|&i| state.x[i][2]).sum::<f64>() / n,
+                radius: ring
+                    .iter()
+                    .map(|&i| state.x[i][0].hypot(state.x[i][1]))
+                    .sum::<f64>()
+                    / n,
+                values: ring_state(model, state, &ring)?,
+            })
+        })
+        .collect()
 }
