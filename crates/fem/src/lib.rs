@@ -13,6 +13,7 @@
 // `!(a > b)` is deliberate where NaN must fail the test.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod contact;
 pub mod element;
 pub mod linsolve;
 pub mod model;

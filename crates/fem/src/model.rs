@@ -17,6 +17,7 @@
 //! #neg(K + c ggᵀ) = #neg(K) − [1 + c gᵀK⁻¹g < 0], and on the constraint subspace
 //! #neg = #neg(K) − [hᵀK⁻¹g < 0].
 
+use crate::contact::{contact_kernel, Plane};
 use crate::element::{membrane_kernel, RefElement};
 use crate::linsolve::SparseLdlt;
 use crate::volume::volume_kernel;
@@ -40,6 +41,35 @@ pub enum Control {
     },
     /// closed isothermal gas: p · V_total = `pv` (Boyle's constant)
     Gas { pv: f64 },
+    /// closed gas and two rigid plates y = ±`half_gap` (normal ∓e_y), displacement controlled
+    Squeeze { pv: f64, half_gap: f64 },
+}
+
+impl Control {
+    /// Boyle's constant, for the closed-gas controls.
+    pub fn gas(&self) -> Option<f64> {
+        match *self {
+            Control::Gas { pv } | Control::Squeeze { pv, .. } => Some(pv),
+            _ => None,
+        }
+    }
+
+    /// The rigid plates this control places.
+    pub fn plates(&self) -> Vec<Plane> {
+        match *self {
+            Control::Squeeze { half_gap, .. } => vec![
+                Plane {
+                    normal: [0.0, -1.0, 0.0],
+                    offset: -half_gap,
+                },
+                Plane {
+                    normal: [0.0, 1.0, 0.0],
+                    offset: -half_gap,
+                },
+            ],
+            _ => vec![],
+        }
+    }
 }
 
 /// A converged (or trial) configuration.
@@ -116,6 +146,10 @@ pub struct Model {
     plug_eq: Vec<Option<usize>>,
     ldlt: SparseLdlt,
     pub settings: NewtonSettings,
+    /// rigid planes always present (any number, any orientation)
+    pub planes: Vec<Plane>,
+    /// contact penalty κ (per unit μH/R², see `contact::penalty_for`)
+    pub penalty: f64,
 }
 
 impl Model {
@@ -228,6 +262,8 @@ impl Model {
             plug_eq,
             ldlt,
             settings: NewtonSettings::default(),
+            planes: vec![],
+            penalty: 0.0,
         })
     }
 
@@ -248,7 +284,21 @@ impl Model {
     /// values. Element kernels run in parallel; every sum is taken in element order, so the result
     /// does not depend on the number of threads.
     pub fn assemble(&self, x: &[[f64; 3]], tangent: bool) -> Result<Assembled, FemError> {
+        self.assemble_with(x, tangent, &[])
+    }
+
+    /// All contact planes for a control: the model's own and the control's plates.
+    pub fn contact_planes(&self, control: Control) -> Vec<Plane> {
+        let mut p = self.planes.clone();
+        p.extend(control.plates());
+        p
+    }
+
+    /// [`Model::assemble`] with contact against `extra` planes (added to the model's own).
+    pub fn assemble_with(&self, x: &[[f64; 3]], tangent: bool, extra: &[Plane]) -> Result<Assembled, FemError> {
         let law = self.law.as_ref();
+        let planes: Vec<Plane> = self.planes.iter().chain(extra).copied().collect();
+        let kappa = self.penalty;
         let locals: Vec<Result<Local, FemError>> = self
             .elements
             .par_iter()
@@ -269,6 +319,9 @@ impl Model {
                         gauss_point: gp,
                         source,
                     })?;
+                if !planes.is_empty() {
+                    l.energy += contact_kernel(el, &xe, &planes, kappa, &mut l.r, tangent.then_some(&mut l.k));
+                }
                 l.v = volume_kernel(&xe, &mut l.g, tangent.then_some(&mut l.h));
                 Ok(l)
             })
@@ -371,13 +424,14 @@ impl Model {
         if let Control::Pressure(p) = control {
             state.p = p;
         }
+        let plates = control.plates();
         let mut last = f64::INFINITY;
         for it in 0..=settings.max_iterations {
-            let a = match self.assemble(&state.x, true) {
+            let a = match self.assemble_with(&state.x, true, &plates) {
                 Ok(a) => a,
                 Err(_) => return Err((it, f64::INFINITY)),
             };
-            if let Control::Gas { pv } = control {
+            if let Some(pv) = control.gas() {
                 state.p = pv / (m * a.volume);
             }
             let p = state.p;
@@ -414,7 +468,7 @@ impl Model {
             let mut dp = 0.0;
             let mut negative = neg;
             match (control, &h) {
-                (Control::Gas { .. }, _) => {
+                (c, _) if c.gas().is_some() => {
                     let cc = p / a.volume;
                     let mut b = a.g.clone();
                     self.ldlt.solve(&mut b);
@@ -478,9 +532,9 @@ impl Model {
                 state.x.clone_from(&x0);
                 self.apply(&mut state.x, &dx, t);
                 state.p = p0 + t * dp;
-                if let Ok(trial) = self.assemble(&state.x, false) {
+                if let Ok(trial) = self.assemble_with(&state.x, false, &plates) {
                     let pt = match control {
-                        Control::Gas { pv } => pv / (m * trial.volume),
+                        c if c.gas().is_some() => c.gas().unwrap_or(0.0) / (m * trial.volume),
                         _ => state.p,
                     };
                     let rt: Vec<f64> = trial
@@ -513,9 +567,9 @@ impl Model {
     /// The residual R = f_int − p ∂V/∂x on the free dofs, with p = `p` or, for closed gas,
     /// p = pv/(m V_part) (for tests and diagnostics).
     pub fn residual(&self, x: &[[f64; 3]], control: Control, p: f64) -> Result<Vec<f64>, FemError> {
-        let a = self.assemble(x, false)?;
-        let p = match control {
-            Control::Gas { pv } => pv / (self.multiplicity() * a.volume),
+        let a = self.assemble_with(x, false, &control.plates())?;
+        let p = match control.gas() {
+            Some(pv) => pv / (self.multiplicity() * a.volume),
             _ => p,
         };
         Ok(a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect())
@@ -530,9 +584,9 @@ impl Model {
         p: f64,
         v: &[f64],
     ) -> Result<Vec<f64>, FemError> {
-        let a = self.assemble(x, true)?;
-        let p = match control {
-            Control::Gas { pv } => pv / (self.multiplicity() * a.volume),
+        let a = self.assemble_with(x, true, &control.plates())?;
+        let p = match control.gas() {
+            Some(pv) => pv / (self.multiplicity() * a.volume),
             _ => p,
         };
         let mut out = vec![0.0; self.n_eq];
@@ -553,7 +607,7 @@ impl Model {
                 k += 1;
             }
         }
-        if let Control::Gas { .. } = control {
+        if control.gas().is_some() {
             let gv: f64 = a.g.iter().zip(v).map(|(g, v)| g * v).sum();
             for (o, g) in out.iter_mut().zip(&a.g) {
                 *o += p / a.volume * g * gv;

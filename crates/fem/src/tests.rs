@@ -499,8 +499,9 @@ fn results_do_not_depend_on_the_thread_count() {
 }
 
 /// The assembled tangents against central differences of the assembled residual, along random
-/// directions, for pressure and closed-gas loading (the latter includes the never-assembled
-/// rank-one term (p/V) g gᵀ). Step 1e-6; tolerance 1e-6 relative to |A v| (FD truncation ~1e-11,
+/// directions, for pressure, closed-gas and squeeze loading (closed gas includes the
+/// never-assembled rank-one term (p/V) g gᵀ; squeeze adds penalty contact with a plate that
+/// penetrates some Gauss points). Step 1e-6; tolerance 1e-6 relative to |A v| (FD truncation ~1e-11,
 /// rounding ~1e-9 relative here).
 #[test]
 fn assembled_tangents_match_finite_differences_including_gas() {
@@ -531,11 +532,22 @@ fn assembled_tangents_match_finite_differences_including_gas() {
         }
     }
     let v_part = model.mesh.volume_at(&st.x);
+    let ymax = st.x.iter().map(|p| p[1]).fold(0.0, f64::max);
+    model.penalty = 50.0;
+    let squeeze = Control::Squeeze {
+        pv: 0.4 * model.multiplicity() * v_part,
+        half_gap: 0.7 * ymax,
+    };
+    // the plate does penetrate some Gauss points
+    let with = model.assemble_with(&st.x, false, &squeeze.plates()).unwrap();
+    let without = model.assemble(&st.x, false).unwrap();
+    assert!(with.energy > without.energy, "no contact in the test state");
     for control in [
         Control::Pressure(0.4),
         Control::Gas {
             pv: 0.4 * model.multiplicity() * v_part,
         },
+        squeeze,
     ] {
         for _ in 0..3 {
             let v: Vec<f64> = (0..model.n_eq)
