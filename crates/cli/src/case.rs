@@ -133,7 +133,14 @@ pub enum ControlKind {
 #[serde(deny_unknown_fields)]
 pub struct StageSpec {
     pub kind: Kind,
-    pub control: ControlKind,
+    /// inflate only: "pressure" or "volume" (a squeeze keeps the gas closed)
+    pub control: Option<ControlKind>,
+    /// squeeze only: the final half-gap ρ = r/R between the plates
+    pub target_rho: Option<f64>,
+    /// squeeze only: penetration (in R) at the gas pressure that sets the penalty κ = ϖ/tol
+    /// (default 1e-3), or the penalty itself
+    pub penetration_tolerance: Option<f64>,
+    pub penalty: Option<f64>,
     pub target_pressure: Option<f64>,
     pub target_stretch: Option<f64>,
     pub target_volume_ratio: Option<f64>,
@@ -154,6 +161,8 @@ pub enum Target {
     Stretch(f64),
     /// total enclosed volume over its reference value, volume control
     VolumeRatio(f64),
+    /// squeeze between plates y = ±ρR with the gas closed in
+    Rho(f64),
 }
 
 impl StageSpec {
@@ -162,29 +171,65 @@ impl StageSpec {
             self.target_pressure,
             self.target_stretch,
             self.target_volume_ratio,
+            self.target_rho,
         );
-        let t = match (self.control, which) {
-            (ControlKind::Pressure, (Some(p), None, None)) => Target::Pressure(p),
-            (ControlKind::Volume, (None, Some(s), None)) => Target::Stretch(s),
-            (ControlKind::Volume, (None, None, Some(v))) => Target::VolumeRatio(v),
-            (ControlKind::Pressure, _) => {
+        let t = match (self.kind, self.control, which) {
+            (Kind::Inflate, Some(ControlKind::Pressure), (Some(p), None, None, None)) => Target::Pressure(p),
+            (Kind::Inflate, Some(ControlKind::Volume), (None, Some(s), None, None)) => Target::Stretch(s),
+            (Kind::Inflate, Some(ControlKind::Volume), (None, None, Some(v), None)) => Target::VolumeRatio(v),
+            (Kind::Inflate, None, _) => bail!("[[stage]] {}: kind = \"inflate\" needs `control` (\"pressure\" or \"volume\")", i + 1),
+            (Kind::Inflate, Some(ControlKind::Pressure), _) => {
                 bail!("[[stage]] {}: control = \"pressure\" takes exactly one target, `target_pressure`", i + 1)
             }
-            (ControlKind::Volume, _) => bail!(
+            (Kind::Inflate, Some(ControlKind::Volume), _) => bail!(
                 "[[stage]] {}: control = \"volume\" takes exactly one target, `target_stretch` (mid-span λs*) or `target_volume_ratio`",
                 i + 1
             ),
+            (Kind::Squeeze, Some(_), _) => bail!(
+                "[[stage]] {}: a squeeze keeps the gas closed (Boyle); it takes no `control`",
+                i + 1
+            ),
+            (Kind::Squeeze, None, (None, None, None, Some(r))) => Target::Rho(r),
+            (Kind::Squeeze, None, _) => bail!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
         };
         let (name, v, ok) = match t {
             Target::Pressure(p) => ("target_pressure", p, p.is_finite() && p >= 0.0),
             Target::Stretch(s) => ("target_stretch", s, s.is_finite() && s >= 1.0),
             Target::VolumeRatio(r) => ("target_volume_ratio", r, r.is_finite() && r >= 1.0),
+            Target::Rho(r) => ("target_rho", r, r.is_finite() && r > 0.0),
         };
         if !ok {
-            bail!("[[stage]] {}: `{name}` = {v} is out of range (pressure ≥ 0, stretch ≥ 1, volume ratio ≥ 1)", i + 1);
+            bail!(
+                "[[stage]] {}: `{name}` = {v} is out of range (pressure ≥ 0, stretch ≥ 1, volume ratio ≥ 1, rho > 0)",
+                i + 1
+            );
         }
         if self.steps == 0 {
             bail!("[[stage]] {}: `steps` must be ≥ 1", i + 1);
+        }
+        if self.kind == Kind::Inflate
+            && (self.penalty.is_some() || self.penetration_tolerance.is_some())
+        {
+            bail!(
+                "[[stage]] {}: `penalty` and `penetration_tolerance` belong to squeeze stages",
+                i + 1
+            );
+        }
+        if let Some(t) = self.penetration_tolerance {
+            if !(t.is_finite() && t > 0.0 && t < 0.1) {
+                bail!(
+                    "[[stage]] {}: `penetration_tolerance` = {t}: must be in (0, 0.1) (in R)",
+                    i + 1
+                );
+            }
+        }
+        if let Some(k) = self.penalty {
+            if !(k.is_finite() && k > 0.0) {
+                bail!(
+                    "[[stage]] {}: `penalty` = {k}: must be finite and > 0",
+                    i + 1
+                );
+            }
         }
         Ok(t)
     }
@@ -218,13 +263,12 @@ impl Case {
             bail!("the case has no [[stage]]");
         }
         for (i, s) in self.stages.iter().enumerate() {
-            if s.kind == Kind::Squeeze {
+            s.target(i)?;
+            if s.kind == Kind::Squeeze && i == 0 {
                 bail!(
-                    "[[stage]] {}: kind = \"squeeze\" (contact with plates) is not implemented yet",
-                    i + 1
+                    "[[stage]] 1: a squeeze needs an inflated tube: put an inflate stage before it"
                 );
             }
-            s.target(i)?;
         }
         self.material.build().context("[material]")?;
         if !(self.solver.rtol > 0.0 && self.solver.rtol < 1e-2) {

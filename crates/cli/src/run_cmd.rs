@@ -5,20 +5,24 @@
 //! error), so a run that fails midway loses nothing that had converged.
 
 use crate::case::{Caps, Case, Target};
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Value};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use tubemem_fem::contact::{penalty_for, Plane};
 use tubemem_fem::model::{nearest_node, run_stage, Control, Model, Stage, State};
-use tubemem_fem::post::{cell_values, midspan, ring_profile, MidSpan, RingValues};
-use tubemem_gps::{inflate, Hypothesis};
+use tubemem_fem::post::{
+    cell_contact_pressure, cell_values, midspan, midspan_contact, ring_profile, ContactValues,
+    MidSpan, RingValues,
+};
+use tubemem_gps::{flatten, inflate, Hypothesis};
+use tubemem_material::MembraneLaw;
 use tubemem_mesh::tube::{capped_tube_with_cap_rows, plugged_tube};
 use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 
-const STEPS_HEADER: &str =
-    "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots";
+pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration";
 
 struct Output {
     dir: PathBuf,
@@ -47,23 +51,33 @@ impl Output {
         })
     }
 
+    /// One row; the contact columns are empty for inflation stages.
     fn row(
         &mut self,
         stage: usize,
         step: usize,
         m: &MidSpan,
-        iterations: usize,
-        negative: usize,
+        its: usize,
+        neg: usize,
+        c: Option<(&ContactValues, f64)>,
     ) -> std::io::Result<()> {
-        writeln!(
+        write!(
             self.steps,
-            "{stage},{step},{},{},{},{},{},{},{},{iterations},{negative}",
+            "{stage},{step},{},{},{},{},{},{},{},{its},{neg}",
             m.w, m.lambda_s, m.lambda_z, m.n_s, m.n_z, m.n_sz, m.volume
         )?;
+        match c {
+            Some((c, d)) => writeln!(
+                self.steps,
+                ",{},{},{},{},{d},{},{}",
+                c.rho, c.chi, c.chi_geometric, c.force, c.contact_pressure, c.penetration
+            )?,
+            None => writeln!(self.steps, ",,,,,,,")?,
+        }
         self.steps.flush()
     }
 
-    fn frame(&mut self, model: &Model, state: &State) -> Result<(), String> {
+    fn frame(&mut self, model: &Model, state: &State, planes: &[Plane]) -> Result<(), String> {
         let cells = cell_values(model, state).map_err(|e| e.to_string())?;
         let disp: Vec<f64> = state
             .x
@@ -81,6 +95,7 @@ impl Output {
             pick(|c| c.n2),
         );
         let wrinkled = pick(|c| if c.wrinkled() { 1.0 } else { 0.0 });
+        let pc = cell_contact_pressure(model, state, planes);
         let name = format!("step_{:05}.vtu", self.frames);
         write_vtu(
             &self.dir.join("vtu").join(&name),
@@ -116,6 +131,11 @@ impl Output {
                     name: "wrinkled",
                     components: 1,
                     values: &wrinkled,
+                },
+                Field {
+                    name: "contact_pressure",
+                    components: 1,
+                    values: &pc,
                 },
             ],
         )
@@ -164,6 +184,39 @@ fn rel(fe: f64, cf: f64) -> f64 {
     (fe - cf) / cf.abs().max(1e-300)
 }
 
+/// The closed-form comparison of a stage's final state.
+fn closed_form(
+    law: &dyn MembraneLaw,
+    ms: &MidSpan,
+    squeeze: Option<(&ContactValues, f64)>,
+) -> Result<Value> {
+    let mut out = json!({});
+    for hyp in [Hypothesis::Gps, Hypothesis::Ps] {
+        let key = hyp.label().to_lowercase();
+        let (cf, err) = match squeeze {
+            None => {
+                let s = inflate(law, hyp, ms.lambda_s)?;
+                (
+                    json!({"w": s.w, "lambda_s": s.lambda_s, "lambda_z": s.lambda_z, "n_s": s.n_s, "n_z": s.n_z}),
+                    json!({"w": rel(ms.w, s.w), "lambda_z": rel(ms.lambda_z, s.lambda_z), "n_s": rel(ms.n_s, s.n_s), "n_z": rel(ms.n_z, s.n_z)}),
+                )
+            }
+            Some((c, ls0)) => {
+                let s = flatten(law, hyp, ls0, c.rho)?;
+                (
+                    json!({"w": s.w, "lambda_s": s.lambda_s, "lambda_z": s.lambda_z, "n_s": s.n_s, "n_z": s.n_z,
+                           "rho": s.rho, "chi": s.chi, "force": s.force, "displacement": s.displacement}),
+                    json!({"w": rel(ms.w, s.w), "lambda_s": rel(ms.lambda_s, s.lambda_s), "lambda_z": rel(ms.lambda_z, s.lambda_z),
+                           "chi": rel(c.chi, s.chi), "force": rel(c.force, s.force)}),
+                )
+            }
+        };
+        out[&key] = cf;
+        out[format!("relative_error_vs_{key}")] = err;
+    }
+    Ok(out)
+}
+
 pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     let case = Case::read(case_path)?;
     let g = &case.geometry;
@@ -184,7 +237,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     model.settings.max_iterations = case.solver.max_iterations;
     let mut o = Output::new(out)?;
     let mut state = model.reference_state();
-    o.frame(&model, &state).map_err(anyhow::Error::msg)?;
+    o.frame(&model, &state, &[]).map_err(anyhow::Error::msg)?;
     let v0 = model.multiplicity() * model.mesh.volume();
     let node = nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
     let mut summary = json!({
@@ -192,7 +245,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
         "mesh": {"nodes": model.mesh.nodes.len(), "elements": model.mesh.quads.len(), "equations": model.n_eq,
                  "symmetry": format!("{:?}", case.mesh.symmetry).to_lowercase()},
         "material": model.law.name(),
-        "units": "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH)",
+        "units": "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH), force = plate force per length/(πμH)",
         "stages": [],
     });
     let write_summary = |summary: &Value| -> Result<()> {
@@ -206,10 +259,13 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
         model.mesh.quads.len(),
         model.n_eq,
         case.mesh.symmetry,
-        closed_form_law.name()
+        model.law.name()
     );
     for (i, spec) in case.stages.iter().enumerate() {
         let target = spec.target(i)?;
+        // for a squeeze: the inflated mid-span stretch λs* and the gas constant at its start
+        let start = midspan(&model, &state)?;
+        let pv = state.p * model.multiplicity() * model.mesh.volume_at(&state.x);
         let (from, to, control): (f64, f64, Box<dyn Fn(f64) -> Control>) = match target {
             Target::Pressure(p) => (state.p, p, Box::new(Control::Pressure)),
             Target::Stretch(s) => (
@@ -226,7 +282,29 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                 r * v0,
                 Box::new(Control::Volume),
             ),
+            Target::Rho(rho) => {
+                if !(state.p > 0.0) {
+                    bail!(
+                        "[[stage]] {}: the tube holds no gas pressure to squeeze (ϖ = {})",
+                        i + 1,
+                        state.p
+                    );
+                }
+                let h0 = state.x.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+                if rho >= h0 {
+                    bail!("[[stage]] {}: `target_rho` = {rho} must be below the current half-height {h0:.6} of the tube", i + 1);
+                }
+                model.penalty = spec.penalty.unwrap_or_else(|| {
+                    penalty_for(state.p, spec.penetration_tolerance.unwrap_or(1e-3))
+                });
+                (
+                    h0,
+                    rho,
+                    Box::new(move |h| Control::Squeeze { pv, half_gap: h }),
+                )
+            }
         };
+        let squeeze = matches!(target, Target::Rho(_));
         let bar = ProgressBar::new(1000);
         bar.set_style(
             ProgressStyle::with_template("stage {prefix} [{bar:40}] {percent:>3}% {msg}")
@@ -241,15 +319,16 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
             initial_steps: spec.steps,
             max_cuts: 12,
         };
-        let mut last: Option<(MidSpan, usize, usize)> = None;
+        let mut last: Option<(MidSpan, Option<ContactValues>, usize, usize)> = None;
         let result = run_stage(
             &mut model,
             &mut state,
             &stage,
-            control,
+            &control,
             |m, step, value, st, info| {
                 let ms = midspan(m, st).map_err(|e| e.to_string())?;
-                let vals = [
+                let cv = squeeze.then(|| midspan_contact(m, st, value));
+                let mut vals = vec![
                     ms.w,
                     ms.lambda_s,
                     ms.lambda_z,
@@ -258,14 +337,24 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                     ms.n_sz,
                     ms.volume,
                 ];
+                if let Some(c) = &cv {
+                    vals.extend([c.chi, c.force, c.contact_pressure, c.penetration]);
+                }
                 if vals.iter().any(|v| !v.is_finite()) {
                     return Err(format!(
                         "a non-finite mid-span value was computed: {vals:?}"
                     ));
                 }
-                o.row(i + 1, step, &ms, info.iterations, info.negative_pivots)
-                    .map_err(|e| e.to_string())?;
-                o.frame(m, st)?;
+                o.row(
+                    i + 1,
+                    step,
+                    &ms,
+                    info.iterations,
+                    info.negative_pivots,
+                    cv.as_ref().map(|c| (c, start.lambda_s - c.rho)),
+                )
+                .map_err(|e| e.to_string())?;
+                o.frame(m, st, &control(value).plates())?;
                 let frac = if to != from {
                     ((value - from) / (to - from)).clamp(0.0, 1.0)
                 } else {
@@ -276,7 +365,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                     "step {step}: ϖ = {:.5}, λs = {:.5}, {} its",
                     ms.w, ms.lambda_s, info.iterations
                 ));
-                last = Some((ms, info.iterations, info.negative_pivots));
+                last = Some((ms, cv, info.iterations, info.negative_pivots));
                 Ok(())
             },
         );
@@ -286,7 +375,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                 .as_array_mut()
                 .expect("stages is an array")
                 .push(json!({"index": i + 1, "error": e.to_string(),
-                "last_converged": last.map(|(m, _, _)| midspan_json(&m))}));
+                "last_converged": last.map(|(m, _, _, _)| midspan_json(&m))}));
             write_summary(&summary)?;
             return Err(e).with_context(|| {
                 format!(
@@ -297,51 +386,89 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                 )
             });
         }
-        let ms = midspan(&model, &state)?;
-        let gps = inflate(closed_form_law.as_ref(), Hypothesis::Gps, ms.lambda_s)?;
-        let ps = inflate(closed_form_law.as_ref(), Hypothesis::Ps, ms.lambda_s)?;
+        let (ms, cv, its, neg) = match last {
+            Some(l) => l,
+            None => (midspan(&model, &state)?, None, 0, 0),
+        };
         let rings = ring_profile(&model, &state)?;
         let profile = out
             .join("profiles")
             .join(format!("stage{}_final.csv", i + 1));
         write_profile(&profile, &rings)?;
         let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
-        let (_, its, neg) = last.unwrap_or((ms, 0, 0));
-        let cf = |s: &tubemem_gps::InflationState| json!({"w": s.w, "lambda_s": s.lambda_s, "lambda_z": s.lambda_z, "n_s": s.n_s, "n_z": s.n_z});
-        let errs = |s: &tubemem_gps::InflationState| json!({"w": rel(ms.w, s.w), "lambda_z": rel(ms.lambda_z, s.lambda_z), "n_s": rel(ms.n_s, s.n_s), "n_z": rel(ms.n_z, s.n_z)});
         let mut fin = midspan_json(&ms);
         fin["newton_iterations"] = json!(its);
         fin["negative_pivots"] = json!(neg);
+        if let Some(c) = &cv {
+            for (k, v) in [
+                ("rho", c.rho),
+                ("chi", c.chi),
+                ("chi_geometric", c.chi_geometric),
+                ("force", c.force),
+                ("displacement", start.lambda_s - c.rho),
+                ("contact_pressure", c.contact_pressure),
+                ("penetration", c.penetration),
+                ("total_plate_force", c.total_force),
+                ("penalty", model.penalty),
+            ] {
+                fin[k] = json!(v);
+            }
+            fin["initial_stretch"] = json!(start.lambda_s);
+        }
+        let cf = closed_form(
+            closed_form_law.as_ref(),
+            &ms,
+            cv.as_ref().map(|c| (c, start.lambda_s)),
+        )?;
+        let mut entry = json!({
+            "index": i + 1,
+            "kind": if squeeze { "squeeze" } else { "inflate" },
+            "target": format!("{target:?}"),
+            "final": fin,
+            "cap_boundary_layer_0.1pct": layer,
+            "profile": profile.display().to_string(),
+        });
+        for (k, v) in cf.as_object().expect("an object") {
+            entry[k] = v.clone();
+        }
         summary["stages"]
             .as_array_mut()
             .expect("stages is an array")
-            .push(json!({
-                "index": i + 1,
-                "kind": "inflate",
-                "target": format!("{target:?}"),
-                "final": fin,
-                "gps": cf(&gps),
-                "ps": cf(&ps),
-                "relative_error_vs_gps": errs(&gps),
-                "relative_error_vs_ps": errs(&ps),
-                "cap_boundary_layer_0.1pct": layer,
-                "profile": profile.display().to_string(),
-            }));
+            .push(entry);
         write_summary(&summary)?;
+        let gps = &summary["stages"][i]["gps"];
+        let ps = &summary["stages"][i]["ps"];
+        let f = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
         println!(
-            "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6}, λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
+            "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6} (GPS {:.6}), λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
             i + 1,
             ms.w,
-            gps.w,
-            100.0 * rel(ms.w, gps.w),
-            ps.w,
+            f(gps, "w"),
+            100.0 * rel(ms.w, f(gps, "w")),
+            f(ps, "w"),
             ms.lambda_s,
+            f(gps, "lambda_s"),
             ms.lambda_z,
-            gps.lambda_z,
+            f(gps, "lambda_z"),
             ms.n_s,
             ms.n_z,
             ms.n_sz
         );
+        if let Some(c) = &cv {
+            println!(
+                "         ρ = {:.4}: χ = {:.5} (GPS {:.5}, PS {:.5}), force ϖχ = {:.5} (GPS {:.5}, {:+.2}%; PS {:.5}), contact pressure {:.4}, penetration {:.1e}",
+                c.rho,
+                c.chi,
+                f(gps, "chi"),
+                f(ps, "chi"),
+                c.force,
+                f(gps, "force"),
+                100.0 * rel(c.force, f(gps, "force")),
+                f(ps, "force"),
+                c.contact_pressure,
+                c.penetration
+            );
+        }
         if let Some(d) = layer {
             println!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)");
         }

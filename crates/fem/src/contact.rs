@@ -64,7 +64,8 @@ pub fn contact_kernel(
                     for b in 0..4 {
                         for i in 0..3 {
                             for j in 0..3 {
-                                k[(3 * a + i) * 12 + 3 * b + j] += w * n[a] * n[b] * plane.normal[i] * plane.normal[j];
+                                k[(3 * a + i) * 12 + 3 * b + j] +=
+                                    w * n[a] * n[b] * plane.normal[i] * plane.normal[j];
                             }
                         }
                     }

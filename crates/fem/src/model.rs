@@ -295,7 +295,12 @@ impl Model {
     }
 
     /// [`Model::assemble`] with contact against `extra` planes (added to the model's own).
-    pub fn assemble_with(&self, x: &[[f64; 3]], tangent: bool, extra: &[Plane]) -> Result<Assembled, FemError> {
+    pub fn assemble_with(
+        &self,
+        x: &[[f64; 3]],
+        tangent: bool,
+        extra: &[Plane],
+    ) -> Result<Assembled, FemError> {
         let law = self.law.as_ref();
         let planes: Vec<Plane> = self.planes.iter().chain(extra).copied().collect();
         let kappa = self.penalty;
@@ -320,7 +325,14 @@ impl Model {
                         source,
                     })?;
                 if !planes.is_empty() {
-                    l.energy += contact_kernel(el, &xe, &planes, kappa, &mut l.r, tangent.then_some(&mut l.k));
+                    l.energy += contact_kernel(
+                        el,
+                        &xe,
+                        &planes,
+                        kappa,
+                        &mut l.r,
+                        tangent.then_some(&mut l.k),
+                    );
                 }
                 l.v = volume_kernel(&xe, &mut l.g, tangent.then_some(&mut l.h));
                 Ok(l)
@@ -527,6 +539,9 @@ impl Model {
             }
             let x0 = state.x.clone();
             let p0 = state.p;
+            // potential and its slope along dx (∂Π/∂x = R)
+            let pi0 = potential(control, a.energy, a.volume, p);
+            let slope: f64 = r.iter().zip(&dx).map(|(ri, di)| ri * di).sum();
             let mut accepted = false;
             for _ in 0..8 {
                 state.x.clone_from(&x0);
@@ -544,9 +559,12 @@ impl Model {
                         .map(|(f, g)| f - pt * g)
                         .collect();
                     let reft = norm(&trial.f_int).max(pt.abs() * norm(&trial.g)).max(1e-12);
-                    // bordered controls: accept full steps (the merit mixes R and c); else
-                    // require a decrease of the residual
-                    if h.is_some() || norm(&rt) / reft < res || t < 1e-3 {
+                    // Bordered controls: accept full steps (the merit mixes R and c). Potential
+                    // controls (pressure, gas, squeeze): accept a decrease of the residual or of
+                    // the total potential Π (Armijo on the directional derivative −Rᵀdx·t).
+                    let pi_t = potential(control, trial.energy, trial.volume, pt);
+                    let armijo = pi0 + 1e-4 * t * slope;
+                    if h.is_some() || norm(&rt) / reft < res || pi_t < armijo || t < 1e-3 {
                         accepted = true;
                         break;
                     }
@@ -653,6 +671,16 @@ impl Model {
     }
 }
 
+/// The total potential of the modelled part for the potential-based controls:
+/// Π = W_int + E_contact − p V_part (pressure) or − (pv/m) ln V_part (closed gas, squeeze; by
+/// Boyle's law pv/m = p V_part at every state).
+fn potential(control: Control, energy: f64, v_part: f64, p: f64) -> f64 {
+    match control {
+        Control::Gas { .. } | Control::Squeeze { .. } => energy - p * v_part * v_part.ln(),
+        _ => energy - p * v_part,
+    }
+}
+
 /// One stage of a run: its number (for messages), the control value at its start and end, and
 /// how to step between them.
 pub struct Stage {
@@ -705,7 +733,12 @@ pub fn run_stage(
     let mut step = 0;
     let mut cuts = 0;
     while lambda < 1.0 {
-        let next = (lambda + dl).min(1.0);
+        // snap to the end when within rounding of it (no zero-length last step)
+        let next = if lambda + dl >= 1.0 - 1e-9 {
+            1.0
+        } else {
+            lambda + dl
+        };
         let value = from + (to - from) * next;
         let mut trial = state.clone();
         match model.solve(&mut trial, control(value)) {

@@ -251,3 +251,148 @@ pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, Fem
         })
         .collect()
 }
+
+/// Mid-span contact values of a squeeze (plates y = ±h), dimensionless.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactValues {
+    /// ρ = h/R
+    pub rho: f64,
+    /// χ = c/(πR) with c = ∫ p_c ds / ϖ, the contact width that the contact-pressure distribution
+    /// around the mid-span ring implies (in GPS p_c = ϖ on the flat zone, so this is its width)
+    pub chi: f64,
+    /// the geometric width of the penetrated part of the mid-span ring (zero crossings of the
+    /// nodal gap, linearly interpolated; O(h) accurate)
+    pub chi_geometric: f64,
+    /// plate force per unit current length at mid-span over πμH (the FE counterpart of ϖχ,
+    /// eq. 80)
+    pub force: f64,
+    /// mean contact pressure per current area at the Gauss points in contact next to Z = 0
+    /// (GPS: equal to ϖ in the flat zone)
+    pub contact_pressure: f64,
+    /// largest penetration anywhere
+    pub penetration: f64,
+    /// total force on one plate (all symmetry copies), over μH R
+    pub total_force: f64,
+}
+
+/// Contact at mid-span against the top plate y = h (normal −e_y).
+pub fn midspan_contact(model: &Model, state: &State, h: f64) -> ContactValues {
+    let mesh = &model.mesh;
+    let planes = mesh.symmetry.planes();
+    let x_copies = if planes.contains(&0) { 2.0 } else { 1.0 };
+    let z_copies = if planes.contains(&2) { 2.0 } else { 1.0 };
+    let kappa = model.penalty;
+    let gap = |p: [f64; 3]| h - p[1];
+    // contact width along the mid-span ring polygon (zero crossings interpolated linearly)
+    let ring = midspan_ring(model);
+    let closed = planes.iter().all(|&ax| ax == 2);
+    let n = ring.len();
+    let segs = if closed { n } else { n.saturating_sub(1) };
+    let mut c = 0.0;
+    for k in 0..segs {
+        let (a, b) = (state.x[ring[k]], state.x[ring[(k + 1) % n]]);
+        let (ga, gb) = (gap(a), gap(b));
+        let len = dist(a, b);
+        c += match (ga < 0.0, gb < 0.0) {
+            (true, true) => len,
+            (true, false) => len * ga / (ga - gb),
+            (false, true) => len * gb / (gb - ga),
+            _ => 0.0,
+        };
+    }
+    let on_ring: std::collections::HashSet<usize> = ring.iter().copied().collect();
+    // force per unit length from the element rows next to the ring, side by side
+    let mut side_force = [0.0; 2];
+    let mut side_extent = [(0.0, 0usize); 2];
+    let (mut pc_sum, mut pc_n) = (0.0, 0usize);
+    let (mut total, mut penetration) = (0.0, 0.0_f64);
+    for el in &model.elements {
+        let xe = el.nodes.map(|i| state.x[i]);
+        let touches = el.nodes.iter().any(|i| on_ring.contains(i));
+        let zc = el.nodes.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0;
+        let side = usize::from(zc < 0.0);
+        let mut fe = 0.0;
+        for g in 0..4 {
+            let p = [0, 1, 2].map(|k| (0..4).map(|a| el.n[g][a] * xe[a][k]).sum::<f64>());
+            let gp_gap = gap(p);
+            if gp_gap < 0.0 {
+                let t = crate::contact::traction(gp_gap, kappa);
+                fe += el.w[g] * t;
+                penetration = penetration.max(-gp_gap);
+                if touches {
+                    let f = el.gradient(g, &xe);
+                    let da = dot(cross(f[0], f[1]), cross(f[0], f[1])).sqrt();
+                    pc_sum += t / da;
+                    pc_n += 1;
+                }
+            }
+        }
+        total += fe;
+        if touches {
+            side_force[side] += fe;
+            // axial extent: mean |Δz| of the element's meridian edges (one end on the ring)
+            let mut ext = 0.0;
+            let mut m = 0;
+            for k in 0..4 {
+                let (a, b) = (el.nodes[k], el.nodes[(k + 1) % 4]);
+                if on_ring.contains(&a) != on_ring.contains(&b) {
+                    ext += (state.x[a][2] - state.x[b][2]).abs();
+                    m += 1;
+                }
+            }
+            if m > 0 {
+                side_extent[side].0 += ext / m as f64;
+                side_extent[side].1 += 1;
+            }
+        }
+    }
+    // per unit length: the row's force over its axial extent (the mean extent of its elements)
+    let mut f_per_len = 0.0;
+    let mut sides = 0.0;
+    for s in 0..2 {
+        if side_extent[s].1 > 0 && side_extent[s].0 > 0.0 {
+            f_per_len += side_force[s] / (side_extent[s].0 / side_extent[s].1 as f64);
+            sides += 1.0;
+        }
+    }
+    let f_per_len = if sides > 0.0 { f_per_len / sides } else { 0.0 };
+    let pi = std::f64::consts::PI;
+    ContactValues {
+        rho: h,
+        chi: if state.p > 0.0 {
+            x_copies * f_per_len / (pi * state.p)
+        } else {
+            0.0
+        },
+        chi_geometric: x_copies * c / pi,
+        force: x_copies * f_per_len / std::f64::consts::PI,
+        contact_pressure: if pc_n > 0 { pc_sum / pc_n as f64 } else { 0.0 },
+        penetration,
+        total_force: x_copies * z_copies * total,
+    }
+}
+
+/// Mean contact pressure per current area of each element (VTU cell data).
+pub fn cell_contact_pressure(
+    model: &Model,
+    state: &State,
+    planes: &[crate::contact::Plane],
+) -> Vec<f64> {
+    model
+        .elements
+        .iter()
+        .map(|el| {
+            let xe = el.nodes.map(|i| state.x[i]);
+            let mut s = 0.0;
+            for g in 0..4 {
+                let p = [0, 1, 2].map(|k| (0..4).map(|a| el.n[g][a] * xe[a][k]).sum::<f64>());
+                let f = el.gradient(g, &xe);
+                let da = dot(cross(f[0], f[1]), cross(f[0], f[1])).sqrt();
+                for pl in planes {
+                    s += 0.25 * crate::contact::traction(pl.gap(p), model.penalty) / da;
+                }
+            }
+            s
+        })
+        .collect()
+}

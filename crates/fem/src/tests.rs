@@ -539,7 +539,9 @@ fn assembled_tangents_match_finite_differences_including_gas() {
         half_gap: 0.7 * ymax,
     };
     // the plate does penetrate some Gauss points
-    let with = model.assemble_with(&st.x, false, &squeeze.plates()).unwrap();
+    let with = model
+        .assemble_with(&st.x, false, &squeeze.plates())
+        .unwrap();
     let without = model.assemble(&st.x, false).unwrap();
     assert!(with.energy > without.energy, "no contact in the test state");
     for control in [
@@ -659,4 +661,217 @@ fn plugged_tube_tangent_matches_finite_differences() {
             );
         }
     }
+}
+
+#[test]
+#[ignore]
+fn squeeze_explore() {
+    use crate::contact::penalty_for;
+    use crate::model::{run_stage, Control, Stage};
+    use crate::post::{midspan, midspan_contact};
+    use tubemem_gps::{flatten, Hypothesis};
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let cases: Vec<(usize, usize, f64, f64)> = std::env::var("SQUEEZE_CASES")
+        .ok()
+        .map(|v| {
+            v.split(';')
+                .map(|c| {
+                    let f: Vec<f64> = c.split(',').map(|x| x.parse().unwrap()).collect();
+                    (f[0] as usize, f[1] as usize, f[2], f[3])
+                })
+                .collect()
+        })
+        .unwrap_or(vec![(32, 80, 20.0, 1e-3), (32, 160, 40.0, 1e-3)]);
+    for (around, along, l, tol) in cases {
+        let t = std::time::Instant::now();
+        let (mut model, _, _) =
+            tube::inflate(l, around, along, tubemem_mesh::Symmetry::Eighth, 1.3);
+        // re-run to get the state (inflate returns only the model): redo quickly
+        let node = crate::model::nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
+        let mut st = model.reference_state();
+        let stage = Stage {
+            index: 1,
+            from: 1.0,
+            to: 1.3,
+            initial_steps: 6,
+            max_cuts: 12,
+        };
+        run_stage(
+            &mut model,
+            &mut st,
+            &stage,
+            |v| Control::Node {
+                node,
+                component: 0,
+                target: v,
+            },
+            |_, _, _, _, _| Ok(()),
+        )
+        .unwrap();
+        let ms0 = midspan(&model, &st).unwrap();
+        let pv = st.p * model.multiplicity() * model.mesh.volume_at(&st.x);
+        model.penalty = penalty_for(st.p, tol);
+        let h0 = st.x.iter().map(|p| p[1]).fold(0.0, f64::max);
+        let stage = Stage {
+            index: 2,
+            from: h0,
+            to: 0.8,
+            initial_steps: 10,
+            max_cuts: 12,
+        };
+        let mut rows = vec![];
+        run_stage(
+            &mut model,
+            &mut st,
+            &stage,
+            |h| Control::Squeeze { pv, half_gap: h },
+            |m, step, h, s, info| {
+                let ms = midspan(m, s).unwrap();
+                let c = midspan_contact(m, s, h);
+                rows.push((step, h, ms, c, info.iterations));
+                Ok(())
+            },
+        )
+        .unwrap();
+        eprintln!(
+            "around {around} L {l} tol {tol}: {} dofs, {:?}",
+            model.n_eq,
+            t.elapsed()
+        );
+        for (step, h, ms, c, its) in rows.iter().step_by(2) {
+            let g = flatten(&law, Hypothesis::Gps, ms0.lambda_s, *h).unwrap();
+            eprintln!(
+                "  {step:2} ρ {h:.4} its {its} | FE w {:.5} ls {:.5} lz {:.5} chi_geo {:.4} chi_eq {:.4} F {:.4} pen {:.1e} | GPS w {:.5} ls {:.5} lz {:.5} chi {:.4} F {:.4} | err w {:+.2e} F {:+.2e} chi_eq {:+.2e}",
+                ms.w, ms.lambda_s, ms.lambda_z, c.chi, c.force / ms.w, c.force, c.penetration, g.w, g.lambda_s, g.lambda_z, g.chi, g.force,
+                ms.w / g.w - 1.0, c.force / g.force - 1.0, c.force / ms.w / g.chi - 1.0
+            );
+        }
+    }
+}
+
+/// Squeeze from λs* = 1.3 to ρ = 0.8 with the gas closed in (eighth model, 32 around,
+/// 4 elements per R along). Returns (final mid-span, contact values, λs*, max penetration).
+fn squeeze(
+    l: f64,
+    around: usize,
+    tol: f64,
+) -> (crate::post::MidSpan, crate::post::ContactValues, f64) {
+    use crate::contact::penalty_for;
+    use crate::model::{nearest_node, run_stage, Control, Stage};
+    use crate::post::{midspan, midspan_contact};
+    let mesh = tubemem_mesh::tube::capped_tube(
+        1.0,
+        l,
+        around,
+        (4.0 * l) as usize,
+        tubemem_mesh::Symmetry::Eighth,
+    )
+    .unwrap();
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let mut model = crate::model::Model::new(mesh, Box::new(law)).unwrap();
+    let node = nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
+    let mut st = model.reference_state();
+    let inflate = Stage {
+        index: 1,
+        from: 1.0,
+        to: 1.3,
+        initial_steps: 6,
+        max_cuts: 12,
+    };
+    run_stage(
+        &mut model,
+        &mut st,
+        &inflate,
+        |v| Control::Node {
+            node,
+            component: 0,
+            target: v,
+        },
+        |_, _, _, _, _| Ok(()),
+    )
+    .unwrap();
+    let ls0 = midspan(&model, &st).unwrap().lambda_s;
+    let pv = st.p * model.multiplicity() * model.mesh.volume_at(&st.x);
+    model.penalty = penalty_for(st.p, tol);
+    let h0 = st.x.iter().map(|p| p[1]).fold(0.0, f64::max);
+    let sq = Stage {
+        index: 2,
+        from: h0,
+        to: 0.8,
+        initial_steps: 10,
+        max_cuts: 12,
+    };
+    run_stage(
+        &mut model,
+        &mut st,
+        &sq,
+        |h| Control::Squeeze { pv, half_gap: h },
+        |_, _, _, _, _| Ok(()),
+    )
+    .unwrap();
+    (
+        midspan(&model, &st).unwrap(),
+        midspan_contact(&model, &st, 0.8),
+        ls0,
+    )
+}
+
+/// Source: GPS flattening, eqs. (76)–(77), at the FE's own λs* and the same ρ = 0.8.
+/// What differs is physics GPS leaves out — the caps hold gas that the plates do not squeeze,
+/// so the pressure rises less — plus discretization. Checked: (1) every error falls when L/R
+/// doubles from 20 to 40 (the end effect); (2) at L/R = 40 the errors stay within bounds set from
+/// this mesh's measured values with margin (measured: ϖ −0.36 %, λs −0.17 %, λz −0.12 %,
+/// χ −1.2 %, force −1.6 %; bounds 0.6 %, 0.3 %, 0.3 %, 2 %, 2.5 %).
+#[test]
+fn squeeze_approaches_gps_as_the_tube_gets_longer() {
+    use tubemem_gps::{flatten, Hypothesis};
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let errs = |l: f64| {
+        let (ms, c, ls0) = squeeze(l, 32, 1e-3);
+        let g = flatten(&law, Hypothesis::Gps, ls0, 0.8).unwrap();
+        let r = |a: f64, b: f64| (a - b) / b;
+        [
+            r(ms.w, g.w),
+            r(ms.lambda_s, g.lambda_s),
+            r(ms.lambda_z, g.lambda_z),
+            r(c.chi, g.chi),
+            r(c.force, g.force),
+        ]
+    };
+    let (e20, e40) = (errs(20.0), errs(40.0));
+    let names = ["ϖ", "λs", "λz", "χ", "force"];
+    eprintln!("L/R = 20: {e20:?}\nL/R = 40: {e40:?}");
+    for k in 0..5 {
+        assert!(
+            e40[k].abs() < e20[k].abs(),
+            "{}: error {} at L/R = 40 not below {} at 20",
+            names[k],
+            e40[k],
+            e20[k]
+        );
+    }
+    let bounds = [6e-3, 3e-3, 3e-3, 2e-2, 2.5e-2];
+    for k in 0..5 {
+        assert!(
+            e40[k].abs() < bounds[k],
+            "{}: {} at L/R = 40",
+            names[k],
+            e40[k]
+        );
+    }
+}
+
+/// Penalty: the penetration is about p/κ, so ten times κ gives a tenth of the penetration
+/// (measured ratio within 20 % of 10), and the mid-span pressure moves by less than 0.5 %
+/// between κ = ϖ*/1e-3 and ϖ*/1e-4 (the penalty error is small against the end effect).
+#[test]
+fn penetration_falls_as_the_penalty_grows() {
+    let (a, ca, _) = squeeze(10.0, 16, 1e-3);
+    let (b, cb, _) = squeeze(10.0, 16, 1e-4);
+    let ratio = ca.penetration / cb.penetration;
+    assert!(
+        (ratio / 10.0 - 1.0).abs() < 0.2,
+        "penetration ratio {ratio}"
+    );
+    assert!((a.w / b.w - 1.0).abs() < 5e-3);
 }
