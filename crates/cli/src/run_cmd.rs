@@ -283,7 +283,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                 Box::new(Control::Volume),
             ),
             Target::Rho(rho) => {
-                if !(state.p > 0.0) {
+                if state.p.is_nan() || state.p <= 0.0 {
                     bail!(
                         "[[stage]] {}: the tube holds no gas pressure to squeeze (ϖ = {})",
                         i + 1,
