@@ -295,7 +295,11 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
                     bail!("[[stage]] {}: `target_rho` = {rho} must be below the current half-height {h0:.6} of the tube", i + 1);
                 }
                 model.penalty = spec.penalty.unwrap_or_else(|| {
-                    penalty_for(state.p, spec.penetration_tolerance.unwrap_or(1e-3))
+                    penalty_for(
+                        state.p,
+                        start.lambda_s * start.lambda_z,
+                        spec.penetration_tolerance.unwrap_or(1e-3),
+                    )
                 });
                 (
                     h0,

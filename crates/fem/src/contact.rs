@@ -8,8 +8,8 @@
 //! K_ab += dA0 κ N_a N_b n⊗n             (where g < 0)
 //! ```
 //! Frictionless: the force is along n only. The contact pressure per current area is
-//! κ⟨−g⟩ dA0/da; the penetration at a contact pressure p is about p/κ, so κ is chosen from the
-//! pressure scale and a stated penetration tolerance (see `penalty_for`).
+//! κ⟨−g⟩ dA0/da; the penetration at a contact pressure p is about p J/κ (J = da/dA0), so κ is
+//! chosen from the pressure, the area stretch and a stated penetration tolerance (`penalty_for`).
 
 use crate::element::RefElement;
 use tubemem_mesh::dot;
@@ -28,10 +28,11 @@ impl Plane {
     }
 }
 
-/// The penalty κ that gives a penetration of `tolerance` (in R) at the pressure `pressure`
-/// (reduced, ϖ): κ = ϖ / tolerance.
-pub fn penalty_for(pressure: f64, tolerance: f64) -> f64 {
-    pressure / tolerance
+/// The penalty κ that gives a penetration of `tolerance` (in R) under the reduced pressure
+/// `pressure` where the membrane's area stretch is `area_stretch` (J = λ1λ2): the penalty acts
+/// per reference area, so the penetration is p J/κ and κ = ϖ J / tolerance.
+pub fn penalty_for(pressure: f64, area_stretch: f64, tolerance: f64) -> f64 {
+    pressure * area_stretch / tolerance
 }
 
 /// Add the contact energy, residual and (if asked) stiffness of one element.
