@@ -10,10 +10,11 @@ import numpy as np
 
 
 def read_steps(run_dir):
-    """steps.csv as a dict of numpy arrays (one entry per column)."""
+    """steps.csv as a dict of numpy arrays (one entry per column); empty fields (the contact
+    columns of inflation rows) are NaN."""
     with open(pathlib.Path(run_dir) / "steps.csv", newline="") as f:
         rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]} if rows else {}
+    return {k: np.array([float(r[k]) if r[k] != "" else np.nan for r in rows]) for k in rows[0]} if rows else {}
 
 
 def read_summary(run_dir):

@@ -478,12 +478,22 @@ fn run_writes_steps_summary_profiles_and_vtu() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap();
     let mut lines = steps.lines();
+    // issue #3's columns, then the contact columns of issue #4 (empty for inflation rows)
     assert_eq!(
         lines.next().unwrap(),
-        "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots"
+        "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,\
+         rho,chi,chi_geometric,force,displacement,contact_pressure,penetration"
     );
     let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert_eq!(f.len(), 18);
+            assert!(
+                f[11..].iter().all(|v| v.is_empty()),
+                "inflation rows have no contact values"
+            );
+            f[..11].iter().map(|v| v.parse().unwrap()).collect()
+        })
         .collect();
     assert!(rows.len() >= 3);
     let last = rows.last().unwrap();
