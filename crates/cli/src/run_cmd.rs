@@ -94,7 +94,7 @@ impl Output {
             pick(|c| c.n1),
             pick(|c| c.n2),
         );
-        let wrinkled = pick(|c| if c.wrinkled() { 1.0 } else { 0.0 });
+        let wrinkled = pick(|c| f64::from(c.state()));
         let pc = cell_contact_pressure(model, state, planes);
         let name = format!("step_{:05}.vtu", self.frames);
         write_vtu(
@@ -178,6 +178,32 @@ pub fn boundary_layer(rings: &[RingValues], half_length: f64, mid: f64, tol: f64
     } else {
         None
     }
+}
+
+/// Where the membrane is wrinkled or slack at the end of a stage: element counts and the range
+/// of reference height Z (in R) and of the polar angle from the tube axis they occupy.
+fn wrinkle_report(model: &Model, state: &State) -> Result<Value> {
+    let cells = cell_values(model, state)?;
+    let mut out = json!({});
+    for (code, name) in [(1u8, "wrinkled"), (2u8, "slack")] {
+        let zs: Vec<f64> = cells
+            .iter()
+            .zip(&model.mesh.quads)
+            .filter(|(c, _)| c.state() == code)
+            .map(|(_, q)| q.iter().map(|&i| model.mesh.nodes[i][2]).sum::<f64>() / 4.0)
+            .collect();
+        let (lo, hi) = zs
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &z| {
+                (a.min(z), b.max(z))
+            });
+        out[name] = if zs.is_empty() {
+            json!({"elements": 0})
+        } else {
+            json!({"elements": zs.len(), "z_ref_min": lo, "z_ref_max": hi})
+        };
+    }
+    Ok(out)
 }
 
 fn rel(fe: f64, cf: f64) -> f64 {
@@ -400,6 +426,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
             .join(format!("stage{}_final.csv", i + 1));
         write_profile(&profile, &rings)?;
         let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
+        let wrinkling = wrinkle_report(&model, &state)?;
         let mut fin = midspan_json(&ms);
         fin["newton_iterations"] = json!(its);
         fin["negative_pivots"] = json!(neg);
@@ -430,6 +457,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
             "target": format!("{target:?}"),
             "final": fin,
             "cap_boundary_layer_0.1pct": layer,
+            "wrinkling": wrinkling,
             "profile": profile.display().to_string(),
         });
         for (k, v) in cf.as_object().expect("an object") {

@@ -147,9 +147,23 @@ pub struct CellValues {
 }
 
 impl CellValues {
-    /// A compressive principal resultant: the membrane would wrinkle there.
+    /// 0 taut (both principal resultants positive), 1 wrinkled (N1 > 0 ≥ N2: tension in one
+    /// direction only; with the relaxed law N2 is then exactly 0), 2 slack (N1 ≤ 0: no tension).
+    /// A tolerance of 1e-10 (|N1| + |N2|) separates "zero" from positive.
+    pub fn state(&self) -> u8 {
+        let tol = 1e-10 * (self.n1.abs() + self.n2.abs()) + 1e-14;
+        if self.n1 <= tol {
+            2
+        } else if self.n2 <= tol {
+            1
+        } else {
+            0
+        }
+    }
+
+    /// Wrinkled or slack: the membrane carries no tension in at least one direction.
     pub fn wrinkled(&self) -> bool {
-        self.n2 < 0.0
+        self.state() != 0
     }
 }
 

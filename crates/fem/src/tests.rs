@@ -875,3 +875,31 @@ fn penetration_falls_as_the_penalty_grows() {
     );
     assert!((a.w / b.w - 1.0).abs() < 5e-3);
 }
+
+/// The taut / wrinkled / slack classification of the output, including the exact zeros the
+/// relaxed law produces (N2 = 0 when wrinkled, both 0 when slack).
+#[test]
+fn wrinkle_state_classification_works() {
+    use crate::post::CellValues;
+    use tubemem_material::relaxed::Relaxed;
+    use tubemem_material::MembraneLaw;
+    let c = |n1: f64, n2: f64| {
+        CellValues {
+            hoop_stretch: 1.0,
+            axial_stretch: 1.0,
+            n1,
+            n2,
+        }
+        .state()
+    };
+    assert_eq!(c(1.0, 0.5), 0);
+    assert_eq!(c(1.0, 0.0), 1);
+    assert_eq!(c(1.0, -0.2), 1);
+    assert_eq!(c(0.0, 0.0), 2);
+    assert_eq!(c(-0.1, -0.3), 2);
+    let r = Relaxed::new(tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap());
+    let [n1, n2] = r.resultants(1.5, 0.6).unwrap(); // λ2 below the natural width: wrinkled
+    assert_eq!(c(n1, n2), 1);
+    let [n1, n2] = r.resultants(0.9, 0.8).unwrap(); // slack
+    assert_eq!(c(n1, n2), 2);
+}
