@@ -159,8 +159,83 @@ fn flattening_row(s: &FlatteningState) -> Vec<f64> {
     ]
 }
 
-/// Compute the curves and write every CSV and PNG into `dir`; returns the files written.
-pub fn write_all(dir: &Path, kuhn: f64) -> Result<Vec<PathBuf>> {
+/// FE points read from a `tubemem run` folder.
+#[derive(Default)]
+struct RunPoints {
+    label: String,
+    /// (λs, ϖ) of inflation steps
+    inflation: Vec<(f64, f64)>,
+    /// (λs, ϖ, displacement, force, λs*) of squeeze steps
+    squeeze: Vec<(f64, f64, f64, f64, f64)>,
+}
+
+fn read_run(dir: &Path) -> Result<RunPoints> {
+    let path = dir.join("steps.csv");
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!(
+            "cannot read {} (is this a tubemem run folder?)",
+            path.display()
+        )
+    })?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .with_context(|| format!("{}: no column `{name}`", path.display()))
+    };
+    let (cw, cls, crho, cdisp, cforce) = (
+        col("w")?,
+        col("lambda_s")?,
+        col("rho")?,
+        col("displacement")?,
+        col("force")?,
+    );
+    let mut pts = RunPoints {
+        label: dir
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default(),
+        ..Default::default()
+    };
+    for (k, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let num = |i: usize| -> Result<f64> {
+            f.get(i)
+                .and_then(|v| v.parse::<f64>().ok())
+                .with_context(|| {
+                    format!(
+                        "{}: row {}: column {i} is not a number",
+                        path.display(),
+                        k + 2
+                    )
+                })
+        };
+        if f.get(crho).is_some_and(|v| !v.is_empty()) {
+            let (ls, w, rho, d, force) =
+                (num(cls)?, num(cw)?, num(crho)?, num(cdisp)?, num(cforce)?);
+            pts.squeeze.push((ls, w, d, force, d + rho));
+        } else {
+            pts.inflation.push((num(cls)?, num(cw)?));
+        }
+    }
+    Ok(pts)
+}
+
+const FE_COLORS: [RGBColor; 3] = [
+    RGBColor(20, 140, 60),
+    RGBColor(150, 60, 170),
+    RGBColor(230, 130, 0),
+];
+
+/// Compute the curves and write every CSV and PNG into `dir`, with the FE points of the run
+/// folders in `overlays` on Figs. 5–7; returns the files written.
+pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let runs: Vec<RunPoints> = overlays
+        .iter()
+        .map(|d| read_run(d))
+        .collect::<Result<_>>()?;
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create folder {}", dir.display()))?;
     let law = AnssariBenamBucchi::new(1.0, kuhn)?;
@@ -235,6 +310,17 @@ pub fn write_all(dir: &Path, kuhn: f64) -> Result<Vec<PathBuf>> {
             dashed: true,
         });
     }
+    for (run, color) in runs.iter().zip(FE_COLORS.iter().cycle()) {
+        let mut pts = run.inflation.clone();
+        pts.extend(run.squeeze.iter().map(|s| (s.0, s.1)));
+        if !pts.is_empty() {
+            markers.push(Markers {
+                label: format!("FE run `{}`", run.label),
+                points: pts,
+                color: *color,
+            });
+        }
+    }
     let title5 = format!("Fig. 5 — reduced pressure vs hoop stretch (ABB, Kuhn N = {kuhn})");
     let p = dir.join("fig5_pressure_stretch.png");
     draw(
@@ -261,6 +347,23 @@ pub fn write_all(dir: &Path, kuhn: f64) -> Result<Vec<PathBuf>> {
                 dashed: false,
             })
             .collect();
+        let mut markers = vec![];
+        for (run, color) in runs.iter().zip(FE_COLORS.iter().cycle()) {
+            // squeeze steps that start from (about) this λs*
+            let pts: Vec<(f64, f64)> = run
+                .squeeze
+                .iter()
+                .filter(|s| (s.4 - ls0).abs() < 0.05 * ls0)
+                .map(|s| (s.2, s.3))
+                .collect();
+            if !pts.is_empty() {
+                markers.push(Markers {
+                    label: format!("FE run `{}`", run.label),
+                    points: pts,
+                    color: *color,
+                });
+            }
+        }
         let title = format!("Fig. {num} — flattening from λs* = {ls0} (ABB, Kuhn N = {kuhn})");
         let p = dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}.png"));
         draw(
@@ -270,7 +373,7 @@ pub fn write_all(dir: &Path, kuhn: f64) -> Result<Vec<PathBuf>> {
                 x_label: "reduced displacement λs* − ρ",
                 y_label: "reduced force ϖχ = pc/(πμH)",
                 series,
-                markers: vec![],
+                markers,
             },
         )?;
         written.push(p);

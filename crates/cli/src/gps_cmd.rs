@@ -305,7 +305,7 @@ pub fn default_job(out: &Path) -> Result<()> {
         );
     }
     println!();
-    let written = figures::write_all(&out.join("figures"), 30.0)?;
+    let written = figures::write_all(&out.join("figures"), 30.0, &[])?;
     for p in written {
         println!("wrote {}", p.display());
     }

@@ -49,6 +49,9 @@ enum Command {
         /// Kuhn segment number 𝒩 of the Anssari-Benam–Bucchi law.
         #[arg(long, default_value_t = 30.0)]
         kuhn: f64,
+        /// A `tubemem run` output folder whose FE points are drawn over Figs. 5–7 (repeatable).
+        #[arg(long)]
+        overlay: Vec<PathBuf>,
     },
 }
 
@@ -57,8 +60,8 @@ fn run(cli: Cli) -> Result<()> {
         None => gps_cmd::default_job(&PathBuf::from("tubemem-out")),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Run { case, out }) => run_cmd::run(&case, &out),
-        Some(Command::Figures { out, kuhn }) => {
-            let written = figures::write_all(&out, kuhn)?;
+        Some(Command::Figures { out, kuhn, overlay }) => {
+            let written = figures::write_all(&out, kuhn, &overlay)?;
             for p in written {
                 println!("wrote {}", p.display());
             }

@@ -683,3 +683,42 @@ fn squeeze_stage_writes_contact_outputs() {
         .unwrap()
         .contains("Name=\"contact_pressure\""));
 }
+
+#[test]
+fn figures_overlay_a_run_folder() {
+    let text =
+        format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.0\nsteps = 4\n");
+    let case = write_case("overlay", &text);
+    let run = case.parent().unwrap().join("run");
+    assert!(tubemem(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let figs = case.parent().unwrap().join("figs");
+    let o = tubemem(&[
+        "figures",
+        "--out",
+        figs.to_str().unwrap(),
+        "--overlay",
+        run.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read(figs.join("fig5_pressure_stretch.png"))
+        .unwrap()
+        .starts_with(b"\x89PNG"));
+    let not_a_run = case.parent().unwrap();
+    assert_clean_failure(
+        &[
+            "figures",
+            "--out",
+            figs.to_str().unwrap(),
+            "--overlay",
+            not_a_run.join("nothing").to_str().unwrap(),
+        ],
+        "is this a tubemem run folder",
+    );
+}
