@@ -1,5 +1,4 @@
 //! `tubemem gps …` and the default job.
-use crate::figures;
 use crate::material_args::MaterialArgs;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
@@ -11,7 +10,6 @@ use tubemem_gps::{
     flatten, flattening_curve, inflate, inflation_curve, FlatteningState, Hypothesis,
     InflationState,
 };
-use tubemem_material::laws::AnssariBenamBucchi;
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
 pub enum Hyp {
@@ -253,61 +251,5 @@ fn print_limits(l: &Limits, json: bool) -> Result<()> {
         "(inflation curve scanned for λs from 1 to {:.3})",
         l.scanned_to
     );
-    Ok(())
-}
-
-/// The main job on the embedded default: the paper's example, GPS against PS, and the figures.
-pub fn default_job(out: &Path) -> Result<()> {
-    let law = AnssariBenamBucchi::new(1.0, 30.0)?;
-    println!(
-        "tubemem — closed form, paper Sec. 4: Anssari-Benam–Bucchi membrane, 𝒩 = 30 (ϖ = pR/μH)\n"
-    );
-    println!("Free inflation");
-    println!(
-        "{:>6} {:>12} {:>12} {:>10} {:>12} {:>10}",
-        "λs", "ϖ GPS", "ϖ PS", "λz GPS", "N_z/μH GPS", "PS error"
-    );
-    for ls in [1.05, 1.1, 1.3, 1.6, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0] {
-        let g = inflate(&law, Hypothesis::Gps, ls)?;
-        let p = inflate(&law, Hypothesis::Ps, ls)?;
-        ensure_finite(&[g.w, p.w, g.lambda_z, g.n_z])?;
-        println!(
-            "{:>6.2} {:>12.6} {:>12.6} {:>10.6} {:>12.6} {:>9.2}%",
-            ls,
-            g.w,
-            p.w,
-            g.lambda_z,
-            g.n_z,
-            100.0 * (p.w - g.w) / g.w
-        );
-    }
-    let l = limit_points(&law, Hypothesis::Gps)?;
-    println!("\nLimit points of the GPS inflation curve (PS has none):");
-    print_limits(&l, false)?;
-    for (ls0, rho) in [(1.3, 0.8), (6.0, 3.0)] {
-        println!("\nFlattening from λs* = {ls0} to ρ = {rho} (gas closed in)");
-        println!(
-            "{:>4} {:>10} {:>10} {:>10} {:>10} {:>12}",
-            "", "ϖ", "λs", "λz", "χ", "force ϖχ"
-        );
-        let g = flatten(&law, Hypothesis::Gps, ls0, rho)?;
-        let p = flatten(&law, Hypothesis::Ps, ls0, rho)?;
-        for (name, s) in [("GPS", g), ("PS", p)] {
-            ensure_finite(&flattening_values(&s))?;
-            println!(
-                "{name:>4} {:>10.6} {:>10.6} {:>10.6} {:>10.6} {:>12.6}",
-                s.w, s.lambda_s, s.lambda_z, s.chi, s.force
-            );
-        }
-        println!(
-            "PS force error: {:+.2}%",
-            100.0 * (p.force - g.force) / g.force
-        );
-    }
-    println!();
-    let written = figures::write_all(&out.join("figures"), 30.0, &[])?;
-    for p in written {
-        println!("wrote {}", p.display());
-    }
     Ok(())
 }

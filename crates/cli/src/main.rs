@@ -1,11 +1,12 @@
 //! `tubemem`: the command-line front end.
 //!
-//! With no arguments it runs the main job: the closed-form GPS-versus-PS comparison for the
-//! paper's example (ABB law, 𝒩 = 30) and the figures, written to `tubemem-out/`.
+//! With no arguments it runs the main job (`main_job`): the paper's example in 3D on the
+//! embedded default case, against GPS and PS, and the figures, written to `tubemem-out/`.
 
 mod case;
 mod figures;
 mod gps_cmd;
+mod main_job;
 mod material_args;
 mod run_cmd;
 
@@ -19,7 +20,7 @@ use std::process::ExitCode;
     name = "tubemem",
     version,
     about = "Verification suite for pressurized membrane tubes: closed-form generalized plane strain (GPS) and plane strain (PS)",
-    long_about = "Verification suite for pressurized membrane tubes.\n\nWith no subcommand, runs the main job: the closed-form GPS-versus-PS comparison of the paper's example (Anssari-Benam–Bucchi law, 𝒩 = 30) and the figures, written to ./tubemem-out."
+    long_about = "Verification suite for pressurized membrane tubes.\n\nWith no subcommand, runs the main job: the paper's example (Anssari-Benam–Bucchi law, 𝒩 = 30) in 3D on the embedded default case cases/squeeze_abb30_ls1.3.toml (inflation to λs* = 1.3, gas closed in, squeeze to ρ = 0.8), compared with the GPS and PS closed forms, and the figures with the FE points, all written to ./tubemem-out."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -57,7 +58,7 @@ enum Command {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => gps_cmd::default_job(&PathBuf::from("tubemem-out")),
+        None => main_job::run(&PathBuf::from("tubemem-out")),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Run { case, out }) => run_cmd::run(&case, &out),
         Some(Command::Figures { out, kuhn, overlay }) => {

@@ -245,6 +245,11 @@ fn closed_form(
 
 pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     let case = Case::read(case_path)?;
+    run_case(&case, &case_path.display().to_string(), out)
+}
+
+/// Run a parsed case; `label` names it in the outputs.
+pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
     let g = &case.geometry;
     let half = 0.5 * g.length / g.radius;
     let (ll, around, along) = (g.length / g.radius, case.mesh.around, case.mesh.along);
@@ -267,7 +272,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     let v0 = model.multiplicity() * model.mesh.volume();
     let node = nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
     let mut summary = json!({
-        "case": case_path.display().to_string(),
+        "case": label,
         "mesh": {"nodes": model.mesh.nodes.len(), "elements": model.mesh.quads.len(), "equations": model.n_eq,
                  "symmetry": format!("{:?}", case.mesh.symmetry).to_lowercase()},
         "material": model.law.name(),
@@ -281,7 +286,7 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
     };
     println!(
         "tubemem run: {} — {} elements, {} equations ({:?} model), {}",
-        case_path.display(),
+        label,
         model.mesh.quads.len(),
         model.n_eq,
         case.mesh.symmetry,
