@@ -75,7 +75,7 @@ pub fn run(out: &Path) -> Result<()> {
     println!(
         "(the FE differs from GPS mostly by the end effect: the caps hold gas the plates do not squeeze; see the README)\n"
     );
-    for p in figures::write_all(&out.join("figures"), 30.0, &[run_dir.clone()])? {
+    for p in figures::write_all(&out.join("figures"), 30.0, std::slice::from_ref(&run_dir))? {
         println!("wrote {}", p.display());
     }
     Ok(())
