@@ -722,3 +722,29 @@ fn figures_overlay_a_run_folder() {
         "is this a tubemem run folder",
     );
 }
+
+/// The main job (no arguments): the embedded squeeze case end to end, in a fresh folder.
+#[test]
+fn main_job_runs_the_embedded_squeeze() {
+    let d = tmp("main-job");
+    let o = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .current_dir(&d)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("Maxwell"), "{out}");
+    assert!(out.contains("FE against GPS and PS flattening"), "{out}");
+    assert!(
+        out.lines().any(|l| l.trim_start().starts_with("0.8000")),
+        "the table reaches ρ = 0.8:\n{out}"
+    );
+    let s: Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("tubemem-out/squeeze/summary.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(s["stages"][1]["kind"], "squeeze");
+    assert!(d
+        .join("tubemem-out/figures/fig6_force_displacement_ls1.3.png")
+        .exists());
+}
