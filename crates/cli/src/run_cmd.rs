@@ -355,6 +355,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
             max_cuts: 12,
         };
         let mut last: Option<(MidSpan, Option<ContactValues>, usize, usize)> = None;
+        let (mut newton_total, mut steps_total) = (0usize, 0usize);
         let result = run_stage(
             &mut model,
             &mut state,
@@ -401,6 +402,8 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                     ms.w, ms.lambda_s, info.iterations
                 ));
                 last = Some((ms, cv, info.iterations, info.negative_pivots));
+                newton_total += info.iterations;
+                steps_total += 1;
                 Ok(())
             },
         );
@@ -434,6 +437,8 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
         let wrinkling = wrinkle_report(&model, &state)?;
         let mut fin = midspan_json(&ms);
         fin["newton_iterations"] = json!(its);
+        fin["stage_steps"] = json!(steps_total);
+        fin["stage_newton_iterations"] = json!(newton_total);
         fin["negative_pivots"] = json!(neg);
         if let Some(c) = &cv {
             for (k, v) in [
