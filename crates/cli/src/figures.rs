@@ -5,14 +5,16 @@
 //! Figs. 6 and 7: reduced force ϖχ versus reduced displacement λs* − ρ (eqs. 80–81) for
 //! λs* = 1.3 and 6.0. The flattening runs to ρ = λs*/2.
 
-use crate::gps_cmd::{write_csv, FLATTENING_HEADER, INFLATION_HEADER};
+use crate::gps_cmd::{
+    flattening_values, inflation_values, write_csv, FLATTENING_HEADER, INFLATION_HEADER,
+};
 use anyhow::{anyhow, Context, Result};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 use tubemem_gps::limits::limit_points;
-use tubemem_gps::{flattening_curve, inflation_curve, FlatteningState, Hypothesis, InflationState};
+use tubemem_gps::{flattening_curve, inflation_curve, Hypothesis};
 use tubemem_material::laws::AnssariBenamBucchi;
 
 static FONT: Once = Once::new();
@@ -142,23 +144,6 @@ pub fn draw(path: &Path, fig: &Figure) -> Result<()> {
     Ok(())
 }
 
-fn inflation_row(s: &InflationState) -> Vec<f64> {
-    vec![s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z]
-}
-fn flattening_row(s: &FlatteningState) -> Vec<f64> {
-    vec![
-        s.w,
-        s.lambda_s,
-        s.lambda_z,
-        s.n_s,
-        s.n_z,
-        s.rho,
-        s.chi,
-        s.force,
-        s.displacement,
-    ]
-}
-
 /// FE points read from a `tubemem run` folder.
 #[derive(Default)]
 struct RunPoints {
@@ -247,7 +232,7 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
     for (h, _) in hyps {
         let c = inflation_curve(&law, h, 1.0, 7.5, 651)?;
         let p = dir.join(format!("inflation_{}.csv", h.label().to_lowercase()));
-        write_csv(&p, INFLATION_HEADER, c.iter().map(inflation_row))?;
+        write_csv(&p, INFLATION_HEADER, c.iter().map(inflation_values))?;
         written.push(p);
         inflation.push(c);
     }
@@ -261,7 +246,7 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
                 "flattening_ls{ls0:.1}_{}.csv",
                 h.label().to_lowercase()
             ));
-            write_csv(&p, FLATTENING_HEADER, c.iter().map(flattening_row))?;
+            write_csv(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
             written.push(p);
             per.push(c);
         }

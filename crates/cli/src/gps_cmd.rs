@@ -111,10 +111,10 @@ fn ensure_finite(values: &[f64]) -> Result<()> {
     }
 }
 
-fn inflation_values(s: &InflationState) -> Vec<f64> {
+pub fn inflation_values(s: &InflationState) -> Vec<f64> {
     vec![s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z]
 }
-fn flattening_values(s: &FlatteningState) -> Vec<f64> {
+pub fn flattening_values(s: &FlatteningState) -> Vec<f64> {
     vec![
         s.w,
         s.lambda_s,
