@@ -932,3 +932,38 @@ fn squeezed_sphere_contact_pressure_equals_the_gas_pressure() {
         "plate force does not converge: {f8}, {f16}, {f32}"
     );
 }
+
+/// A flat membrane pressed on a plane: a flat (distorted) element lying δ inside the plane
+/// n·x = d, tilted arbitrarily. Exact: energy κδ²A/2 (A the element area), total force κδA along
+/// n only (frictionless), and no force at all when it lies outside.
+#[test]
+fn flat_membrane_pressed_on_a_plane() {
+    use crate::contact::{contact_kernel, Plane};
+    use crate::element::RefElement;
+    use tubemem_mesh::quad_area;
+    let (kappa, delta) = (250.0, 2e-3);
+    // the plane z = 0 rotated by 0.4 rad about x: normal n, offset 0
+    let (c, s) = (0.4f64.cos(), 0.4f64.sin());
+    let n = [0.0, -s, c];
+    let local = [[0.0, 0.0], [1.3, 0.1], [1.1, 0.9], [-0.2, 0.8]];
+    // in-plane axes e1 = x, e2 = (0, c, s); the element sits at n·x = −δ
+    let place = |d: f64| local.map(|[u, v]| [u, v * c + d * n[1], v * s + d * n[2]]);
+    let x = place(-delta);
+    let re = RefElement::new(0, [0, 1, 2, 3], &x).unwrap();
+    let plane = Plane { normal: n, offset: 0.0 };
+    let mut r = [0.0; 12];
+    let mut k = [0.0; 144];
+    let e = contact_kernel(&re, &x, &[plane], kappa, &mut r, Some(&mut k));
+    let area = quad_area(&x);
+    assert!((e - 0.5 * kappa * delta * delta * area).abs() < 1e-12 * e);
+    // total force on the membrane (minus the residual) is κδA along n
+    let f: [f64; 3] = [0, 1, 2].map(|i| -(0..4).map(|a| r[3 * a + i]).sum::<f64>());
+    for i in 0..3 {
+        assert!((f[i] - kappa * delta * area * n[i]).abs() < 1e-12 * kappa * delta * area, "{f:?}");
+    }
+    // outside the plane: no contact
+    let xo = place(delta);
+    let mut r2 = [0.0; 12];
+    assert_eq!(contact_kernel(&re, &xo, &[plane], kappa, &mut r2, None), 0.0);
+    assert!(r2.iter().all(|v| *v == 0.0));
+}
