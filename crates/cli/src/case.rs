@@ -41,6 +41,9 @@ use tubemem_mesh::Symmetry;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
+    /// the folder of the case file (user mesh paths are relative to it)
+    #[serde(skip)]
+    pub base_dir: std::path::PathBuf,
     pub geometry: Geometry,
     pub material: MaterialSpec,
     pub mesh: MeshSpec,
@@ -107,8 +110,13 @@ pub enum Caps {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
-    pub around: usize,
-    pub along: usize,
+    /// a user mesh (tubemem JSON, see `tubemem_mesh::io`; `python -m tubemem_ref.meshio_io`
+    /// converts any meshio-readable quad mesh), relative to the case file's folder
+    pub file: Option<String>,
+    /// elements around (multiple of 8) of the generated tube
+    pub around: Option<usize>,
+    /// elements along the cylinder (even) of the generated tube
+    pub along: Option<usize>,
     /// rows of elements in each cap between its equator and its top face (default around/8)
     pub cap_rows: Option<usize>,
     #[serde(default)]
@@ -239,7 +247,10 @@ impl Case {
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read case file {}", path.display()))?;
-        Self::parse(&text).with_context(|| format!("in case file {}", path.display()))
+        let mut case =
+            Self::parse(&text).with_context(|| format!("in case file {}", path.display()))?;
+        case.base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+        Ok(case)
     }
 
     pub fn parse(text: &str) -> Result<Self> {
@@ -258,6 +269,15 @@ impl Case {
             if !(v.is_finite() && v > 0.0) {
                 bail!("[geometry] `{k}` = {v}: must be finite and > 0");
             }
+        }
+        let m = &self.mesh;
+        match (&m.file, m.around, m.along) {
+            (Some(_), None, None) if m.cap_rows.is_none() && m.symmetry == Symmetry::None => {}
+            (Some(_), ..) => bail!(
+                "[mesh] `file` gives the whole mesh: drop `around`, `along`, `cap_rows` and `symmetry` (the file sets its own symmetry)"
+            ),
+            (None, Some(_), Some(_)) => {}
+            (None, ..) => bail!("[mesh] needs `around` and `along` (a generated tube) or `file` (a user mesh)"),
         }
         if self.stages.is_empty() {
             bail!("the case has no [[stage]]");

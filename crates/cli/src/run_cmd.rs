@@ -252,15 +252,26 @@ pub fn run(case_path: &Path, out: &Path) -> Result<()> {
 pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
     let g = &case.geometry;
     let half = 0.5 * g.length / g.radius;
-    let (ll, around, along) = (g.length / g.radius, case.mesh.around, case.mesh.along);
-    let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
-    let mesh = match g.caps {
-        Caps::Hemisphere => {
-            capped_tube_with_cap_rows(1.0, ll, around, along, cap_rows, case.mesh.symmetry)
+    let ll = g.length / g.radius;
+    let mesh = match (&case.mesh.file, case.mesh.around, case.mesh.along) {
+        (Some(file), ..) => {
+            let path = case.base_dir.join(file);
+            tubemem_mesh::io::read_json(&path, g.radius)
+                .with_context(|| format!("[mesh] file = {file:?}"))?
         }
-        Caps::RigidPlug => plugged_tube(1.0, ll, around, along, case.mesh.symmetry),
-    }
-    .context("[mesh]")?;
+        (None, Some(around), Some(along)) => {
+            let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
+            match g.caps {
+                Caps::Hemisphere => {
+                    capped_tube_with_cap_rows(1.0, ll, around, along, cap_rows, case.mesh.symmetry)
+                }
+                Caps::RigidPlug => plugged_tube(1.0, ll, around, along, case.mesh.symmetry),
+            }
+            .context("[mesh]")?
+        }
+        _ => bail!("[mesh] needs `around` and `along`, or `file`"),
+    };
+    let symmetry = mesh.symmetry;
     let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;
     let mut model = Model::new(mesh, law)?;
@@ -274,7 +285,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
     let mut summary = json!({
         "case": label,
         "mesh": {"nodes": model.mesh.nodes.len(), "elements": model.mesh.quads.len(), "equations": model.n_eq,
-                 "symmetry": format!("{:?}", case.mesh.symmetry).to_lowercase()},
+                 "symmetry": format!("{symmetry:?}").to_lowercase()},
         "material": model.law.name(),
         "units": "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH), force = plate force per length/(πμH)",
         "stages": [],
@@ -289,7 +300,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
         label,
         model.mesh.quads.len(),
         model.n_eq,
-        case.mesh.symmetry,
+        symmetry,
         model.law.name()
     );
     for (i, spec) in case.stages.iter().enumerate() {

@@ -546,6 +546,17 @@ fn malformed_case_files_name_the_key_and_line() {
             SMALL_CASE.replace("kind = \"inflate\"", "kind = \"inflat\""),
             "inflat",
         ),
+        (
+            SMALL_CASE.replace("around = 16", "file = \"mesh.json\"\naround = 16"),
+            "drop `around`",
+        ),
+        (
+            SMALL_CASE
+                .replace("around = 16\n", "file = \"missing.json\"\n")
+                .replace("along = 24\n", "")
+                .replace("symmetry = \"eighth\"\n", ""),
+            "missing.json",
+        ),
     ];
     for (i, (text, needle)) in cases.iter().enumerate() {
         let case = write_case(&format!("bad{i}"), text);

@@ -950,7 +950,10 @@ fn flat_membrane_pressed_on_a_plane() {
     let place = |d: f64| local.map(|[u, v]| [u, v * c + d * n[1], v * s + d * n[2]]);
     let x = place(-delta);
     let re = RefElement::new(0, [0, 1, 2, 3], &x).unwrap();
-    let plane = Plane { normal: n, offset: 0.0 };
+    let plane = Plane {
+        normal: n,
+        offset: 0.0,
+    };
     let mut r = [0.0; 12];
     let mut k = [0.0; 144];
     let e = contact_kernel(&re, &x, &[plane], kappa, &mut r, Some(&mut k));
@@ -959,11 +962,17 @@ fn flat_membrane_pressed_on_a_plane() {
     // total force on the membrane (minus the residual) is κδA along n
     let f: [f64; 3] = [0, 1, 2].map(|i| -(0..4).map(|a| r[3 * a + i]).sum::<f64>());
     for i in 0..3 {
-        assert!((f[i] - kappa * delta * area * n[i]).abs() < 1e-12 * kappa * delta * area, "{f:?}");
+        assert!(
+            (f[i] - kappa * delta * area * n[i]).abs() < 1e-12 * kappa * delta * area,
+            "{f:?}"
+        );
     }
     // outside the plane: no contact
     let xo = place(delta);
     let mut r2 = [0.0; 12];
-    assert_eq!(contact_kernel(&re, &xo, &[plane], kappa, &mut r2, None), 0.0);
+    assert_eq!(
+        contact_kernel(&re, &xo, &[plane], kappa, &mut r2, None),
+        0.0
+    );
     assert!(r2.iter().all(|v| *v == 0.0));
 }

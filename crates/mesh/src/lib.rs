@@ -23,6 +23,7 @@
 // a non-finite coordinate is reported instead of slipping through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod io;
 pub mod tube;
 pub mod vtu;
 
@@ -69,7 +70,7 @@ pub enum MeshError {
         "the enclosed volume is {volume} ≤ 0: the element normals point inward (inverted mesh)"
     )]
     InwardNormals { volume: f64 },
-    #[error("cannot write {path}: {reason}")]
+    #[error("{path}: {reason}")]
     Io { path: String, reason: String },
 }
 
@@ -231,6 +232,8 @@ impl Mesh {
         let on: Vec<Vec<bool>> = (0..3).map(|ax| self.on_plane(ax)).collect();
         let mut keys: Vec<_> = edges.keys().copied().collect();
         keys.sort_unstable();
+        // orientation conflicts: (element, element, edge)
+        let mut conflicts: Vec<(usize, usize, (usize, usize))> = Vec::new();
         for key in keys {
             let users = &edges[&key];
             match users.len() {
@@ -262,12 +265,7 @@ impl Mesh {
                 }
                 2 => {
                     if users[0].1 == users[1].1 {
-                        return Err(MeshError::Inverted {
-                            element: users[1].0.max(users[0].0),
-                            neighbour: users[1].0.min(users[0].0),
-                            a: key.0,
-                            b: key.1,
-                        });
+                        conflicts.push((users[0].0, users[1].0, key));
                     }
                 }
                 c => {
@@ -278,6 +276,30 @@ impl Mesh {
                     })
                 }
             }
+        }
+        if !conflicts.is_empty() {
+            // An inverted element disagrees with (up to) all its neighbours, each neighbour only
+            // with it: name the element with the most conflicts (ties: the lowest index).
+            let mut count: HashMap<usize, usize> = HashMap::new();
+            for &(a, b, _) in &conflicts {
+                *count.entry(a).or_default() += 1;
+                *count.entry(b).or_default() += 1;
+            }
+            let worst = count
+                .iter()
+                .max_by(|x, y| x.1.cmp(y.1).then(y.0.cmp(x.0)))
+                .map(|(&e, _)| e)
+                .unwrap_or(conflicts[0].0);
+            let &(a, b, edge) = conflicts
+                .iter()
+                .find(|c| c.0 == worst || c.1 == worst)
+                .unwrap_or(&conflicts[0]);
+            return Err(MeshError::Inverted {
+                element: worst,
+                neighbour: if a == worst { b } else { a },
+                a: edge.0,
+                b: edge.1,
+            });
         }
         let v = self.volume();
         if !(v > 0.0) {

@@ -96,18 +96,17 @@ fn symmetry_reductions_work() {
 #[test]
 fn mesh_check_rejects_bad_meshes() {
     let good = capped_tube(1.0, 4.0, 8, 4, Symmetry::None).unwrap();
-    let mut flipped = good.clone();
-    flipped.quads[5] = [
-        flipped.quads[5][0],
-        flipped.quads[5][3],
-        flipped.quads[5][2],
-        flipped.quads[5][1],
-    ];
-    assert!(
-        matches!(flipped.check(), Err(MeshError::Inverted { .. })),
-        "{:?}",
-        flipped.check()
-    );
+    // a flipped element is named (it disagrees with all its neighbours), whatever its index
+    for e in [0, 5, good.quads.len() - 1] {
+        let mut flipped = good.clone();
+        let q = flipped.quads[e];
+        flipped.quads[e] = [q[0], q[3], q[2], q[1]];
+        let r = flipped.check();
+        assert!(
+            matches!(r, Err(MeshError::Inverted { element, .. }) if element == e),
+            "{r:?}"
+        );
+    }
     let mut open = good.clone();
     open.quads.remove(3);
     assert!(matches!(open.check(), Err(MeshError::Open { .. })));
@@ -258,4 +257,40 @@ fn cap_rows_refine_the_caps() {
         capped_tube_with_cap_rows(r, l, around, 8, 2, Symmetry::None).unwrap()
     );
     assert!(capped_tube_with_cap_rows(r, l, around, 8, 0, Symmetry::None).is_err());
+}
+
+#[test]
+fn json_mesh_round_trip_and_rejection() {
+    let dir = std::env::temp_dir().join(format!("tubemem-json-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = capped_tube(1.0, 4.0, 8, 4, Symmetry::Eighth).unwrap();
+    let p = dir.join("m.json");
+    crate::io::write_json(&p, &mesh).unwrap();
+    assert_eq!(crate::io::read_json(&p, 1.0).unwrap(), mesh);
+    // scaled coordinates come back in units of R
+    let scaled = Mesh {
+        nodes: mesh.nodes.iter().map(|q| q.map(|v| 2.0 * v)).collect(),
+        ..mesh.clone()
+    };
+    crate::io::write_json(&p, &scaled).unwrap();
+    assert_eq!(crate::io::read_json(&p, 2.0).unwrap(), mesh);
+    // an inverted element is rejected and named
+    let mut bad = mesh.clone();
+    bad.quads[3] = [
+        bad.quads[3][0],
+        bad.quads[3][3],
+        bad.quads[3][2],
+        bad.quads[3][1],
+    ];
+    crate::io::write_json(&p, &bad).unwrap();
+    let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
+    assert!(e.contains("inverted") && e.contains("element 3"), "{e}");
+    // malformed JSON: line and column
+    std::fs::write(
+        &p,
+        "{\n  \"nodes\": [[0, 0, 0]],\n  \"quads\": [[0, 1, 2]]\n}",
+    )
+    .unwrap();
+    let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
+    assert!(e.contains("line 3"), "{e}");
 }
