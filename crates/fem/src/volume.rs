@@ -9,7 +9,7 @@
 //! The Hessian is symmetric (it is the Hessian of a scalar), so the pressure load stiffness
 //! −p ∂²V/∂x² is symmetric as well.
 
-use tubemem_mesh::{cross, dot, shape, GAUSS2};
+use tubemem_mesh::{cross, dot, shape, tangents, GAUSS2};
 
 fn skew(a: [f64; 3]) -> [[f64; 3]; 3] {
     [[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]]
@@ -29,16 +29,7 @@ pub fn volume_kernel(
     let mut v = 0.0;
     for &(xi, eta) in &GAUSS2 {
         let (n, d) = shape(xi, eta);
-        let mut p = [0.0; 3];
-        let mut g1 = [0.0; 3];
-        let mut g2 = [0.0; 3];
-        for a in 0..4 {
-            for k in 0..3 {
-                p[k] += n[a] * x[a][k];
-                g1[k] += d[a][0] * x[a][k];
-                g2[k] += d[a][1] * x[a][k];
-            }
-        }
+        let (p, g1, g2) = tangents(x, xi, eta);
         let g12 = cross(g1, g2);
         v += third * dot(p, g12);
         let (g2x, xg1) = (cross(g2, p), cross(p, g1));
