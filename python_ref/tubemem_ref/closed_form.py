@@ -118,3 +118,39 @@ def gps_maxwell(kuhn=30.0):
     p = optimize.brentq(lambda q: area(q)[0], w_min + 1e-9, w_max - 1e-9, xtol=1e-15, rtol=1e-14)
     _, l1, l3 = area(p)
     return p, l1, l3
+
+
+def gps_square_channel(ls0, hs, kuhn=30.0):
+    """Hand calculation from the paper's general GPS equations (55)-(60) for a tube inflated to
+    ls0, gas closed in, then squeezed in a square channel |x|, |y| <= h (h < r*): the section is a
+    square of side 2h with four corner arcs of radius r (Sec. 3.2), so
+        L = 2 pi r + 8 (h - r),  A = 4 h^2 - (4 - pi) r^2,
+        w r = N_s,  w A / L = N_z,  ls = L / (2 pi),  lz w A = w* lz* pi ls*^2.
+    Unknowns (w, r, lz) for each h (ls follows from r); continuation from h = r*."""
+    w0, lz0 = gps_inflation(ls0, kuhn)
+    gas = w0 * lz0 * np.pi * ls0**2
+
+    def res(z, h):
+        w, r, lz = z
+        length = 2 * np.pi * r + 8 * (h - r)
+        area = 4 * h * h - (4 - np.pi) * r * r
+        ls = length / (2 * np.pi)
+        ns, nz = abb_resultants(ls, lz, kuhn)
+        return [w * r - ns, w * area / length - nz, (lz * w * area - gas) / gas]
+
+    z = np.array([w0, ls0, lz0])
+    out, h_prev = [], ls0
+    for h in hs:
+        n = max(1, int(np.ceil((h_prev - h) / (0.01 * ls0))))
+        for hh in np.linspace(h_prev, h, n + 1)[1:]:
+            sol = optimize.root(res, z, args=(hh,), method="hybr", tol=1e-14)
+            if not sol.success and np.max(np.abs(res(sol.x, hh))) > 1e-11:
+                raise RuntimeError(f"square channel: hybrd failed at h = {hh}: {sol.message}")
+            z = sol.x
+        h_prev = h
+        w, r, lz = z
+        length = 2 * np.pi * r + 8 * (h - r)
+        out.append(dict(h=h, w=w, r=r, lambda_s=length / (2 * np.pi), lambda_z=lz,
+                        area=4 * h * h - (4 - np.pi) * r * r,
+                        force=w * 2 * (h - r) / np.pi))  # p x flat width 2(h - r), over pi
+    return out
