@@ -1,0 +1,149 @@
+"""Axisymmetric capped tube in scikit-fem, written from the membrane equations of the paper
+(Sec. 2), independently of the Rust code.
+
+The meridian of a closed tube of revolution — a cylinder of radius R = 1 and length L between two
+hemispherical caps — is parametrized by its reference arc length S from the cap's pole (S = 0) to
+the mid-span (S = pi/2 + L/2); by symmetry only this half is modelled. Fields r(S), z(S) are P2.
+
+    lambda_1 = |d(r, z)/dS|  (meridional),  lambda_2 = r / R0(S)  (hoop)
+    R0(S) = sin S on the cap, 1 on the cylinder
+    Pi = int 2 pi R0 W(lambda_1, lambda_2) dS - p V,   V = pi int r^2 z' dS   (half tube: |V|)
+
+Boundary conditions: r = 0 at the pole, z = 0 at mid-span (symmetry plane). The pressure p is
+either prescribed (pressure control) or the Lagrange multiplier of a constraint (the mid-span
+radius, as the paper controls its inflation), solved in one bordered Newton system with the
+consistent tangent. The mid-span values are lambda_s = r/R and lambda_z = lambda_1 there, and the
+profiles along z give the end-cap boundary layer.
+"""
+
+import numpy as np
+from skfem import Basis, BilinearForm, ElementLineP2, ElementVector, Functional, LinearForm, MeshLine1
+
+from .gps_section import abb_derivatives
+
+
+class AxisymmetricTube:
+    def __init__(self, length, kuhn=30.0, cap_elements=32, cylinder_elements=160, intorder=6):
+        self.kuhn = kuhn
+        self.length = length
+        sj = np.pi / 2
+        nodes = np.concatenate([np.linspace(0.0, sj, cap_elements + 1),
+                                np.linspace(sj, sj + length / 2, cylinder_elements + 1)[1:]])
+        self.s_end = sj + length / 2
+        self.basis = Basis(MeshLine1.init_tensor(nodes), ElementVector(ElementLineP2(), 2), intorder=intorder)
+        nd = self.basis.nodal_dofs
+        self.fixed = np.array([nd[0, 0], nd[1, -1]])  # r at the pole, z at mid-span
+        self.free = np.setdiff1d(np.arange(self.basis.N), self.fixed)
+        self.mid_r = nd[0, -1]
+
+    def reference(self):
+        s = self.basis.doflocs[0]
+        comp = np.arange(self.basis.N) % 2
+        q = np.zeros(self.basis.N)
+        sj, half = np.pi / 2, self.length / 2
+        cap = s <= sj
+        r = np.where(cap, np.sin(np.minimum(s, sj)), 1.0)
+        z = np.where(cap, half + np.cos(np.minimum(s, sj)), half - (s - sj))
+        q[comp == 0] = r[comp == 0]
+        q[comp == 1] = z[comp == 1]
+        return q
+
+    def _forms(self):
+        kuhn = self.kuhn
+
+        def geo(w):
+            u = w["u"]
+            s = w.x[0]
+            r0 = np.where(s <= np.pi / 2, np.sin(np.minimum(s, np.pi / 2)), 1.0)
+            dr, dz = u.grad[0][0], u.grad[1][0]
+            l1 = np.sqrt(dr**2 + dz**2)
+            l2 = u[0] / r0
+            return r0, u[0], u[1], dr, dz, l1, l2
+
+        @LinearForm
+        def r_int(v, w):
+            r0, r, z, dr, dz, l1, l2 = geo(w)
+            _, w1, w2, _, _, _ = abb_derivatives(l1, l2, kuhn)
+            return 2 * np.pi * r0 * (w1 / l1 * (dr * v.grad[0][0] + dz * v.grad[1][0]) + w2 * v[0] / r0)
+
+        @BilinearForm
+        def k_int(u, v, w):
+            r0, r, z, dr, dz, l1, l2 = geo(w)
+            _, w1, w2, w11, w12, w22 = abb_derivatives(l1, l2, kuhn)
+            gu = dr * u.grad[0][0] + dz * u.grad[1][0]
+            gv = dr * v.grad[0][0] + dz * v.grad[1][0]
+            uv = u.grad[0][0] * v.grad[0][0] + u.grad[1][0] * v.grad[1][0]
+            return 2 * np.pi * r0 * ((w11 / l1**2 - w1 / l1**3) * gu * gv + w1 / l1 * uv
+                                     + w12 / (l1 * r0) * (gv * u[0] + gu * v[0]) + w22 / r0**2 * u[0] * v[0])
+
+        @Functional
+        def volume(w):
+            _, r, z, dr, dz, _, _ = geo(w)
+            return -np.pi * r**2 * dz  # z decreases from the pole to mid-span
+
+        @LinearForm
+        def d_volume(v, w):
+            _, r, z, dr, dz, _, _ = geo(w)
+            return -np.pi * (2 * r * dz * v[0] + r**2 * v.grad[1][0])
+
+        @BilinearForm
+        def d2_volume(u, v, w):
+            _, r, z, dr, dz, _, _ = geo(w)
+            return -np.pi * (2 * dz * u[0] * v[0] + 2 * r * (u[0] * v.grad[1][0] + v[0] * u.grad[1][0]))
+
+        return r_int, k_int, volume, d_volume, d2_volume
+
+    def solve_stretch(self, q, p, target, tol=1e-11, max_iterations=60):
+        """Newton for the state whose mid-span radius is `target`, pressure as the multiplier."""
+        b = self.basis
+        r_int, k_int, volume, d_volume, d2_volume = self._forms()
+        fr = self.free
+        k_mid = int(np.where(fr == self.mid_r)[0][0])
+        for it in range(max_iterations):
+            uq = b.interpolate(q)
+            g = d_volume.assemble(b, u=uq)
+            res = (r_int.assemble(b, u=uq) - p * g)[fr]
+            kk = (k_int.assemble(b, u=uq) - p * d2_volume.assemble(b, u=uq)).toarray()[np.ix_(fr, fr)]
+            n = len(fr)
+            jac = np.zeros((n + 1, n + 1))
+            jac[:n, :n] = kk
+            jac[:n, n] = -g[fr]
+            jac[n, k_mid] = 1.0
+            rhs = -np.append(res, q[self.mid_r] - target)
+            step = np.linalg.solve(jac, rhs)
+            t = min(1.0, 0.1 / max(np.abs(step[:-1]).max(), 1e-300))
+            q = q.copy()
+            q[fr] += t * step[:-1]
+            p += t * step[-1]
+            if np.abs(step).max() < tol and np.abs(res).max() < 1e-9 * max(1.0, np.abs(r_int.assemble(b, u=uq)).max()):
+                return q, p, it
+        raise RuntimeError(f"axisymmetric Newton did not converge at target {target}")
+
+    def profile(self, q):
+        """(z, lambda_s, lambda_z) at the mesh vertices on the cylinder and cap, from mid-span out."""
+        nd = self.basis.nodal_dofs
+        r, z = q[nd[0]], q[nd[1]]
+        s = self.basis.mesh.p[0]
+        r0 = np.where(s <= np.pi / 2, np.sin(np.minimum(s, np.pi / 2)), 1.0)
+        ds = np.gradient(s)
+        l1 = np.hypot(np.gradient(r), np.gradient(z)) / ds
+        with np.errstate(divide="ignore", invalid="ignore"):
+            l2 = np.where(r0 > 0, r / r0, np.nan)
+        return z, l2, l1, s
+
+    def midspan(self, q, p):
+        uq = self.basis.interpolate(q)
+        # lambda_z at mid-span from the P2 field's derivative at the last quadrature point
+        dz = uq.grad[1][0][-1, -1]
+        dr = uq.grad[0][0][-1, -1]
+        return dict(w=p, lambda_s=q[self.mid_r], lambda_z=float(np.hypot(dr, dz)))
+
+
+def inflate_to(length, target, kuhn=30.0, steps=6, **mesh):
+    """Inflate the capped tube to mid-span stretch `target` (continuation in steps)."""
+    tube = AxisymmetricTube(length, kuhn, **mesh)
+    q, p = tube.reference(), 0.0
+    # a small pressure-like start: a slightly inflated reference avoids the stress-free state
+    for t in np.linspace(1.0, target, steps + 1)[1:]:
+        q, p, _ = tube.solve_stretch(q, p, t)
+    return tube, q, p
