@@ -287,6 +287,9 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
         "mesh": {"nodes": model.mesh.nodes.len(), "elements": model.mesh.quads.len(), "equations": model.n_eq,
                  "symmetry": format!("{symmetry:?}").to_lowercase()},
         "material": model.law.name(),
+        "material_spec": serde_json::to_value(case.material)?,
+        "geometry": {"radius": g.radius, "length": g.length, "thickness": g.thickness,
+                     "caps": format!("{:?}", g.caps).to_lowercase()},
         "units": "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH), force = plate force per length/(πμH)",
         "stages": [],
     });

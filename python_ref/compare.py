@@ -1,0 +1,118 @@
+"""Compare a `tubemem run` folder with the independent references.
+
+    python python_ref/compare.py RUN_DIR [--out RUN_DIR/compare]
+
+For every stage of the run it computes the matching reference and prints (and writes as
+compare.csv) a side-by-side table of the mid-span values: FE (Rust), scikit-fem, closed form,
+and the relative differences.
+- inflation stage: the scikit-fem axisymmetric capped tube of the same L/R at the FE's mid-span
+  λs, and GPS (eq. 66); it also plots the end-cap profile λs(Z), FE against axisymmetric, as
+  profile_stageN.png and reports the largest difference along the tube;
+- squeeze stage: the scikit-fem GPS cross-section with contact at the FE's λs* and ρ, and GPS
+  flattening (eqs. 76-77).
+Only the Anssari-Benam--Bucchi law is implemented in the references.
+"""
+
+import argparse
+import csv
+import pathlib
+import sys
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from tubemem_ref import axisym, closed_form, gps_section, runs  # noqa: E402
+
+
+def rel(a, b):
+    return a / b - 1.0
+
+
+def read_profile(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def compare(run_dir, out_dir, plot=True):
+    run_dir = pathlib.Path(run_dir)
+    out_dir = pathlib.Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    summary = runs.read_summary(run_dir)
+    spec, geo = summary["material_spec"], summary["geometry"]
+    if spec.get("model") != "abb":
+        raise SystemExit(f"the references implement the abb law only, not {spec.get('model')!r}")
+    if geo.get("caps") != "hemisphere":
+        raise SystemExit("the axisymmetric reference models hemispherical caps only")
+    kuhn, length = spec["kuhn"], geo["length"] / geo["radius"]
+    rows = []
+    ls_star = None
+    for st in summary["stages"]:
+        if "final" not in st:
+            continue
+        fin, idx = st["final"], st["index"]
+        if st["kind"] == "inflate":
+            ls = fin["lambda_s"]
+            tube, q, p = axisym.inflate_to(length, ls, kuhn=kuhn, cylinder_elements=int(8 * length))
+            ax = tube.midspan(q, p)
+            w, lz = closed_form.gps_inflation(ls, kuhn)
+            for k, fe, sk, cf in [("w", fin["w"], ax["w"], w), ("lambda_z", fin["lambda_z"], ax["lambda_z"], lz)]:
+                rows.append((idx, "inflate", k, fe, sk, cf, rel(fe, sk), rel(fe, cf), rel(sk, cf)))
+            prof = read_profile(pathlib.Path(st["profile"]))
+            z_ax, ls_ax, _, s_ax = tube.profile(q)
+            cyl = s_ax >= np.pi / 2 - 1e-12
+            z_ref_ax = length / 2 - (s_ax[cyl] - np.pi / 2)
+            order = np.argsort(z_ref_ax)
+            sel = prof["z_ref"] >= -1e-12
+            ls_interp = np.interp(prof["z_ref"][sel], z_ref_ax[order], ls_ax[cyl][order])
+            diff = prof["lambda_s"][sel] - ls_interp
+            imax = int(np.argmax(np.abs(diff)))
+            rows.append((idx, "inflate", "profile max |Δλs|", float(np.abs(diff).max()), float(prof["z_ref"][sel][imax]),
+                         np.nan, np.nan, np.nan, np.nan))
+            if plot:
+                import matplotlib
+                matplotlib.use("Agg")
+                import matplotlib.pyplot as plt
+                fig, ax1 = plt.subplots(figsize=(8, 5))
+                ax1.plot(z_ref_ax[order], ls_ax[cyl][order], "-", label="scikit-fem axisymmetric")
+                ax1.plot(prof["z_ref"][sel], prof["lambda_s"][sel], "o", ms=3, label="tubemem FE (Rust)")
+                ax1.axhline(ls, color="grey", ls=":", label="mid-span λs")
+                ax1.set_xlabel("reference height Z/R (0 = mid-span, L/2R = cap junction)")
+                ax1.set_ylabel("hoop stretch λs")
+                ax1.set_title(f"End-cap profile, stage {idx}, L/R = {length:g}")
+                ax1.legend()
+                fig.tight_layout()
+                fig.savefig(out_dir / f"profile_stage{idx}.png", dpi=110)
+                plt.close(fig)
+            ls_star = ls
+        elif st["kind"] == "squeeze":
+            ls0, rho = fin["initial_stretch"], fin["rho"]
+            sec = gps_section.squeeze(ls0, [rho], kuhn=kuhn, elements=64, penalty=1e5)[0]
+            cf = closed_form.gps_flattening(ls0, [rho], kuhn)[0]
+            for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
+                rows.append((idx, "squeeze", k, fin[k], sec[k], cf[k], rel(fin[k], sec[k]), rel(fin[k], cf[k]), rel(sec[k], cf[k])))
+    header = ["stage", "kind", "quantity", "fe", "scikit_fem", "closed_form", "fe_vs_skfem", "fe_vs_closed", "skfem_vs_closed"]
+    with open(out_dir / "compare.csv", "w", newline="") as f:
+        wr = csv.writer(f)
+        wr.writerow(header)
+        wr.writerows(rows)
+    print(f"{'stage':>5} {'kind':>8} {'quantity':>18} {'FE':>12} {'scikit-fem':>12} {'closed':>12} {'FE/skfem-1':>11} {'FE/GPS-1':>10} {'skfem/GPS-1':>11}")
+    for r in rows:
+        if r[2].startswith("profile"):
+            print(f"{r[0]:>5} {r[1]:>8} {r[2]:>18} {r[3]:>12.3e} at Z = {r[4]:.3f}")
+        else:
+            print(f"{r[0]:>5} {r[1]:>8} {r[2]:>18} {r[3]:>12.7f} {r[4]:>12.7f} {r[5]:>12.7f} {r[6]:>+11.2e} {r[7]:>+10.2e} {r[8]:>+11.2e}")
+    return rows
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="Compare a tubemem run folder with the scikit-fem references and the closed form.")
+    ap.add_argument("run_dir")
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--no-plot", action="store_true")
+    a = ap.parse_args(argv)
+    compare(a.run_dir, a.out or pathlib.Path(a.run_dir) / "compare", plot=not a.no_plot)
+
+
+if __name__ == "__main__":
+    main()
