@@ -35,3 +35,41 @@ def test_axisymmetric_limit_point_pressure_is_the_gps_one():
         best = max(best, (p, ls))
     assert abs(best[0] / wmax - 1) < 2e-3, (best, wmax)
     assert abs(best[1] - lmax) < 0.03, (best, lmax)
+
+
+def test_mooney_rivlin_and_pressure_control():
+    """Mooney-Rivlin (alpha = 0.1): the mid-span at L/R = 20 matches GPS built from eqs. (86)-(87)
+    (measured 5.9e-8; bound 1e-4), and pressure control at that pressure returns the same state."""
+    law = ("mooney-rivlin", 0.1)
+    tube, q, p = axisym.inflate_to(20.0, 1.3, law=law)
+    m = tube.midspan(q, p)
+    w, lz = cf.gps_inflation_mr(1.3, 0.1)
+    assert abs(m["w"] / w - 1) < 1e-4 and abs(m["lambda_z"] / lz - 1) < 1e-4
+    t2 = axisym.AxisymmetricTube(20.0, law=law)
+    q2, p2 = t2.reference(), 0.0
+    for pp in np.linspace(0.1, m["w"], 8):
+        q2, p2, _ = t2.solve(q2, p2, ("pressure", pp))
+    assert abs(q2[t2.mid_r] - 1.3) < 1e-8
+
+
+def test_volume_control_passes_the_limit_point_into_a_bulge():
+    """Volume control from lambda_s = 1.5 (L/R = 20, ABB N = 30): the pressure passes its
+    maximum (measured 0.757781, as on the stretch-controlled path, +1.2e-3 from the GPS limit)
+    and falls, while the mid-span stretch runs away from the rest of the tube: an axisymmetric
+    bulge (measured at V = 1.25 V0: w = 0.68922, lambda_s 2.349 at mid-span against 1.350 at
+    Z = 6 R)."""
+    (lmax, wmax), _ = cf.gps_limit_points()
+    tube, q, p = axisym.inflate_to(20.0, 1.5)
+    v0 = tube.half_volume(q)
+    states = []
+
+    def record(q, p):
+        _, ls, _, s = tube.profile(q)
+        states.append((p, q[tube.mid_r], ls[np.argmin(np.abs(s - (np.pi / 2 + 4)))]))
+
+    axisym.inflate_volume(tube, q, p, 1.25 * v0, 0.01 * v0, on_step=record)
+    pmax = max(s[0] for s in states)
+    assert abs(pmax / wmax - 1) < 2e-3, (pmax, wmax)
+    p_end, ls_mid, ls_side = states[-1]
+    assert p_end < pmax - 0.03, "the pressure falls past the limit point"
+    assert ls_mid - ls_side > 0.5, f"no localized bulge: mid-span {ls_mid}, Z = 6: {ls_side}"

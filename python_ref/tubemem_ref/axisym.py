@@ -12,19 +12,20 @@ the mid-span (S = pi/2 + L/2); by symmetry only this half is modelled. Fields r(
 Boundary conditions: r = 0 at the pole, z = 0 at mid-span (symmetry plane). The pressure p is
 either prescribed (pressure control) or the Lagrange multiplier of a constraint (the mid-span
 radius, as the paper controls its inflation), solved in one bordered Newton system with the
-consistent tangent. The mid-span values are lambda_s = r/R and lambda_z = lambda_1 there, and the
+consistent tangent; or the pressure is prescribed, or the volume (control = "pressure" |
+"stretch" | "volume" in `AxisymmetricTube.solve`). The mid-span values are lambda_s = r/R and lambda_z = lambda_1 there, and the
 profiles along z give the end-cap boundary layer.
 """
 
 import numpy as np
 from skfem import Basis, BilinearForm, ElementLineP2, ElementVector, Functional, LinearForm, MeshLine1
 
-from .gps_section import abb_derivatives
+from .gps_section import law_derivatives
 
 
 class AxisymmetricTube:
-    def __init__(self, length, kuhn=30.0, cap_elements=32, cylinder_elements=160, intorder=6):
-        self.kuhn = kuhn
+    def __init__(self, length, kuhn=30.0, cap_elements=32, cylinder_elements=160, intorder=6, law=None):
+        self.law = law or ("abb", kuhn)
         self.length = length
         sj = np.pi / 2
         nodes = np.concatenate([np.linspace(0.0, sj, cap_elements + 1),
@@ -49,7 +50,7 @@ class AxisymmetricTube:
         return q
 
     def _forms(self):
-        kuhn = self.kuhn
+        law = self.law
 
         def geo(w):
             u = w["u"]
@@ -63,13 +64,13 @@ class AxisymmetricTube:
         @LinearForm
         def r_int(v, w):
             r0, r, z, dr, dz, l1, l2 = geo(w)
-            _, w1, w2, _, _, _ = abb_derivatives(l1, l2, kuhn)
+            _, w1, w2, _, _, _ = law_derivatives(l1, l2, law)
             return 2 * np.pi * r0 * (w1 / l1 * (dr * v.grad[0][0] + dz * v.grad[1][0]) + w2 * v[0] / r0)
 
         @BilinearForm
         def k_int(u, v, w):
             r0, r, z, dr, dz, l1, l2 = geo(w)
-            _, w1, w2, w11, w12, w22 = abb_derivatives(l1, l2, kuhn)
+            _, w1, w2, w11, w12, w22 = law_derivatives(l1, l2, law)
             gu = dr * u.grad[0][0] + dz * u.grad[1][0]
             gv = dr * v.grad[0][0] + dz * v.grad[1][0]
             uv = u.grad[0][0] * v.grad[0][0] + u.grad[1][0] * v.grad[1][0]
@@ -93,31 +94,51 @@ class AxisymmetricTube:
 
         return r_int, k_int, volume, d_volume, d2_volume
 
-    def solve_stretch(self, q, p, target, tol=1e-11, max_iterations=60):
-        """Newton for the state whose mid-span radius is `target`, pressure as the multiplier."""
+    def solve_stretch(self, q, p, target, **kw):
+        """The state whose mid-span radius is `target`, pressure as the multiplier."""
+        return self.solve(q, p, ("stretch", target), **kw)
+
+    def half_volume(self, q):
+        _, _, volume, _, _ = self._forms()
+        return volume.assemble(self.basis, u=self.basis.interpolate(q))
+
+    def solve(self, q, p, control, tol=1e-11, max_iterations=60):
+        """Newton for control = ("pressure", p) | ("stretch", mid-span radius) |
+        ("volume", half-tube volume); the pressure is the Lagrange multiplier of the latter two."""
         b = self.basis
         r_int, k_int, volume, d_volume, d2_volume = self._forms()
         fr = self.free
+        kind, value = control
+        if kind == "pressure":
+            p = value
         k_mid = int(np.where(fr == self.mid_r)[0][0])
         for it in range(max_iterations):
             uq = b.interpolate(q)
             g = d_volume.assemble(b, u=uq)
-            res = (r_int.assemble(b, u=uq) - p * g)[fr]
+            fint = r_int.assemble(b, u=uq)
+            res = (fint - p * g)[fr]
             kk = (k_int.assemble(b, u=uq) - p * d2_volume.assemble(b, u=uq)).toarray()[np.ix_(fr, fr)]
             n = len(fr)
-            jac = np.zeros((n + 1, n + 1))
-            jac[:n, :n] = kk
-            jac[:n, n] = -g[fr]
-            jac[n, k_mid] = 1.0
-            rhs = -np.append(res, q[self.mid_r] - target)
-            step = np.linalg.solve(jac, rhs)
+            if kind == "pressure":
+                step = np.append(np.linalg.solve(kk, -res), 0.0)
+            else:
+                jac = np.zeros((n + 1, n + 1))
+                jac[:n, :n] = kk
+                jac[:n, n] = -g[fr]
+                if kind == "stretch":
+                    jac[n, k_mid] = 1.0
+                    c = q[self.mid_r] - value
+                else:
+                    jac[n, :n] = g[fr]
+                    c = volume.assemble(b, u=uq) - value
+                step = np.linalg.solve(jac, -np.append(res, c))
             t = min(1.0, 0.1 / max(np.abs(step[:-1]).max(), 1e-300))
             q = q.copy()
             q[fr] += t * step[:-1]
             p += t * step[-1]
-            if np.abs(step).max() < tol and np.abs(res).max() < 1e-9 * max(1.0, np.abs(r_int.assemble(b, u=uq)).max()):
+            if np.abs(step).max() < tol and np.abs(res).max() < 1e-9 * max(1.0, np.abs(fint).max()):
                 return q, p, it
-        raise RuntimeError(f"axisymmetric Newton did not converge at target {target}")
+        raise RuntimeError(f"axisymmetric Newton did not converge for {control}")
 
     def profile(self, q):
         """(z, lambda_s, lambda_z) at the mesh vertices on the cylinder and cap, from mid-span out."""
@@ -139,11 +160,32 @@ class AxisymmetricTube:
         return dict(w=p, lambda_s=q[self.mid_r], lambda_z=float(np.hypot(dr, dz)))
 
 
-def inflate_to(length, target, kuhn=30.0, steps=6, **mesh):
+def inflate_to(length, target, kuhn=30.0, steps=6, law=None, **mesh):
     """Inflate the capped tube to mid-span stretch `target` (continuation in steps)."""
-    tube = AxisymmetricTube(length, kuhn, **mesh)
+    tube = AxisymmetricTube(length, kuhn, law=law, **mesh)
     q, p = tube.reference(), 0.0
     # a small pressure-like start: a slightly inflated reference avoids the stress-free state
     for t in np.linspace(1.0, target, steps + 1)[1:]:
         q, p, _ = tube.solve_stretch(q, p, t)
     return tube, q, p
+
+
+def inflate_volume(tube, q, p, v_target, dv, min_dv=1e-6, on_step=None):
+    """Volume-controlled continuation of the half tube from (q, p) to `v_target`, with step
+    halving on failure and growth after easy steps; `on_step(q, p)` sees every converged state."""
+    v = tube.half_volume(q)
+    while v < v_target - 1e-12:
+        step = min(dv, v_target - v)
+        try:
+            q1, p1, it = tube.solve(q, p, ("volume", v + step))
+        except (RuntimeError, np.linalg.LinAlgError):
+            dv *= 0.5
+            if dv < min_dv:
+                raise
+            continue
+        q, p, v = q1, p1, v + step
+        if on_step is not None:
+            on_step(q, p)
+        if it < 6:
+            dv *= 1.5
+    return q, p

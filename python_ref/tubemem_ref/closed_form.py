@@ -154,3 +154,16 @@ def gps_square_channel(ls0, hs, kuhn=30.0):
                         area=4 * h * h - (4 - np.pi) * r * r,
                         force=w * 2 * (h - r) / np.pi))  # p x flat width 2(h - r), over pi
     return out
+
+
+def mr_resultants(ls, lz, alpha):
+    """eqs. (86)-(87): Mooney-Rivlin (N_s, N_z)/(mu H), lambda_I = ls, lambda_II = lz."""
+    j3 = (ls * lz) ** 3
+    return (ls / lz - 1 / j3) * (1 + alpha * lz**2), (lz / ls - 1 / j3) * (1 + alpha * ls**2)
+
+
+def gps_inflation_mr(ls, alpha):
+    """(w, lambda_z) of GPS free inflation for Mooney-Rivlin: eq. (66) with eqs. (86)-(87)."""
+    g = lambda lz: mr_resultants(ls, lz, alpha)[0] - 2 * mr_resultants(ls, lz, alpha)[1]
+    lz = optimize.brentq(g, 0.5, 20.0, xtol=1e-15, rtol=1e-15)
+    return mr_resultants(ls, lz, alpha)[0] / ls, lz

@@ -27,6 +27,26 @@ from skfem import Basis, BilinearForm, ElementLineP2, ElementVector, Functional,
 from .closed_form import gps_inflation
 
 
+def law_derivatives(l1, l2, law):
+    """W(λ1, λ2) and W_1, W_2, W_11, W_12, W_22 for law = ("abb", 𝒩) (eq. 21) or
+    ("mooney-rivlin", α) (eq. 85; α = 0 is neo-Hookean)."""
+    kind, param = law
+    if kind == "abb":
+        return abb_derivatives(l1, l2, param)
+    if kind == "mooney-rivlin":
+        a = param
+        i1 = l1**2 + l2**2 + 1 / (l1 * l2) ** 2
+        i2 = 1 / l1**2 + 1 / l2**2 + (l1 * l2) ** 2
+        i1_1, i1_2 = 2 * l1 - 2 / (l1**3 * l2**2), 2 * l2 - 2 / (l1**2 * l2**3)
+        i1_11, i1_22, i1_12 = 2 + 6 / (l1**4 * l2**2), 2 + 6 / (l1**2 * l2**4), 4 / (l1**3 * l2**3)
+        i2_1, i2_2 = -2 / l1**3 + 2 * l1 * l2**2, -2 / l2**3 + 2 * l1**2 * l2
+        i2_11, i2_22, i2_12 = 6 / l1**4 + 2 * l2**2, 6 / l2**4 + 2 * l1**2, 4 * l1 * l2
+        h = 0.5
+        return (h * ((i1 - 3) + a * (i2 - 3)), h * (i1_1 + a * i2_1), h * (i1_2 + a * i2_2),
+                h * (i1_11 + a * i2_11), h * (i1_12 + a * i2_12), h * (i1_22 + a * i2_22))
+    raise ValueError(f"unknown law {kind!r}")
+
+
 def abb_derivatives(ls, lz, kuhn):
     """W(λs, λz) of eq. (21) and its derivatives W_s, W_z, W_ss, W_sz, W_zz (arrays)."""
     n = kuhn
