@@ -167,3 +167,63 @@ def gps_inflation_mr(ls, alpha):
     g = lambda lz: mr_resultants(ls, lz, alpha)[0] - 2 * mr_resultants(ls, lz, alpha)[1]
     lz = optimize.brentq(g, 0.5, 20.0, xtol=1e-15, rtol=1e-15)
     return mr_resultants(ls, lz, alpha)[0] / ls, lz
+
+
+def gps_polygon(ls0, lines, hs, kuhn=30.0):
+    """Hand calculation (paper Secs. 3.2 and 3.6, eqs. 55-60) for a tube inflated to ls0, gas
+    closed in, then confined by straight walls forming a convex polygon, lines(h) -> list of
+    (nx, ny, d) with the region nx x + ny y >= d. Where the membrane is free it is a circular arc
+    of one radius r; the section is the polygon with each corner replaced by a tangent arc:
+        L = P + r sum[(pi - a_k) - 2 cot(a_k / 2)],  A = A_P - r^2 sum[cot(a_k / 2) - (pi - a_k) / 2]
+    (P, A_P the polygon's perimeter and area, a_k its interior angles), and
+        w r = N_s,  w A / L = N_z,  ls = L / (2 pi),  lz w A = w* lz* pi ls*^2.
+    Returns, for each h, w, r, ls, lz, A and the force on each wall over pi, w (side - flat cut)."""
+    w0, lz0 = gps_inflation(ls0, kuhn)
+    gas = w0 * lz0 * np.pi * ls0**2
+
+    def polygon(h):
+        ls_ = lines(h)
+        n = len(ls_)
+        verts = []
+        for i in range(n):
+            (a1, b1, d1), (a2, b2, d2) = ls_[i], ls_[(i + 1) % n]
+            verts.append(np.linalg.solve([[a1, b1], [a2, b2]], [d1, d2]))
+        verts = np.array(verts)  # vertex i joins side i and side i+1
+        sides = np.array([np.linalg.norm(verts[i] - verts[i - 1]) for i in range(n)])  # side i
+        per = sides.sum()
+        x, y = verts[:, 0], verts[:, 1]
+        area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+        angles = []
+        for i in range(n):
+            u, v = verts[i - 1] - verts[i], verts[(i + 1) % n] - verts[i]
+            angles.append(np.arccos(np.dot(u, v) / np.linalg.norm(u) / np.linalg.norm(v)))
+        return per, area, np.array(angles), sides
+
+    def res(z, h):
+        w, r, lz = z
+        per, ap, ang, _ = polygon(h)
+        length = per + r * np.sum((np.pi - ang) - 2 / np.tan(ang / 2))
+        area = ap - r * r * np.sum(1 / np.tan(ang / 2) - (np.pi - ang) / 2)
+        ns, nz = abb_resultants(length / (2 * np.pi), lz, kuhn)
+        return [w * r - ns, w * area / length - nz, (lz * w * area - gas) / gas]
+
+    z = np.array([w0, ls0, lz0])
+    out, h_prev = [], hs[0] if False else None
+    h_prev = None
+    for h in hs:
+        steps = [h] if h_prev is None else np.linspace(h_prev, h, 21)[1:]
+        for hh in steps:
+            sol = optimize.root(res, z, args=(hh,), method="hybr", tol=1e-14)
+            if not sol.success and np.max(np.abs(res(sol.x, hh))) > 1e-11:
+                raise RuntimeError(f"polygon: hybrd failed at h = {hh}: {sol.message}")
+            z = sol.x
+        h_prev = h
+        w, r, lz = z
+        per, ap, ang, sides = polygon(h)
+        length = per + r * np.sum((np.pi - ang) - 2 / np.tan(ang / 2))
+        # flat length on side i: side minus the tangent lengths r cot(a/2) at its two corners
+        cot = 1 / np.tan(ang / 2)
+        flats = np.array([sides[i] - r * (cot[i - 1] + cot[i]) for i in range(len(sides))])
+        out.append(dict(h=h, w=w, r=r, lambda_s=length / (2 * np.pi), lambda_z=lz,
+                        area=ap - r * r * np.sum(cot - (np.pi - ang) / 2), forces=list(w * flats / np.pi)))
+    return out
