@@ -84,27 +84,6 @@ class GpsRing(GpsSection):
                 return q, lz, it
         raise RuntimeError(f"GPS ring Newton did not converge at {planes}")
 
-    def _full(self, q, lz, planes, m):
-        """Residual and Jacobian in all dofs (before periodic reduction) and lambda_z."""
-        b = self.basis
-        f = self._forms(lz, planes)
-        uq = b.interpolate(q)
-        a = f["area"].assemble(b, u=uq)
-        da = f["d_area"].assemble(b, u=uq)
-        r = f["r_membrane"].assemble(b, u=uq) - m / a * da
-        r_lz = f["w_z"].assemble(b, u=uq) - m / lz
-        k = f["k_membrane"].assemble(b, u=uq).toarray()
-        k += m / a**2 * np.outer(da, da) - m / a * f["d2_area"].assemble(b, u=uq).toarray()
-        k_lz = f["k_membrane_lz"].assemble(b, u=uq)
-        k_zz = f["w_zz"].assemble(b, u=uq) + m / lz**2
-        n = self.n
-        jac = np.zeros((n + 1, n + 1))
-        jac[:n, :n] = k
-        jac[:n, n] = k_lz
-        jac[n, :n] = k_lz
-        jac[n, n] = k_zz
-        return np.append(r, r_lz), jac, a
-
     def outputs(self, q, lz, planes, m):
         b = self.basis
         f = self._forms(lz, planes)

@@ -180,27 +180,33 @@ class GpsSection:
                     r_membrane=r_membrane, d_area=d_area, k_membrane_lz=k_membrane_lz,
                     k_membrane=k_membrane, d2_area=d2_area)
 
-    def residual_jacobian(self, q, lz, planes, m4):
-        """Residual and Jacobian in the unknowns (free dofs, λz); m4 = M/4 (quarter)."""
+    def _full(self, q, lz, planes, m):
+        """Residual and Jacobian in all dofs and λz (before constraints); m is the gas constant
+        of the modelled part (M/4 for the quarter, M for the full ring)."""
         b = self.basis
         f = self._forms(lz, planes)
         uq = b.interpolate(q)
         a = f["area"].assemble(b, u=uq)
         da = f["d_area"].assemble(b, u=uq)
-        r = f["r_membrane"].assemble(b, u=uq) - m4 / a * da
-        r_lz = f["w_z"].assemble(b, u=uq) - m4 / lz
+        r = f["r_membrane"].assemble(b, u=uq) - m / a * da
+        r_lz = f["w_z"].assemble(b, u=uq) - m / lz
         k = f["k_membrane"].assemble(b, u=uq).toarray()
-        k += m4 / a**2 * np.outer(da, da) - m4 / a * f["d2_area"].assemble(b, u=uq).toarray()
+        k += m / a**2 * np.outer(da, da) - m / a * f["d2_area"].assemble(b, u=uq).toarray()
         k_lz = f["k_membrane_lz"].assemble(b, u=uq)
-        k_zz = f["w_zz"].assemble(b, u=uq) + m4 / lz**2
-        fr = self.free
-        nf = len(fr)
-        jac = np.zeros((nf + 1, nf + 1))
-        jac[:nf, :nf] = k[np.ix_(fr, fr)]
-        jac[:nf, nf] = k_lz[fr]
-        jac[nf, :nf] = k_lz[fr]
-        jac[nf, nf] = k_zz
-        return np.append(r[fr], r_lz), jac, a
+        k_zz = f["w_zz"].assemble(b, u=uq) + m / lz**2
+        n = self.n
+        jac = np.zeros((n + 1, n + 1))
+        jac[:n, :n] = k
+        jac[:n, n] = k_lz
+        jac[n, :n] = k_lz
+        jac[n, n] = k_zz
+        return np.append(r, r_lz), jac, a
+
+    def residual_jacobian(self, q, lz, planes, m4):
+        """Residual and Jacobian in the unknowns (free dofs, λz); m4 = M/4 (quarter)."""
+        res, jac, a = self._full(q, lz, planes, m4)
+        keep = np.append(self.free, self.n)
+        return res[keep], jac[np.ix_(keep, keep)], a
 
     def solve(self, q, lz, planes, m4, tol=1e-11, max_iterations=50):
         """Newton from (q, λz) against `planes`; returns (q, λz, iterations)."""
