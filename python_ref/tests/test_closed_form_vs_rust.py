@@ -5,7 +5,6 @@ condition number of order 1e2 and hybrd stops at tol = 1e-14, so states agree to
 Limit points are located to 1e-8 in lambda_s (the issue's requirement) by both sides.
 """
 
-import numpy as np
 import pytest
 
 from tubemem_ref import closed_form as cf

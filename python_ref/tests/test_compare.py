@@ -10,33 +10,14 @@ import pathlib
 import subprocess
 import sys
 
-import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 import compare  # noqa: E402
+from cases import SMALL, SQUEEZE  # noqa: E402
 
-CASE = """
-[geometry]
-radius = 1.0
-length = 8.0
-[material]
-model = "abb"
-shear_modulus = 1.0
-kuhn = 30
-[mesh]
-around = 16
-along = 24
-symmetry = "eighth"
-[[stage]]
-kind = "inflate"
-control = "volume"
-target_stretch = 1.2
-steps = 4
-[[stage]]
-kind = "squeeze"
-target_rho = 1.0
-steps = 4
-"""
+CASE = SMALL + SQUEEZE
+
+
 
 
 def test_compare_a_run_folder(tmp_path, tubemem_exe):

@@ -6,9 +6,11 @@ the section is the walls' polygon with each corner replaced by a tangent arc of 
 radius r). Measured at kappa = 1e5: two plates, 128 elements, rho = 0.8: w -2.4e-5, lambda_s
 +1.5e-5, lambda_z -5e-6, force -2.0e-4. V-groove, 96 elements: w, lambda_s, lambda_z, area
 <= 3.6e-5; the force on each wall <= 3.5e-3 (its flat zone is only about two elements wide;
-1.3e-3 at 192 elements). The rigid-mode multipliers are ~1e-6 of the wall forces: the pins
-carry no load. Bounds: 1e-4 (the issue's tolerance) for w, lambda_s, lambda_z, area; 1e-3 for
-the two-plate force, 5e-3 for the V-groove wall forces; 1e-4 for the multipliers over the force.
+1.3e-3 at 192 elements). The rigid-mode multipliers are 4e-17 of the plate force for two
+plates and at most 5.8e-5 of the largest wall force for the V-groove: about 1e-6 absolute, the
+Newton tolerance (1e-9 of a first-iteration residual of ~1e3), so the pins carry no load. Bounds: 1e-4 (the issue's tolerance) for w, lambda_s, lambda_z, area; 1e-3 for
+the two-plate force, 5e-3 for the V-groove wall forces; 1e-4 for the multipliers over the
+force (the solver-tolerance level above).
 """
 
 import numpy as np

@@ -4,31 +4,18 @@ run as the generated mesh. The nodes are the same, in the same order, but the co
 through two text formats, which may round the last digit (measured: results differ by 2e-15
 relative), so the runs must agree to 1e-12. Bad meshes are refused with a clear message."""
 
-import json
 import subprocess
 
 import meshio
 import numpy as np
 import pytest
 
+from cases import GENERATED_MESH, GEOMETRY
+from cases import INFLATE as STAGE
 from tubemem_ref import meshio_io, runs
 
-GEOMETRY = """
-[geometry]
-radius = 1.0
-length = 8.0
-[material]
-model = "abb"
-shear_modulus = 1.0
-kuhn = 30
-"""
-STAGE = """
-[[stage]]
-kind = "inflate"
-control = "volume"
-target_stretch = 1.2
-steps = 4
-"""
+
+
 
 
 def run(exe, case_text, folder):
@@ -39,7 +26,7 @@ def run(exe, case_text, folder):
 
 
 def test_gmsh_round_trip_reproduces_the_generated_run(tmp_path, tubemem_exe):
-    gen = run(tubemem_exe, GEOMETRY + '[mesh]\naround = 16\nalong = 24\nsymmetry = "eighth"\n' + STAGE, tmp_path / "gen")
+    gen = run(tubemem_exe, GEOMETRY + GENERATED_MESH + STAGE, tmp_path / "gen")
     assert gen.returncode == 0, gen.stderr
     ref = meshio.read(tmp_path / "gen/out/vtu/step_00000.vtu")
     meshio.write(tmp_path / "ref.msh", meshio.Mesh(ref.points, [("quad", ref.cells_dict["quad"])]), file_format="gmsh22")
@@ -57,7 +44,7 @@ def test_bad_meshes_are_refused(tmp_path, tubemem_exe):
     pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
     with pytest.raises(ValueError, match="triangle"):
         meshio_io.to_tubemem_json(meshio.Mesh(pts, [("triangle", [[0, 1, 2]])]), tmp_path / "t.json")
-    gen = run(tubemem_exe, GEOMETRY + '[mesh]\naround = 16\nalong = 24\nsymmetry = "eighth"\n' + STAGE, tmp_path / "gen")
+    gen = run(tubemem_exe, GEOMETRY + GENERATED_MESH + STAGE, tmp_path / "gen")
     assert gen.returncode == 0, gen.stderr
     ref = meshio.read(tmp_path / "gen/out/vtu/step_00000.vtu")
     quads = ref.cells_dict["quad"].copy()

@@ -6,26 +6,10 @@ import subprocess
 
 import numpy as np
 
+from cases import SMALL as CASE
 from tubemem_ref import runs
 
-CASE = """
-[geometry]
-radius = 1.0
-length = 8.0
-[material]
-model = "abb"
-shear_modulus = 1.0
-kuhn = 30
-[mesh]
-around = 16
-along = 24
-symmetry = "eighth"
-[[stage]]
-kind = "inflate"
-control = "volume"
-target_stretch = 1.2
-steps = 4
-"""
+
 
 
 def test_run_folder_reads_back(tmp_path, tubemem_exe):

@@ -164,7 +164,6 @@ def inflate_to(length, target, kuhn=30.0, steps=6, law=None, **mesh):
     """Inflate the capped tube to mid-span stretch `target` (continuation in steps)."""
     tube = AxisymmetricTube(length, kuhn, law=law, **mesh)
     q, p = tube.reference(), 0.0
-    # a small pressure-like start: a slightly inflated reference avoids the stress-free state
     for t in np.linspace(1.0, target, steps + 1)[1:]:
         q, p, _ = tube.solve_stretch(q, p, t)
     return tube, q, p

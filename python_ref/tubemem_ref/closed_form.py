@@ -38,7 +38,10 @@ def gps_inflation(ls, kuhn=30.0):
     """(w, lambda_z) for free inflation under GPS, eq. (66)."""
     if ls == 1.0:
         return 0.0, 1.0
-    g = lambda lz: np.subtract(*np.multiply(abb_resultants(ls, lz, kuhn), (1.0, 2.0)))
+    def g(lz):
+        ns, nz = abb_resultants(ls, lz, kuhn)
+        return ns - 2 * nz
+
     lz = optimize.brentq(g, 0.5, lock_lambda_z(ls, kuhn) * (1 - 1e-12), xtol=1e-15, rtol=1e-15)
     ns, _ = abb_resultants(ls, lz, kuhn)
     return ns / ls, lz
@@ -208,8 +211,7 @@ def gps_polygon(ls0, lines, hs, kuhn=30.0):
         return [w * r - ns, w * area / length - nz, (lz * w * area - gas) / gas]
 
     z = np.array([w0, ls0, lz0])
-    out, h_prev = [], hs[0] if False else None
-    h_prev = None
+    out, h_prev = [], None
     for h in hs:
         steps = [h] if h_prev is None else np.linspace(h_prev, h, 21)[1:]
         for hh in steps:

@@ -47,9 +47,8 @@ class GpsRing(GpsSection):
         return np.array([gx @ self.t, gy @ self.t, rot @ self.t])[self.rigid]
 
     def solve(self, q, lz, planes, m4, tol=1e-11, max_iterations=60):
-        """Newton on (reduced dofs, lambda_z, three multipliers); m4 is M/4 (as in GpsSection,
-        so the same forms apply: here the area functional covers the whole ring, so M/4 of the
-        quarter becomes M: pass m4 = M)."""
+        """Newton on (reduced dofs, lambda_z, the rigid-mode multipliers); `m4` is the gas
+        constant of the modelled part, here the whole ring: pass M (GpsSection passes M/4)."""
         t = self.t
         c = self._rigid(q)
         nr, nc = t.shape[1], len(self.rigid)
