@@ -972,4 +972,3 @@ fn check_tangent_along(
         );
     }
 }
-
