@@ -94,6 +94,20 @@ pub struct FlatteningState {
     pub displacement: f64,
 }
 
+/// A GPS cross-section squeezed under a given pressure ([`section_at_pressure`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SectionState {
+    pub w: f64,
+    pub rho: f64,
+    pub lambda_s: f64,
+    pub lambda_z: f64,
+    pub n_s: f64,
+    pub n_z: f64,
+    pub chi: f64,
+    /// reduced force ϖχ (eq. 80)
+    pub force: f64,
+}
+
 const MAX_CUTS: usize = 30;
 
 fn at_ls(ls: f64) -> String {
@@ -441,6 +455,89 @@ pub fn flattening_curve(
         out.push(fl.continue_to(out[n - 1], prev2, rho)?);
     }
     Ok(out)
+}
+
+/// The GPS cross-section squeezed to half-gap `rho` under a *given* gas pressure `w` — eqs. (76)
+/// without the gas law (77₂). This is the local, translation-invariant mechanics of the section:
+/// a finite tube's mid-span obeys it whatever its total gas volume, so comparing the FE's mid-span
+/// with it at the FE's own pressure separates the end effect that passes through the shared gas
+/// (caps holding gas the plates do not squeeze) from the section's own mechanics.
+///
+/// Unknowns (λs, λz), with χ = λs − ρ:
+/// N_s(λs, λz) = ϖρ and N_z(λs, λz) = (ϖρ/2)(2λs − ρ)/λs. Where the law has limit points
+/// (ABB with 𝒩 = 30) several stretches carry the same pressure, so `guess` (λs, λz) picks the
+/// branch: pass the Boyle flattening at the same ρ, or the previous state of a sequence.
+pub fn section_at_pressure(
+    law: &dyn MembraneLaw,
+    rho: f64,
+    w: f64,
+    guess: [f64; 2],
+) -> Result<SectionState, GpsError> {
+    if !(rho.is_finite() && rho > 0.0) {
+        return Err(invalid("rho", rho, "the half-gap ρ must be positive"));
+    }
+    if !(w.is_finite() && w > 0.0) {
+        return Err(invalid("w", w, "the gas pressure ϖ must be positive"));
+    }
+    let at = format!("ρ = {rho}, ϖ = {w}");
+    if !(guess.iter().all(|g| g.is_finite() && *g > 0.0)) {
+        return Err(invalid(
+            "guess",
+            guess[0],
+            "the initial (λs, λz) must be finite and positive",
+        ));
+    }
+    let f = |x: [f64; 2]| {
+        let [ls, lz] = x;
+        let r = resultants::resultants(law, ls, lz)?;
+        let q = 0.5 * w * rho * (2.0 - rho / ls);
+        let dq = 0.5 * w * rho * rho / (ls * ls);
+        let scale = w * rho;
+        Ok((
+            [(r.ns - w * rho) / scale, (r.nz - q) / scale],
+            [
+                [r.jac[0][0] / scale, r.jac[0][1] / scale],
+                [(r.jac[1][0] - dq) / scale, r.jac[1][1] / scale],
+            ],
+        ))
+    };
+    let [ls, lz] = newton::system2(f, guess, 1e-12).map_err(|e| match e.material {
+        Some(source) => GpsError::Material {
+            stage: "GPS section at a given pressure (eq. 76)",
+            at: at.clone(),
+            source,
+        },
+        None => GpsError::NoConvergence {
+            stage: "GPS section at a given pressure (eq. 76)",
+            at: at.clone(),
+            residual: e.residual,
+            iterations: e.iterations,
+        },
+    })?;
+    let chi = ls - rho;
+    if chi < -1e-10 {
+        return Err(GpsError::NoConvergence {
+            stage: "GPS section at a given pressure (negative contact length: ϖ too low for ρ)",
+            at,
+            residual: chi,
+            iterations: 0,
+        });
+    }
+    let r = resultants::resultants(law, ls, lz).map_err(|source| GpsError::Material {
+        stage: "GPS section at a given pressure",
+        at,
+        source,
+    })?;
+    Ok(SectionState {
+        w,
+        rho,
+        lambda_s: ls,
+        lambda_z: lz,
+        n_s: r.ns,
+        n_z: r.nz,
+        chi,
+        force: w * chi,
+    })
 }
 
 #[cfg(test)]

@@ -364,3 +364,63 @@ fn bad_inputs_are_rejected_with_typed_errors() {
     assert!(matches!(e, GpsError::Material { .. }), "{e}");
     assert!(e.to_string().contains("locking"), "{e}");
 }
+
+/// At the pressure the gas law gives, the section-at-pressure solve must land on the same state as
+/// the Boyle flattening (both solve eq. 76; the flattening adds 77₂): agreement to the Newton
+/// tolerance, 1e-11 relative. Residuals of eq. 76 written out from eq. 58 (independent of the
+/// crate's resultants) must vanish to 1e-11 of ϖρ.
+#[test]
+fn section_at_pressure_reproduces_the_boyle_flattening_at_its_own_pressure() {
+    let law = abb30();
+    for (ls0, rho) in [(1.3, 1.25), (1.3, 0.8), (1.3, 0.4), (6.0, 3.0), (6.0, 5.5)] {
+        let f = flatten(&law, Hypothesis::Gps, ls0, rho).unwrap();
+        // a guess 5 % off the answer, so that the solve has work to do
+        let s =
+            section_at_pressure(&law, rho, f.w, [1.05 * f.lambda_s, 0.95 * f.lambda_z]).unwrap();
+        assert!(
+            rel(s.lambda_s, f.lambda_s).abs() < 1e-11,
+            "{ls0} {rho}: {s:?} vs {f:?}"
+        );
+        assert!(rel(s.lambda_z, f.lambda_z).abs() < 1e-11, "{ls0} {rho}");
+        assert!((s.chi - f.chi).abs() < 1e-11 * f.lambda_s, "{ls0} {rho}");
+        assert!(
+            (s.force - f.force).abs() < 1e-11 * f.lambda_s * f.w,
+            "{ls0} {rho}"
+        );
+        let (ns, nz) = eq58(s.lambda_s, s.lambda_z, 30.0);
+        let wr = s.w * rho;
+        assert!((ns - wr).abs() < 1e-11 * wr);
+        assert!((nz - 0.5 * wr * (rho + 2.0 * s.chi) / (rho + s.chi)).abs() < 1e-11 * wr);
+    }
+}
+
+/// Below the λs* = 1.3 limit point the section stiffens: more pressure at the same ρ means more
+/// hoop stretch, so a longer contact (χ grows with ϖ); a pressure too low for the plates to touch
+/// is reported, not returned as a negative contact length.
+#[test]
+fn section_at_pressure_responds_to_pressure_and_rejects_bad_input() {
+    let law = abb30();
+    let g = flatten(&law, Hypothesis::Gps, 1.3, 0.8).unwrap();
+    let guess = [g.lambda_s, g.lambda_z];
+    let a = section_at_pressure(&law, 0.8, 0.80, guess).unwrap();
+    let b = section_at_pressure(&law, 0.8, 0.84, guess).unwrap();
+    assert!(b.chi > a.chi && b.lambda_s > a.lambda_s, "{a:?} {b:?}");
+    // ϖρ = N_s needs λs > ρ: at ρ = 1.3, ϖ = 0.1 the free inflation stretch is below 1.3
+    assert!(section_at_pressure(&law, 1.3, 0.1, [1.3, 1.05]).is_err());
+    for (rho, w) in [
+        (0.0, 0.8),
+        (-1.0, 0.8),
+        (f64::NAN, 0.8),
+        (0.8, 0.0),
+        (0.8, f64::INFINITY),
+    ] {
+        assert!(matches!(
+            section_at_pressure(&law, rho, w, guess),
+            Err(GpsError::InvalidInput { .. })
+        ));
+    }
+    assert!(matches!(
+        section_at_pressure(&law, 0.8, 0.8, [f64::NAN, 1.0]),
+        Err(GpsError::InvalidInput { .. })
+    ));
+}
