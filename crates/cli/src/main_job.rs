@@ -46,12 +46,13 @@ pub fn run(out: &Path) -> Result<()> {
             .with_context(|| format!("steps.csv has no `{n}`"))
     };
     let (cw, crho, cforce, cdisp) = (col("w")?, col("rho")?, col("force")?, col("displacement")?);
+    let clocal = col("local_force")?;
     println!(
         "\nSqueeze, mid-span: FE against GPS and PS flattening at the same ρ (from the FE's λs*)"
     );
     println!(
-        "{:>7} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9} {:>9} {:>8}",
-        "ρ", "ϖ FE", "ϖ GPS", "ϖ PS", "FE−GPS", "force FE", "GPS", "PS", "FE−GPS"
+        "{:>7} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9} {:>9} {:>8} {:>10}",
+        "ρ", "ϖ FE", "ϖ GPS", "ϖ PS", "FE−GPS", "force FE", "GPS", "PS", "FE−GPS", "FE−GPS(ϖ)"
     );
     for line in lines {
         let f: Vec<&str> = line.split(',').collect();
@@ -60,20 +61,23 @@ pub fn run(out: &Path) -> Result<()> {
         }
         let num = |i: usize| f[i].parse::<f64>().unwrap_or(f64::NAN);
         let (w, rho, force, d) = (num(cw), num(crho), num(cforce), num(cdisp));
+        let local = num(clocal);
         let g = flatten(&law, Hypothesis::Gps, rho + d, rho)?;
         let p = flatten(&law, Hypothesis::Ps, rho + d, rho)?;
         println!(
-            "{rho:>7.4} {w:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {force:>9.5} {:>9.5} {:>9.5} {:>+7.2}%",
+            "{rho:>7.4} {w:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {force:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {:>+9.2}%",
             g.w,
             p.w,
             100.0 * (w / g.w - 1.0),
             g.force,
             p.force,
-            100.0 * (force / g.force - 1.0)
+            100.0 * (force / g.force - 1.0),
+            100.0 * (force / local - 1.0)
         );
     }
     println!(
-        "(the FE differs from GPS mostly by the end effect: the caps hold gas the plates do not squeeze; see the README)\n"
+        "(FE−GPS(ϖ): the force against the GPS section under the FE's own pressure, eq. 76 without the gas law.\n \
+         The FE differs from GPS mostly by the end effect, which acts through the gas: the ends keep gas the plates do not squeeze; see the README)\n"
     );
     for p in figures::write_all(&out.join("figures"), 30.0, std::slice::from_ref(&run_dir))? {
         println!("wrote {}", p.display());

@@ -17,12 +17,53 @@ use tubemem_fem::post::{
     cell_contact_pressure, cell_values, midspan, midspan_contact, ring_profile, ContactValues,
     MidSpan, RingValues,
 };
-use tubemem_gps::{flatten, inflate, Hypothesis};
+use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
 use tubemem_mesh::tube::{capped_tube_with_cap_rows, plugged_tube};
 use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 
-pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration";
+pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
+gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force";
+
+/// The closed-form columns of a steps.csv row: GPS at the same mid-span λs (inflation) or at the
+/// same ρ from the run's λs* (squeeze, eqs. 76–77), then, for a squeeze, the GPS section under the
+/// FE's own mid-span pressure (eq. 76 without the gas law: the local mechanics, free of the end
+/// effect that acts through the shared gas). A closed form that has no solution leaves its
+/// fields empty: the run goes on.
+fn closed_form_columns(
+    law: &dyn MembraneLaw,
+    ms: &MidSpan,
+    squeeze: Option<(&ContactValues, f64)>,
+) -> [Option<f64>; 9] {
+    let mut out = [None; 9];
+    match squeeze {
+        None => {
+            if let Ok(s) = inflate(law, Hypothesis::Gps, ms.lambda_s) {
+                out[..3].copy_from_slice(&[Some(s.w), Some(s.lambda_s), Some(s.lambda_z)]);
+            }
+        }
+        Some((c, ls0)) => {
+            if let Ok(g) = flatten(law, Hypothesis::Gps, ls0, c.rho) {
+                out[..5].copy_from_slice(&[
+                    Some(g.w),
+                    Some(g.lambda_s),
+                    Some(g.lambda_z),
+                    Some(g.chi),
+                    Some(g.force),
+                ]);
+                if let Ok(l) = section_at_pressure(law, c.rho, ms.w, [g.lambda_s, g.lambda_z]) {
+                    out[5..].copy_from_slice(&[
+                        Some(l.lambda_s),
+                        Some(l.lambda_z),
+                        Some(l.chi),
+                        Some(l.force),
+                    ]);
+                }
+            }
+        }
+    }
+    out
+}
 
 struct Output {
     dir: PathBuf,
@@ -54,12 +95,12 @@ impl Output {
     /// One row; the contact columns are empty for inflation stages.
     fn row(
         &mut self,
-        stage: usize,
-        step: usize,
+        (stage, step): (usize, usize),
         m: &MidSpan,
         its: usize,
         neg: usize,
         c: Option<(&ContactValues, f64)>,
+        cf: &[Option<f64>],
     ) -> std::io::Result<()> {
         write!(
             self.steps,
@@ -67,13 +108,20 @@ impl Output {
             m.w, m.lambda_s, m.lambda_z, m.n_s, m.n_z, m.n_sz, m.volume
         )?;
         match c {
-            Some((c, d)) => writeln!(
+            Some((c, d)) => write!(
                 self.steps,
                 ",{},{},{},{},{d},{},{}",
                 c.rho, c.chi, c.chi_geometric, c.force, c.contact_pressure, c.penetration
             )?,
-            None => writeln!(self.steps, ",,,,,,,")?,
+            None => write!(self.steps, ",,,,,,,")?,
         }
+        for v in cf {
+            match v {
+                Some(v) => write!(self.steps, ",{v}")?,
+                None => write!(self.steps, ",")?,
+            }
+        }
+        writeln!(self.steps)?;
         self.steps.flush()
     }
 
@@ -240,6 +288,14 @@ fn closed_form(
         out[&key] = cf;
         out[format!("relative_error_vs_{key}")] = err;
     }
+    if let (Some((c, _)), Some(g)) = (squeeze, out["gps"]["lambda_s"].as_f64()) {
+        let guess = [g, out["gps"]["lambda_z"].as_f64().unwrap_or(1.0)];
+        let l = section_at_pressure(law, c.rho, ms.w, guess)?;
+        out["gps_at_fe_pressure"] = json!({"w": l.w, "lambda_s": l.lambda_s, "lambda_z": l.lambda_z,
+            "n_s": l.n_s, "n_z": l.n_z, "rho": l.rho, "chi": l.chi, "force": l.force});
+        out["relative_error_vs_gps_at_fe_pressure"] = json!({"lambda_s": rel(ms.lambda_s, l.lambda_s),
+            "lambda_z": rel(ms.lambda_z, l.lambda_z), "chi": rel(c.chi, l.chi), "force": rel(c.force, l.force)});
+    }
     Ok(out)
 }
 
@@ -395,13 +451,18 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                         "a non-finite mid-span value was computed: {vals:?}"
                     ));
                 }
+                let cf = closed_form_columns(
+                    closed_form_law.as_ref(),
+                    &ms,
+                    cv.as_ref().map(|c| (c, start.lambda_s)),
+                );
                 o.row(
-                    i + 1,
-                    step,
+                    (i + 1, step),
                     &ms,
                     info.iterations,
                     info.negative_pivots,
                     cv.as_ref().map(|c| (c, start.lambda_s - c.rho)),
+                    &cf,
                 )
                 .map_err(|e| e.to_string())?;
                 o.frame(m, st, &control(value).plates())?;
@@ -523,6 +584,17 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                 f(ps, "force"),
                 c.contact_pressure,
                 c.penetration
+            );
+        }
+        let loc = &summary["stages"][i]["gps_at_fe_pressure"];
+        if let (Some(c), false) = (&cv, loc.is_null()) {
+            println!(
+                "         GPS section at the FE's pressure ϖ = {:.6} (eq. 76, no gas law): λs {:+.3}%, λz {:+.3}%, χ {:+.3}%, force {:+.3}%",
+                ms.w,
+                100.0 * rel(ms.lambda_s, f(loc, "lambda_s")),
+                100.0 * rel(ms.lambda_z, f(loc, "lambda_z")),
+                100.0 * rel(c.chi, f(loc, "chi")),
+                100.0 * rel(c.force, f(loc, "force")),
             );
         }
         if let Some(d) = layer {
