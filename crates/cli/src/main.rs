@@ -3,17 +3,11 @@
 //! With no arguments it runs the main job (`main_job`): the paper's example in 3D on the
 //! embedded default case, against GPS and PS, and the figures, written to `tubemem-out/`.
 
-mod case;
-mod figures;
-mod gps_cmd;
-mod main_job;
-mod material_args;
-mod run_cmd;
-
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use tubemem_cli::{figures, gps_cmd, main_job, run_cmd};
 
 #[derive(Parser, Debug)]
 #[command(
