@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every tubemem test: formatting, clippy, the Rust workspace tests, and the Python reference
-# tests in a virtual environment that this script creates (./.venv) and fills from PyPI.
+# Runs every tubemem test: formatting, clippy, the Rust workspace tests, the Python reference
+# tests and the tests of the Python API (the PyO3 module built by maturin), in a virtual
+# environment that this script creates (./.venv) and fills from PyPI.
 # This is the README's test command, and .ci/run calls exactly this.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,4 +23,10 @@ fi
 .venv/bin/python -m pip install --quiet --upgrade pip
 .venv/bin/python -m pip install --quiet -r python_ref/requirements.txt
 .venv/bin/python -m pip install --quiet -e python_ref
+echo "== Python API: maturin develop (crates/py, release)"
+.venv/bin/python -m pip install --quiet "maturin>=1.16,<2"
+VIRTUAL_ENV="$PWD/.venv" .venv/bin/maturin develop --release --quiet -m crates/py/Cargo.toml
+echo "== pytest: python_ref/tests"
 TUBEMEM_BIN="$PWD/target/release/tubemem" .venv/bin/python -m pytest python_ref/tests -q
+echo "== pytest: crates/py/tests (the Python API)"
+.venv/bin/python -m pytest crates/py/tests -q

@@ -1,0 +1,282 @@
+//! Python bindings: `import tubemem`.
+//!
+//! The closed form (`gps_*`, `resultants`) and the 3D FE runs (`run_case`, `run_case_text`) of the
+//! Rust crates, with results as plain Python dicts and lists (the same keys as `summary.json` and
+//! the `tubemem gps` CSV columns). Materials are dicts in the case-file form, e.g.
+//! `{"model": "abb", "shear_modulus": 1.0, "kuhn": 30}`; `None` means that one (the paper's law).
+//!
+//! Errors: invalid input raises `ValueError` (naming the parameter and its admissible range);
+//! a closed form or FE run that fails raises `tubemem.TubememError` (a `RuntimeError`), whose
+//! message carries the whole context chain (stage, step, residual, case key and line). Long
+//! runs release the interpreter lock.
+//!
+//! Dicts cross the boundary as JSON (serde on this side, `json` on the Python side): every
+//! result type already serializes for `summary.json`, so there is one conversion to keep right.
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use tubemem_gps::{GpsError, Hypothesis};
+use tubemem_material::{MaterialError, MaterialSpec, MembraneLaw};
+
+create_exception!(
+    tubemem,
+    TubememError,
+    PyRuntimeError,
+    "A closed-form solve or finite element run that failed; the message names the stage, step and residual."
+);
+
+/// The paper's law: Anssari-Benam–Bucchi with μ = 1 and 𝒩 = 30.
+const DEFAULT_MATERIAL: MaterialSpec = MaterialSpec::Abb {
+    shear_modulus: 1.0,
+    kuhn: 30.0,
+};
+
+fn gps_err(e: GpsError) -> PyErr {
+    match e {
+        GpsError::InvalidInput { .. } => PyValueError::new_err(e.to_string()),
+        GpsError::Material {
+            source: MaterialError::InvalidParameter { .. },
+            ..
+        } => PyValueError::new_err(e.to_string()),
+        _ => TubememError::new_err(e.to_string()),
+    }
+}
+
+fn material_err(e: MaterialError) -> PyErr {
+    match e {
+        // a stretch beyond the locking limit, asked for directly, is bad input too
+        MaterialError::InvalidParameter { .. }
+        | MaterialError::InvalidState { .. }
+        | MaterialError::Locking { .. } => PyValueError::new_err(e.to_string()),
+        _ => TubememError::new_err(e.to_string()),
+    }
+}
+
+/// A Python object to a serde value, through `json.dumps`.
+fn from_py<T: serde::de::DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
+    let json = obj.py().import("json")?;
+    let text: String = json.call_method1("dumps", (obj,))?.extract()?;
+    serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
+}
+
+/// A serde value to a Python object, through `json.loads`.
+fn to_py<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value)
+        .map_err(|e| TubememError::new_err(format!("cannot serialize a result: {e}")))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+fn law(material: Option<&Bound<'_, PyAny>>) -> PyResult<Box<dyn MembraneLaw>> {
+    let spec = match material {
+        Some(m) if !m.is_none() => from_py::<MaterialSpec>(m, "material")?,
+        _ => DEFAULT_MATERIAL,
+    };
+    spec.build().map_err(material_err)
+}
+
+fn hypothesis(name: &str) -> PyResult<Hypothesis> {
+    match name.to_ascii_lowercase().as_str() {
+        "gps" => Ok(Hypothesis::Gps),
+        "ps" => Ok(Hypothesis::Ps),
+        _ => Err(PyValueError::new_err(format!(
+            "hypothesis = {name:?}: must be \"gps\" (generalized plane strain) or \"ps\" (plane strain)"
+        ))),
+    }
+}
+
+/// Free inflation at hoop stretch `stretch` (eq. 66 under GPS, eq. 70 under PS):
+/// dict with w, lambda_s, lambda_z, n_s, n_z (dimensionless, R = μH = 1).
+#[pyfunction]
+#[pyo3(signature = (stretch, material=None, hypothesis="gps"))]
+fn gps_inflate<'py>(
+    py: Python<'py>,
+    stretch: f64,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = law(material)?;
+    let s = tubemem_gps::inflate(law.as_ref(), self::hypothesis(hypothesis)?, stretch)
+        .map_err(gps_err)?;
+    to_py(py, &s)
+}
+
+/// `points` free-inflation states equally spaced in λs from `stretch_from` to `stretch_to`: a list
+/// of dicts as in `gps_inflate`.
+#[pyfunction]
+#[pyo3(signature = (stretch_to, points=100, stretch_from=1.0, material=None, hypothesis="gps"))]
+fn gps_inflation_curve<'py>(
+    py: Python<'py>,
+    stretch_to: f64,
+    points: usize,
+    stretch_from: f64,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = law(material)?;
+    let hyp = self::hypothesis(hypothesis)?;
+    let c = py
+        .detach(|| {
+            tubemem_gps::inflation_curve(law.as_ref(), hyp, stretch_from, stretch_to, points)
+        })
+        .map_err(gps_err)?;
+    to_py(py, &c)
+}
+
+/// The tube inflated to λs* = `initial_stretch`, the gas closed in (Boyle), squeezed between two
+/// plates to half-gap `rho` (GPS eqs. 76–77, PS eqs. 78–79): dict with w, lambda_s, lambda_z, n_s,
+/// n_z, rho, chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81).
+#[pyfunction]
+#[pyo3(signature = (initial_stretch, rho, material=None, hypothesis="gps"))]
+fn gps_flatten<'py>(
+    py: Python<'py>,
+    initial_stretch: f64,
+    rho: f64,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = law(material)?;
+    let s = tubemem_gps::flatten(
+        law.as_ref(),
+        self::hypothesis(hypothesis)?,
+        initial_stretch,
+        rho,
+    )
+    .map_err(gps_err)?;
+    to_py(py, &s)
+}
+
+/// `points` flattening states equally spaced in ρ from λs* down to `rho_to`: a list of dicts as in
+/// `gps_flatten` (the curves of the paper's Figs. 6–7).
+#[pyfunction]
+#[pyo3(signature = (initial_stretch, rho_to, points=100, material=None, hypothesis="gps"))]
+fn gps_flattening_curve<'py>(
+    py: Python<'py>,
+    initial_stretch: f64,
+    rho_to: f64,
+    points: usize,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = law(material)?;
+    let hyp = self::hypothesis(hypothesis)?;
+    let c = py
+        .detach(|| {
+            tubemem_gps::flattening_curve(law.as_ref(), hyp, initial_stretch, rho_to, points)
+        })
+        .map_err(gps_err)?;
+    to_py(py, &c)
+}
+
+/// The GPS cross-section squeezed to half-gap `rho` under the given pressure `w` (eq. 76 without
+/// the gas law): dict with w, rho, lambda_s, lambda_z, n_s, n_z, chi, force. `guess` = (λs, λz)
+/// picks the branch where several stretches carry the same pressure (pass the GPS flattening at
+/// the same ρ).
+#[pyfunction]
+#[pyo3(signature = (rho, w, guess, material=None))]
+fn gps_section_at_pressure<'py>(
+    py: Python<'py>,
+    rho: f64,
+    w: f64,
+    guess: (f64, f64),
+    material: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = law(material)?;
+    let s = tubemem_gps::section_at_pressure(law.as_ref(), rho, w, [guess.0, guess.1])
+        .map_err(gps_err)?;
+    to_py(py, &s)
+}
+
+/// Limit points of the free-inflation curve and the Maxwell (bulge propagation) pressure:
+/// dict with max, min ({lambda_s, lambda_z, w} or None), maxwell ({w, lambda_s_lower,
+/// lambda_s_upper} or None) and scanned_to.
+#[pyfunction]
+#[pyo3(signature = (material=None, hypothesis="gps"))]
+fn gps_limits<'py>(
+    py: Python<'py>,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let law = law(material)?;
+    let hyp = self::hypothesis(hypothesis)?;
+    let l = py
+        .detach(|| tubemem_gps::limits::limit_points(law.as_ref(), hyp))
+        .map_err(gps_err)?;
+    to_py(py, &l)
+}
+
+/// Cauchy stress resultants (N_1, N_2)/(μH) of the membrane law at principal stretches
+/// (`l1`, `l2`), eq. (18).
+#[pyfunction]
+#[pyo3(signature = (l1, l2, material=None))]
+fn resultants(l1: f64, l2: f64, material: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
+    let law = law(material)?;
+    let [n1, n2] = law.resultants(l1, l2).map_err(material_err)?;
+    Ok((n1, n2))
+}
+
+fn read_summary<'py>(py: Python<'py>, out: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
+    let text = std::fs::read_to_string(out.join("summary.json")).map_err(|e| {
+        TubememError::new_err(format!(
+            "cannot read {}: {e}",
+            out.join("summary.json").display()
+        ))
+    })?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+fn run_err(e: anyhow::Error) -> PyErr {
+    TubememError::new_err(format!("{e:#}"))
+}
+
+/// Run a case file (TOML, as for `tubemem run`), writing steps.csv, summary.json, profiles/ and
+/// the VTU series to `out`; returns summary.json as a dict. On failure the converged steps are
+/// already in `out` and `TubememError` says which stage, step and residual.
+#[pyfunction]
+fn run_case<'py>(py: Python<'py>, case: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    py.detach(|| tubemem_cli::run_cmd::run(&case, &out))
+        .map_err(run_err)?;
+    read_summary(py, &out)
+}
+
+/// Run a case given as TOML text (user mesh files are looked up relative to `base_dir`); as
+/// `run_case` otherwise.
+#[pyfunction]
+#[pyo3(signature = (text, out, base_dir=None))]
+fn run_case_text<'py>(
+    py: Python<'py>,
+    text: &str,
+    out: PathBuf,
+    base_dir: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut case = tubemem_cli::case::Case::parse(text)
+        .map_err(|e| PyValueError::new_err(format!("in the case text: {e:#}")))?;
+    case.base_dir = base_dir.unwrap_or_default();
+    py.detach(|| tubemem_cli::run_cmd::run_case(&case, "case text from Python", &out))
+        .map_err(run_err)?;
+    read_summary(py, &out)
+}
+
+/// The embedded default case (`cases/squeeze_abb30_ls1.3.toml`, the main job's) as TOML text.
+#[pyfunction]
+fn default_case() -> &'static str {
+    tubemem_cli::main_job::DEFAULT_CASE
+}
+
+#[pymodule]
+fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("TubememError", m.py().get_type::<TubememError>())?;
+    m.add_function(wrap_pyfunction!(gps_inflate, m)?)?;
+    m.add_function(wrap_pyfunction!(gps_inflation_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(gps_flatten, m)?)?;
+    m.add_function(wrap_pyfunction!(gps_flattening_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(gps_section_at_pressure, m)?)?;
+    m.add_function(wrap_pyfunction!(gps_limits, m)?)?;
+    m.add_function(wrap_pyfunction!(resultants, m)?)?;
+    m.add_function(wrap_pyfunction!(run_case, m)?)?;
+    m.add_function(wrap_pyfunction!(run_case_text, m)?)?;
+    m.add_function(wrap_pyfunction!(default_case, m)?)?;
+    Ok(())
+}

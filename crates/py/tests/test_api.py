@@ -1,0 +1,165 @@
+"""Tests of the Python API (`import tubemem`, the PyO3 bindings in crates/py).
+
+The closed-form values are checked against the independent scipy implementation in
+python_ref (tubemem_ref.closed_form: the paper's formulas written out again and solved with
+brentq / hybrd, not with the Rust Newton). Tolerance 1e-9 relative: both sides converge to
+~1e-13, and 1e-9 is the bound the python_ref tests already hold the `tubemem` binary to.
+"""
+
+import csv
+import math
+import pathlib
+
+import pytest
+
+import tubemem
+from tubemem_ref import closed_form as cf
+
+ABB30 = {"model": "abb", "shear_modulus": 1.0, "kuhn": 30}
+TOL = 1e-9
+
+SMALL_CASE = """
+[geometry]
+radius = 1.0
+length = 8.0
+
+[material]
+model = "abb"
+shear_modulus = 1.0
+kuhn = 30
+
+[mesh]
+around = 16
+along = 24
+symmetry = "eighth"
+
+[[stage]]
+kind = "inflate"
+control = "volume"
+target_stretch = 1.2
+steps = 4
+
+[[stage]]
+kind = "squeeze"
+target_rho = 1.0
+steps = 4
+"""
+
+
+def rel(a, b):
+    return abs(a - b) / abs(b)
+
+
+def test_module_metadata():
+    assert tubemem.__version__
+    assert issubclass(tubemem.TubememError, RuntimeError)
+    assert "[[stage]]" in tubemem.default_case()
+
+
+@pytest.mark.parametrize("ls", [1.1, 1.3, 2.0, 6.0])
+def test_gps_inflation_matches_the_scipy_closed_form(ls):
+    s = tubemem.gps_inflate(ls)
+    w, lz = cf.gps_inflation(ls, 30.0)
+    assert rel(s["w"], w) < TOL and rel(s["lambda_z"], lz) < TOL
+    # the default material is the paper's ABB, N = 30
+    assert s == tubemem.gps_inflate(ls, material=ABB30, hypothesis="GPS")
+    p = tubemem.gps_inflate(ls, hypothesis="ps")
+    assert p["lambda_z"] == 1.0 and rel(p["w"], cf.ps_inflation(ls, 30.0)) < TOL
+
+
+def test_limit_points_match_the_scipy_closed_form():
+    lim = tubemem.gps_limits()
+    (lsmax, wmax), (lsmin, wmin) = cf.gps_limit_points(30.0)
+    assert rel(lim["max"]["w"], wmax) < 1e-8 and rel(lim["max"]["lambda_s"], lsmax) < 1e-6
+    assert rel(lim["min"]["w"], wmin) < 1e-8 and rel(lim["min"]["lambda_s"], lsmin) < 1e-6
+    assert rel(lim["maxwell"]["w"], cf.gps_maxwell(30.0)[0]) < 1e-8
+    assert tubemem.gps_limits(hypothesis="ps")["max"] is None
+
+
+def test_flattening_matches_the_scipy_closed_form_and_the_local_section():
+    ref = cf.gps_flattening(1.3, [1.0, 0.8], 30.0)
+    curve = tubemem.gps_flattening_curve(1.3, 0.8, points=3)
+    assert [round(s["rho"], 12) for s in curve] == [1.3, 1.05, 0.8]
+    for rho, r in zip([1.0, 0.8], ref):
+        s = tubemem.gps_flatten(1.3, rho)
+        for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
+            assert rel(s[k], r[k]) < TOL, (rho, k)
+        assert s["displacement"] == pytest.approx(1.3 - rho, abs=1e-14)
+        # the section under the Boyle pressure is the same state (eq. 76 without 77's gas law)
+        loc = tubemem.gps_section_at_pressure(rho, s["w"], (s["lambda_s"], s["lambda_z"]))
+        assert rel(loc["chi"], s["chi"]) < TOL
+    # PS is stiffer than GPS in the squeeze (paper Figs. 6-7)
+    assert tubemem.gps_flatten(1.3, 0.8, hypothesis="ps")["force"] > curve[-1]["force"]
+
+
+def test_resultants_are_eq_58_and_take_any_material():
+    n1, n2 = tubemem.resultants(1.3, 1.05)
+    ns, nz = cf.abb_resultants(1.3, 1.05, 30.0)
+    assert rel(n1, ns) < 1e-12 and rel(n2, nz) < 1e-12
+    mr = {"model": "mooney-rivlin", "shear_modulus": 1.0, "alpha": 0.1}
+    m1, m2 = tubemem.resultants(1.3, 1.05, material=mr)
+    r1, r2 = cf.mr_resultants(1.3, 1.05, 0.1)
+    # eqs. (86)-(87) are scaled by mu while eq. (83) as printed gives mu0 = mu (1 + alpha)
+    # (README, "Mooney-Rivlin"): the ratio is scale-free
+    assert rel(m1 / m2, r1 / r2) < 1e-12
+    assert tubemem.gps_inflate(1.3, material=mr)["lambda_z"] == pytest.approx(
+        cf.gps_inflation_mr(1.3, 0.1)[1], rel=TOL
+    )
+
+
+@pytest.mark.parametrize(
+    "call, needle",
+    [
+        (lambda: tubemem.gps_inflate(0.5), "lambda_s"),
+        (lambda: tubemem.gps_inflate(math.nan), "lambda_s"),
+        (lambda: tubemem.gps_inflate(1.3, hypothesis="3d"), "hypothesis"),
+        (lambda: tubemem.gps_flatten(1.3, 1.5), "rho"),
+        (lambda: tubemem.gps_inflate(1.3, material={"model": "abb", "shear_modulus": 1.0, "kuhn": 0.5}), "kuhn"),
+        (lambda: tubemem.gps_inflate(1.3, material={"model": "abb", "kuhn": 30}), "shear_modulus"),
+        (lambda: tubemem.gps_inflate(1.3, material={"model": "rubber"}), "rubber"),
+        (lambda: tubemem.resultants(9.0, 9.0), "locking"),  # I1 = 162 > 3N = 90
+        (lambda: tubemem.gps_flattening_curve(1.3, 0.8, points=1), "points"),
+    ],
+)
+def test_bad_input_raises_value_error_naming_it(call, needle):
+    with pytest.raises(ValueError, match=needle):
+        call()
+
+
+def test_run_case_text_writes_the_outputs_and_returns_the_summary(tmp_path):
+    out = tmp_path / "run"
+    s = tubemem.run_case_text(SMALL_CASE, str(out))
+    assert [st["kind"] for st in s["stages"]] == ["inflate", "squeeze"]
+    sq = s["stages"][1]
+    assert sq["final"]["rho"] == 1.0
+    # the summary returned is the one on disk, and its last row is the last steps.csv row
+    rows = list(csv.DictReader(open(out / "steps.csv")))
+    assert float(rows[-1]["force"]) == sq["final"]["force"]
+    assert float(rows[-1]["gps_force"]) == sq["gps"]["force"]
+    # the closed form in the summary is the API's closed form
+    g = tubemem.gps_flatten(sq["final"]["initial_stretch"], 1.0)
+    assert rel(sq["gps"]["force"], g["force"]) < 1e-12
+    assert (out / "tube.pvd").exists()
+
+
+def test_run_case_reads_a_file(tmp_path):
+    case = tmp_path / "case.toml"
+    case.write_text(SMALL_CASE.split("[[stage]]\nkind = \"squeeze\"")[0])
+    s = tubemem.run_case(str(case), str(tmp_path / "out"))
+    assert s["case"] == str(case) and len(s["stages"]) == 1
+
+
+def test_a_malformed_case_names_the_key(tmp_path):
+    with pytest.raises(ValueError, match="kuhm"):
+        tubemem.run_case_text(SMALL_CASE.replace("kuhn = 30", "kuhn = 30\nkuhm = 2"), str(tmp_path))
+
+
+def test_a_failing_run_raises_and_keeps_its_converged_steps(tmp_path):
+    # N = 3 locks near lambda_s = 2.4 on the GPS path; the case asks for 3.0
+    text = SMALL_CASE.replace("kuhn = 30", "kuhn = 3").replace("target_stretch = 1.2", "target_stretch = 3.0")
+    out = tmp_path / "out"
+    with pytest.raises(tubemem.TubememError, match="stage 1") as e:
+        tubemem.run_case_text(text, str(out))
+    assert "residual" in str(e.value) and "converged steps are in" in str(e.value)
+    rows = list(csv.DictReader(open(out / "steps.csv")))
+    assert len(rows) >= 2 and all(math.isfinite(float(r["w"])) for r in rows)
