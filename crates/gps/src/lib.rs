@@ -268,19 +268,7 @@ impl<'a> Flattening<'a> {
         let at = format!("ρ = {rho} (λs* = {})", self.initial.lambda_s);
         let law = self.law;
         let m = self.gas;
-        let fail = |f: newton::Failure, stage: &'static str| match f.material {
-            Some(source) => GpsError::Material {
-                stage,
-                at: at.clone(),
-                source,
-            },
-            None => GpsError::NoConvergence {
-                stage,
-                at: at.clone(),
-                residual: f.residual,
-                iterations: f.iterations,
-            },
-        };
+        let fail = |f: newton::Failure, stage: &'static str| f.into_error(stage, &at);
         let (ls, lz) = match self.hyp {
             Hypothesis::Gps => {
                 // F1 = N_s (2λs − ρ)/(2λs) − N_z        (eq. 76₂ with ϖρ = N_s, χ = λs − ρ)
@@ -501,19 +489,8 @@ pub fn section_at_pressure(
             ],
         ))
     };
-    let [ls, lz] = newton::system2(f, guess, 1e-12).map_err(|e| match e.material {
-        Some(source) => GpsError::Material {
-            stage: "GPS section at a given pressure (eq. 76)",
-            at: at.clone(),
-            source,
-        },
-        None => GpsError::NoConvergence {
-            stage: "GPS section at a given pressure (eq. 76)",
-            at: at.clone(),
-            residual: e.residual,
-            iterations: e.iterations,
-        },
-    })?;
+    let [ls, lz] = newton::system2(f, guess, 1e-12)
+        .map_err(|e| e.into_error("GPS section at a given pressure (eq. 76)", &at))?;
     let chi = ls - rho;
     if chi < -1e-10 {
         return Err(GpsError::NoConvergence {

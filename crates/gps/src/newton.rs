@@ -10,6 +10,26 @@ pub(crate) struct Failure {
     pub material: Option<MaterialError>,
 }
 
+impl Failure {
+    /// The typed error of a failed solve in `stage` at `at`: the material's, if that is what
+    /// stopped it, otherwise no convergence with the residual and iteration count.
+    pub(crate) fn into_error(self, stage: &'static str, at: &str) -> crate::GpsError {
+        match self.material {
+            Some(source) => crate::GpsError::Material {
+                stage,
+                at: at.to_string(),
+                source,
+            },
+            None => crate::GpsError::NoConvergence {
+                stage,
+                at: at.to_string(),
+                residual: self.residual,
+                iterations: self.iterations,
+            },
+        }
+    }
+}
+
 const MAX_IT: usize = 60;
 const MAX_HALVINGS: usize = 40;
 

@@ -68,6 +68,15 @@ fn to_py<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound
     py.import("json")?.call_method1("loads", (text,))
 }
 
+/// A closed-form computation run without the interpreter lock, its result as a Python object.
+fn detached<'py, T: serde::Serialize + Send>(
+    py: Python<'py>,
+    f: impl FnOnce() -> Result<T, GpsError> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let value = py.detach(f).map_err(gps_err)?;
+    to_py(py, &value)
+}
+
 fn law(material: Option<&Bound<'_, PyAny>>) -> PyResult<Box<dyn MembraneLaw>> {
     let spec = match material {
         Some(m) if !m.is_none() => from_py::<MaterialSpec>(m, "material")?,
@@ -114,14 +123,10 @@ fn gps_inflation_curve<'py>(
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let law = law(material)?;
-    let hyp = self::hypothesis(hypothesis)?;
-    let c = py
-        .detach(|| {
-            tubemem_gps::inflation_curve(law.as_ref(), hyp, stretch_from, stretch_to, points)
-        })
-        .map_err(gps_err)?;
-    to_py(py, &c)
+    let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
+    detached(py, || {
+        tubemem_gps::inflation_curve(law.as_ref(), hyp, stretch_from, stretch_to, points)
+    })
 }
 
 /// The tube inflated to λs* = `initial_stretch`, the gas closed in (Boyle), squeezed between two
@@ -159,14 +164,10 @@ fn gps_flattening_curve<'py>(
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let law = law(material)?;
-    let hyp = self::hypothesis(hypothesis)?;
-    let c = py
-        .detach(|| {
-            tubemem_gps::flattening_curve(law.as_ref(), hyp, initial_stretch, rho_to, points)
-        })
-        .map_err(gps_err)?;
-    to_py(py, &c)
+    let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
+    detached(py, || {
+        tubemem_gps::flattening_curve(law.as_ref(), hyp, initial_stretch, rho_to, points)
+    })
 }
 
 /// The GPS cross-section squeezed to half-gap `rho` under the given pressure `w` (eq. 76 without
@@ -198,12 +199,8 @@ fn gps_limits<'py>(
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let law = law(material)?;
-    let hyp = self::hypothesis(hypothesis)?;
-    let l = py
-        .detach(|| tubemem_gps::limits::limit_points(law.as_ref(), hyp))
-        .map_err(gps_err)?;
-    to_py(py, &l)
+    let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
+    detached(py, || tubemem_gps::limits::limit_points(law.as_ref(), hyp))
 }
 
 /// Cauchy stress resultants (N_1, N_2)/(μH) of the membrane law at principal stretches

@@ -9,6 +9,7 @@ brentq / hybrd, not with the Rust Newton). Tolerance 1e-9 relative: both sides c
 import csv
 import math
 import pathlib
+import sys
 
 import pytest
 
@@ -18,32 +19,12 @@ from tubemem_ref import closed_form as cf
 ABB30 = {"model": "abb", "shear_modulus": 1.0, "kuhn": 30}
 TOL = 1e-9
 
-SMALL_CASE = """
-[geometry]
-radius = 1.0
-length = 8.0
+# the small tube shared with the python_ref tests (L/R = 8, 16 around, lambda_s* = 1.2), squeezed
+# to rho = 1.0
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[3] / "python_ref" / "tests"))
+from cases import SMALL, SQUEEZE  # noqa: E402
 
-[material]
-model = "abb"
-shear_modulus = 1.0
-kuhn = 30
-
-[mesh]
-around = 16
-along = 24
-symmetry = "eighth"
-
-[[stage]]
-kind = "inflate"
-control = "volume"
-target_stretch = 1.2
-steps = 4
-
-[[stage]]
-kind = "squeeze"
-target_rho = 1.0
-steps = 4
-"""
+SMALL_CASE = SMALL + SQUEEZE
 
 
 def rel(a, b):
@@ -144,7 +125,7 @@ def test_run_case_text_writes_the_outputs_and_returns_the_summary(tmp_path):
 
 def test_run_case_reads_a_file(tmp_path):
     case = tmp_path / "case.toml"
-    case.write_text(SMALL_CASE.split("[[stage]]\nkind = \"squeeze\"")[0])
+    case.write_text(SMALL)
     s = tubemem.run_case(str(case), str(tmp_path / "out"))
     assert s["case"] == str(case) and len(s["stages"]) == 1
 
