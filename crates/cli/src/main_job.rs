@@ -46,7 +46,7 @@ pub fn run(out: &Path) -> Result<()> {
             .with_context(|| format!("steps.csv has no `{n}`"))
     };
     let (cw, crho, cforce, cdisp) = (col("w")?, col("rho")?, col("force")?, col("displacement")?);
-    let clocal = col("local_force")?;
+    let (cgw, cgf, clocal) = (col("gps_w")?, col("gps_force")?, col("local_force")?);
     println!(
         "\nSqueeze, mid-span: FE against GPS and PS flattening at the same ρ (from the FE's λs*)"
     );
@@ -61,17 +61,17 @@ pub fn run(out: &Path) -> Result<()> {
         }
         let num = |i: usize| f[i].parse::<f64>().unwrap_or(f64::NAN);
         let (w, rho, force, d) = (num(cw), num(crho), num(cforce), num(cdisp));
-        let local = num(clocal);
-        let g = flatten(&law, Hypothesis::Gps, rho + d, rho)?;
+        // GPS as the run wrote it at this step; PS solved here from the run's λs* = ρ + d
+        let (gw, gforce, local) = (num(cgw), num(cgf), num(clocal));
         let p = flatten(&law, Hypothesis::Ps, rho + d, rho)?;
         println!(
             "{rho:>7.4} {w:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {force:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {:>+9.2}%",
-            g.w,
+            gw,
             p.w,
-            100.0 * (w / g.w - 1.0),
-            g.force,
+            100.0 * (w / gw - 1.0),
+            gforce,
             p.force,
-            100.0 * (force / g.force - 1.0),
+            100.0 * (force / gforce - 1.0),
             100.0 * (force / local - 1.0)
         );
     }

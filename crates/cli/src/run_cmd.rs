@@ -17,7 +17,7 @@ use tubemem_fem::post::{
     cell_contact_pressure, cell_values, midspan, midspan_contact, ring_profile, ContactValues,
     MidSpan, RingValues,
 };
-use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
+use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis, SectionState};
 use tubemem_material::MembraneLaw;
 use tubemem_mesh::tube::{capped_tube_with_cap_rows, plugged_tube};
 use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
@@ -25,44 +25,58 @@ use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force";
 
-/// The closed-form columns of a steps.csv row: GPS at the same mid-span λs (inflation) or at the
-/// same ρ from the run's λs* (squeeze, eqs. 76–77), then, for a squeeze, the GPS section under the
-/// FE's own mid-span pressure (eq. 76 without the gas law: the local mechanics, free of the end
-/// effect that acts through the shared gas). A closed form that has no solution leaves its
-/// fields empty: the run goes on.
-fn closed_form_columns(
-    law: &dyn MembraneLaw,
-    ms: &MidSpan,
-    squeeze: Option<(&ContactValues, f64)>,
-) -> [Option<f64>; 9] {
-    let mut out = [None; 9];
-    match squeeze {
-        None => {
-            if let Ok(s) = inflate(law, Hypothesis::Gps, ms.lambda_s) {
-                out[..3].copy_from_slice(&[Some(s.w), Some(s.lambda_s), Some(s.lambda_z)]);
+/// The closed form at one step: GPS at the same mid-span λs (inflation) or at the same ρ from the
+/// run's λs* (squeeze, eqs. 76–77), then, for a squeeze, the GPS section under the FE's own
+/// mid-span pressure (eq. 76 without the gas law: the local mechanics, free of the end effect that
+/// acts through the shared gas). A closed form that has no solution leaves its steps.csv fields
+/// empty (and the section's error goes to summary.json): the run goes on.
+struct StepClosedForm {
+    /// w, lambda_s, lambda_z, chi, force
+    gps: [Option<f64>; 5],
+    /// `None` for inflation steps or when the GPS flattening itself failed
+    local: Option<Result<SectionState, String>>,
+}
+
+impl StepClosedForm {
+    fn new(law: &dyn MembraneLaw, ms: &MidSpan, squeeze: Option<(&ContactValues, f64)>) -> Self {
+        let mut gps = [None; 5];
+        let mut local = None;
+        match squeeze {
+            None => {
+                if let Ok(s) = inflate(law, Hypothesis::Gps, ms.lambda_s) {
+                    gps[..3].copy_from_slice(&[Some(s.w), Some(s.lambda_s), Some(s.lambda_z)]);
+                }
             }
-        }
-        Some((c, ls0)) => {
-            if let Ok(g) = flatten(law, Hypothesis::Gps, ls0, c.rho) {
-                out[..5].copy_from_slice(&[
-                    Some(g.w),
-                    Some(g.lambda_s),
-                    Some(g.lambda_z),
-                    Some(g.chi),
-                    Some(g.force),
-                ]);
-                if let Ok(l) = section_at_pressure(law, c.rho, ms.w, [g.lambda_s, g.lambda_z]) {
-                    out[5..].copy_from_slice(&[
-                        Some(l.lambda_s),
-                        Some(l.lambda_z),
-                        Some(l.chi),
-                        Some(l.force),
-                    ]);
+            Some((c, ls0)) => {
+                if let Ok(g) = flatten(law, Hypothesis::Gps, ls0, c.rho) {
+                    gps = [g.w, g.lambda_s, g.lambda_z, g.chi, g.force].map(Some);
+                    local = Some(
+                        section_at_pressure(law, c.rho, ms.w, [g.lambda_s, g.lambda_z])
+                            .map_err(|e| e.to_string()),
+                    );
                 }
             }
         }
+        Self { gps, local }
     }
-    out
+
+    /// The nine closed-form fields of a steps.csv row (`STEPS_HEADER` from `gps_w` on).
+    fn columns(&self) -> impl Iterator<Item = Option<f64>> + '_ {
+        let local = match &self.local {
+            Some(Ok(l)) => [l.lambda_s, l.lambda_z, l.chi, l.force].map(Some),
+            _ => [None; 4],
+        };
+        self.gps.into_iter().chain(local)
+    }
+}
+
+/// The last converged step of a stage: what its summary entry reports.
+struct LastStep {
+    ms: MidSpan,
+    contact: Option<ContactValues>,
+    iterations: usize,
+    negative_pivots: usize,
+    local: Option<Result<SectionState, String>>,
 }
 
 struct Output {
@@ -100,7 +114,7 @@ impl Output {
         its: usize,
         neg: usize,
         c: Option<(&ContactValues, f64)>,
-        cf: &[Option<f64>],
+        cf: &StepClosedForm,
     ) -> std::io::Result<()> {
         write!(
             self.steps,
@@ -115,7 +129,7 @@ impl Output {
             )?,
             None => write!(self.steps, ",,,,,,,")?,
         }
-        for v in cf {
+        for v in cf.columns() {
             match v {
                 Some(v) => write!(self.steps, ",{v}")?,
                 None => write!(self.steps, ",")?,
@@ -263,6 +277,7 @@ fn closed_form(
     law: &dyn MembraneLaw,
     ms: &MidSpan,
     squeeze: Option<(&ContactValues, f64)>,
+    local: Option<&Result<SectionState, String>>,
 ) -> Result<Value> {
     let mut out = json!({});
     for hyp in [Hypothesis::Gps, Hypothesis::Ps] {
@@ -288,18 +303,16 @@ fn closed_form(
         out[&key] = cf;
         out[format!("relative_error_vs_{key}")] = err;
     }
-    if let (Some((c, _)), Some(g)) = (squeeze, out["gps"]["lambda_s"].as_f64()) {
-        let guess = [g, out["gps"]["lambda_z"].as_f64().unwrap_or(1.0)];
-        // a diagnostic: if the section has no solution at the FE's pressure, say so and go on
-        match section_at_pressure(law, c.rho, ms.w, guess) {
-            Ok(l) => {
-                out["gps_at_fe_pressure"] = json!({"w": l.w, "lambda_s": l.lambda_s, "lambda_z": l.lambda_z,
-                    "n_s": l.n_s, "n_z": l.n_z, "rho": l.rho, "chi": l.chi, "force": l.force});
-                out["relative_error_vs_gps_at_fe_pressure"] = json!({"lambda_s": rel(ms.lambda_s, l.lambda_s),
-                    "lambda_z": rel(ms.lambda_z, l.lambda_z), "chi": rel(c.chi, l.chi), "force": rel(c.force, l.force)});
-            }
-            Err(e) => out["gps_at_fe_pressure"] = json!({"error": e.to_string()}),
+    // the section at the FE's pressure, as solved for the step's steps.csv row
+    match (squeeze, local) {
+        (Some((c, _)), Some(Ok(l))) => {
+            out["gps_at_fe_pressure"] = json!({"w": l.w, "lambda_s": l.lambda_s, "lambda_z": l.lambda_z,
+                "n_s": l.n_s, "n_z": l.n_z, "rho": l.rho, "chi": l.chi, "force": l.force});
+            out["relative_error_vs_gps_at_fe_pressure"] = json!({"lambda_s": rel(ms.lambda_s, l.lambda_s),
+                "lambda_z": rel(ms.lambda_z, l.lambda_z), "chi": rel(c.chi, l.chi), "force": rel(c.force, l.force)});
         }
+        (Some(_), Some(Err(e))) => out["gps_at_fe_pressure"] = json!({ "error": e }),
+        _ => {}
     }
     Ok(out)
 }
@@ -429,7 +442,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
             initial_steps: spec.steps,
             max_cuts: 12,
         };
-        let mut last: Option<(MidSpan, Option<ContactValues>, usize, usize)> = None;
+        let mut last: Option<LastStep> = None;
         let (mut newton_total, mut steps_total) = (0usize, 0usize);
         let result = run_stage(
             &mut model,
@@ -456,7 +469,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                         "a non-finite mid-span value was computed: {vals:?}"
                     ));
                 }
-                let cf = closed_form_columns(
+                let cf = StepClosedForm::new(
                     closed_form_law.as_ref(),
                     &ms,
                     cv.as_ref().map(|c| (c, start.lambda_s)),
@@ -481,7 +494,13 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                     "step {step}: ϖ = {:.5}, λs = {:.5}, {} its",
                     ms.w, ms.lambda_s, info.iterations
                 ));
-                last = Some((ms, cv, info.iterations, info.negative_pivots));
+                last = Some(LastStep {
+                    ms,
+                    contact: cv,
+                    iterations: info.iterations,
+                    negative_pivots: info.negative_pivots,
+                    local: cf.local,
+                });
                 newton_total += info.iterations;
                 steps_total += 1;
                 Ok(())
@@ -493,7 +512,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                 .as_array_mut()
                 .expect("stages is an array")
                 .push(json!({"index": i + 1, "error": e.to_string(),
-                "last_converged": last.map(|(m, _, _, _)| midspan_json(&m))}));
+                "last_converged": last.map(|l| midspan_json(&l.ms))}));
             write_summary(&summary)?;
             return Err(e).with_context(|| {
                 format!(
@@ -504,9 +523,21 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
                 )
             });
         }
-        let (ms, cv, its, neg) = match last {
+        let LastStep {
+            ms,
+            contact: cv,
+            iterations: its,
+            negative_pivots: neg,
+            local,
+        } = match last {
             Some(l) => l,
-            None => (midspan(&model, &state)?, None, 0, 0),
+            None => LastStep {
+                ms: midspan(&model, &state)?,
+                contact: None,
+                iterations: 0,
+                negative_pivots: 0,
+                local: None,
+            },
         };
         let rings = ring_profile(&model, &state)?;
         let profile = out
@@ -540,6 +571,7 @@ pub fn run_case(case: &Case, label: &str, out: &Path) -> Result<()> {
             closed_form_law.as_ref(),
             &ms,
             cv.as_ref().map(|c| (c, start.lambda_s)),
+            local.as_ref(),
         )?;
         let mut entry = json!({
             "index": i + 1,
