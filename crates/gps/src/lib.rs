@@ -320,15 +320,7 @@ impl<'a> Flattening<'a> {
             at: at.clone(),
             source,
         })?;
-        let chi = ls - rho;
-        if chi < -1e-10 {
-            return Err(GpsError::NoConvergence {
-                stage: "flattening (negative contact length)",
-                at,
-                residual: chi,
-                iterations: 0,
-            });
-        }
+        let chi = contact_length(ls, rho, "flattening (negative contact length)", &at)?;
         let w = r.ns / rho;
         Ok(FlatteningState {
             w,
@@ -392,6 +384,21 @@ impl<'a> Flattening<'a> {
             }
         }
     }
+}
+
+/// χ = λs − ρ (the perimeter 2πλs = 2πρ + 2πχ); a negative one means the solve found a state
+/// the plates do not touch.
+fn contact_length(ls: f64, rho: f64, stage: &'static str, at: &str) -> Result<f64, GpsError> {
+    let chi = ls - rho;
+    if chi < -1e-10 {
+        return Err(GpsError::NoConvergence {
+            stage,
+            at: at.to_string(),
+            residual: chi,
+            iterations: 0,
+        });
+    }
+    Ok(chi)
 }
 
 fn check_rho(rho: f64, initial_stretch: f64) -> Result<(), GpsError> {
@@ -491,15 +498,12 @@ pub fn section_at_pressure(
     };
     let [ls, lz] = newton::system2(f, guess, 1e-12)
         .map_err(|e| e.into_error("GPS section at a given pressure (eq. 76)", &at))?;
-    let chi = ls - rho;
-    if chi < -1e-10 {
-        return Err(GpsError::NoConvergence {
-            stage: "GPS section at a given pressure (negative contact length: ϖ too low for ρ)",
-            at,
-            residual: chi,
-            iterations: 0,
-        });
-    }
+    let chi = contact_length(
+        ls,
+        rho,
+        "GPS section at a given pressure (negative contact length: ϖ too low for ρ)",
+        &at,
+    )?;
     let r = resultants::resultants(law, ls, lz).map_err(|source| GpsError::Material {
         stage: "GPS section at a given pressure",
         at,
