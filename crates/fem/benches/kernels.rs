@@ -1,0 +1,51 @@
+//! Cost of the element kernels on one quad at a finite-strain state (ABB 𝒩 = 30 with the
+//! tension-field relaxation, as the runs use): membrane residual + 12×12 tangent, volume with
+//! gradient + Hessian, and penalty contact against one penetrated plane.
+//! `cargo bench -p tubemem-fem --bench kernels`
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+use tubemem_fem::contact::{contact_kernel, Plane};
+use tubemem_fem::element::{membrane_kernel, RefElement};
+use tubemem_fem::volume::volume_kernel;
+use tubemem_material::{MaterialSpec, Wrinkling};
+
+fn bench(c: &mut Criterion) {
+    let law = MaterialSpec::Abb {
+        shear_modulus: 1.0,
+        kuhn: 30.0,
+    }
+    .build_with(Wrinkling::Relaxed)
+    .unwrap();
+    let x0 = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.1, 0.0],
+        [1.1, 1.0, 0.1],
+        [0.0, 0.9, 0.0],
+    ];
+    let x = x0.map(|p| [1.3 * p[0] + 0.1 * p[1], 1.15 * p[1], p[2] + 0.2 * p[0]]);
+    let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
+    let mut r = [0.0; 12];
+    let mut k = [0.0; 144];
+    c.bench_function("membrane_kernel_with_tangent", |b| {
+        b.iter(|| membrane_kernel(law.as_ref(), &re, black_box(&x), &mut r, Some(&mut k)).unwrap())
+    });
+    let mut g = [0.0; 12];
+    let mut h = [0.0; 144];
+    c.bench_function("volume_kernel_with_hessian", |b| {
+        b.iter(|| volume_kernel(black_box(&x), &mut g, Some(&mut h)))
+    });
+    let plane = [Plane {
+        normal: [0.0, -1.0, 0.0],
+        offset: -1.0,
+    }];
+    c.bench_function("contact_kernel_with_tangent", |b| {
+        b.iter(|| {
+            r.fill(0.0);
+            k.fill(0.0);
+            contact_kernel(&re, black_box(&x), &plane, 1e3, &mut r, Some(&mut k))
+        })
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
