@@ -25,7 +25,10 @@
 
 pub mod io;
 pub mod tube;
+pub mod volume;
 pub mod vtu;
+
+pub use volume::quad_volume;
 
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -100,6 +103,12 @@ impl Symmetry {
             Symmetry::Eighth => &[2, 1, 0],
         }
     }
+    /// Whether a ring of nodes around the axis goes all the way round (no symmetry plane through
+    /// the axis cuts it). The one test of ring topology, for perimeters, contact widths and plug
+    /// faces.
+    pub fn rings_closed(self) -> bool {
+        self.planes().iter().all(|&ax| ax == 2)
+    }
     /// How many copies of the model make the whole tube.
     pub fn multiplicity(self) -> f64 {
         match self {
@@ -154,7 +163,7 @@ impl Mesh {
             + self
                 .plugs
                 .iter()
-                .map(|r| plug_face(x, r).volume())
+                .map(|r| plug_face(x, r, self.symmetry.rings_closed()).volume())
                 .sum::<f64>()
     }
 
@@ -204,14 +213,15 @@ impl Mesh {
             }
             // The Jacobian g1 × g2 must keep the direction of the centre normal at every corner
             // (a collapsed edge gives zero there, a bow-tie a reversed one).
-            let (_, c1, c2) = tangents(&x, 0.0, 0.0);
-            let n0 = cross(c1, c2);
+            let xv = x.map(nalgebra::Vector3::from);
+            let [_, c1, c2] = volume::tangents(&xv, 0.0, 0.0);
+            let n0 = c1.cross(&c2);
             for (k, (xi, eta)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
                 .into_iter()
                 .enumerate()
             {
-                let (_, g1, g2) = tangents(&x, xi, eta);
-                if !(dot(cross(g1, g2), n0) > 1e-8 * dot(n0, n0)) {
+                let [_, g1, g2] = volume::tangents(&xv, xi, eta);
+                if !(g1.cross(&g2).dot(&n0) > 1e-8 * n0.dot(&n0)) {
                     return Err(MeshError::Degenerate {
                         element: e,
                         reason: format!("the Jacobian vanishes or reverses at corner {k} (collapsed edge or bow-tie)"),
@@ -326,18 +336,12 @@ impl PlugFace {
     }
 }
 
-/// The face of the plug whose ring is `ring` (sorted by angle), at positions `x`.
-pub fn plug_face(x: &[[f64; 3]], ring: &[usize]) -> PlugFace {
+/// The face of the plug whose ring is `ring` (sorted by angle), at positions `x`; `closed`
+/// when the ring goes all the way round ([`Symmetry::rings_closed`]).
+pub fn plug_face(x: &[[f64; 3]], ring: &[usize], closed: bool) -> PlugFace {
     let z = ring.iter().map(|&i| x[i][2]).sum::<f64>() / ring.len().max(1) as f64;
-    let closed = {
-        // a full ring closes on itself: its first and last nodes are neighbours
-        let (a, b) = (x[ring[0]], x[ring[ring.len() - 1]]);
-        let ang = |p: [f64; 3]| p[1].atan2(p[0]);
-        let gap = (ang(a) - ang(b)).rem_euclid(std::f64::consts::TAU);
-        ring.len() > 2 && gap < 1.5 * std::f64::consts::TAU / ring.len() as f64
-    };
     let n = ring.len();
-    let segs = if closed { n } else { n - 1 };
+    let segs = if closed { n } else { n.saturating_sub(1) };
     let mut area = 0.0;
     for k in 0..segs {
         let (p, q) = (x[ring[k]], x[ring[(k + 1) % n]]);
@@ -394,40 +398,13 @@ pub fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
     (n, d)
 }
 
-/// Tangent vectors g1, g2 and position at (ξ, η).
-pub fn tangents(x: &[[f64; 3]; 4], xi: f64, eta: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
-    let (n, d) = shape(xi, eta);
-    let mut p = [0.0; 3];
-    let mut g1 = [0.0; 3];
-    let mut g2 = [0.0; 3];
-    for a in 0..4 {
-        for k in 0..3 {
-            p[k] += n[a] * x[a][k];
-            g1[k] += d[a][0] * x[a][k];
-            g2[k] += d[a][1] * x[a][k];
-        }
-    }
-    (p, g1, g2)
-}
-
-/// (1/3) ∫ x·(g1 × g2) dξdη over one quad (exact with 2×2 Gauss).
-pub fn quad_volume(x: &[[f64; 3]; 4]) -> f64 {
-    GAUSS2
-        .iter()
-        .map(|&(xi, eta)| {
-            let (p, g1, g2) = tangents(x, xi, eta);
-            dot(p, cross(g1, g2)) / 3.0
-        })
-        .sum()
-}
-
 /// Area ∫ |g1 × g2| dξdη (2×2 Gauss).
 pub fn quad_area(x: &[[f64; 3]; 4]) -> f64 {
     GAUSS2
         .iter()
         .map(|&(xi, eta)| {
-            let (_, g1, g2) = tangents(x, xi, eta);
-            dot(cross(g1, g2), cross(g1, g2)).sqrt()
+            let [_, g1, g2] = volume::tangents(&x.map(nalgebra::Vector3::from), xi, eta);
+            g1.cross(&g2).norm()
         })
         .sum()
 }

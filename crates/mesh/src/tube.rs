@@ -10,7 +10,7 @@
 //! Elements: `around` = 4m around the cylinder (a multiple of 8, so that x = 0 and y = 0 are
 //! mesh lines), `along` along it (even, so that z = 0 is a mesh line), 3m² per cap.
 
-use crate::{cross, dot, sub, tangents, Mesh, MeshError, Symmetry};
+use crate::{dot, Mesh, MeshError, Symmetry};
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_4;
 
@@ -124,9 +124,10 @@ fn half_cube(m: usize, rows: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
 /// Orient every quad so that g1 × g2 at its centre points away from `center(centroid)`.
 fn orient(nodes: &[[f64; 3]], quads: &mut [[usize; 4]], center: impl Fn([f64; 3]) -> [f64; 3]) {
     for q in quads.iter_mut() {
-        let x = q.map(|i| nodes[i]);
-        let (p, g1, g2) = tangents(&x, 0.0, 0.0);
-        if dot(cross(g1, g2), sub(p, center(p))) < 0.0 {
+        let x = q.map(|i| nalgebra::Vector3::from(nodes[i]));
+        let [p, g1, g2] = crate::volume::tangents(&x, 0.0, 0.0);
+        let c = nalgebra::Vector3::from(center(p.into()));
+        if g1.cross(&g2).dot(&(p - c)) < 0.0 {
             *q = [q[0], q[3], q[2], q[1]];
         }
     }
