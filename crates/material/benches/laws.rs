@@ -13,6 +13,18 @@ fn bench(c: &mut Criterion) {
     c.bench_function("abb_stress_tangent_autodiff", |b| {
         b.iter(|| ad.stress_tangent(black_box(cs)).unwrap())
     });
+    c.bench_function("abb_derivatives_autodiff_hand", |b| {
+        b.iter(|| {
+            ad.derivatives_ab_hand(black_box(2.1), black_box(0.9))
+                .unwrap()
+        })
+    });
+    c.bench_function("abb_derivatives_autodiff_numdual", |b| {
+        b.iter(|| {
+            ad.derivatives_ab_num_dual(black_box(2.1), black_box(0.9))
+                .unwrap()
+        })
+    });
 }
 
 criterion_group!(benches, bench);

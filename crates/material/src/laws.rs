@@ -76,6 +76,9 @@ impl MembraneLaw for AnssariBenamBucchi {
     fn shear_modulus(&self) -> f64 {
         self.shear_modulus
     }
+    fn locking_limit(&self) -> Option<f64> {
+        Some(3.0 * self.kuhn)
+    }
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
         // W(a, b) = W̄(I1), I1 = a + 1/b.
         let i1 = a + 1.0 / b;

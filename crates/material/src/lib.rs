@@ -101,6 +101,11 @@ pub trait MembraneLaw: Send + Sync + std::fmt::Debug {
     fn name(&self) -> String;
     /// μ, the modulus that scales the dimensionless energy (μH scales the resultants).
     fn shear_modulus(&self) -> f64;
+    /// The finite-extensibility limit of I1 = tr C + 1/det C, where the energy diverges
+    /// (`None` for laws without one). Used to diagnose a solve that fails as it approaches it.
+    fn locking_limit(&self) -> Option<f64> {
+        None
+    }
     /// W(a, b) and its derivatives. Called with a > 0, b > 0 only; returns
     /// [`MaterialError::Locking`] beyond a finite-extensibility limit.
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError>;
@@ -291,6 +296,14 @@ impl<E: InvariantEnergy> MembraneLaw for AutoDiff<E> {
         self.shear_modulus
     }
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
+        self.derivatives_ab_hand(a, b)
+    }
+}
+
+impl<E: InvariantEnergy> AutoDiff<E> {
+    /// W and its (a, b) derivatives through the hand-written [`dual::HyperDual2`] (what
+    /// [`MembraneLaw::derivatives_ab`] uses).
+    pub fn derivatives_ab_hand(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
         use dual::{HyperDual2, Real};
         let a = HyperDual2::variable(a, 0);
         let b = HyperDual2::variable(b, 1);
@@ -303,6 +316,36 @@ impl<E: InvariantEnergy> MembraneLaw for AutoDiff<E> {
             w_aa: w.h[0],
             w_ab: w.h[1],
             w_bb: w.h[2],
+        })
+    }
+}
+
+impl<E: InvariantEnergy> AutoDiff<E> {
+    /// The same derivatives through num-dual's `Dual2SVec64<2>`: the independent reference for
+    /// the hand-written dual number (slower; see [`dual`]).
+    pub fn derivatives_ab_num_dual(
+        &self,
+        a: f64,
+        b: f64,
+    ) -> Result<EnergyDerivatives, MaterialError> {
+        use nalgebra::SVector;
+        use num_dual::{Dual2SVec64, DualNum};
+        let x = SVector::<f64, 2>::new(a, b);
+        let mut v = x.map(Dual2SVec64::<2>::from_re);
+        v[0].v1 = num_dual::Derivative::some(nalgebra::RowSVector::<f64, 2>::new(1.0, 0.0));
+        v[1].v1 = num_dual::Derivative::some(nalgebra::RowSVector::<f64, 2>::new(0.0, 1.0));
+        let (a, b) = (v[0], v[1]);
+        let binv = b.recip();
+        let w = self.energy.energy(a + binv, a * binv + b)?;
+        let g = w.v1.unwrap_generic(nalgebra::U1, nalgebra::U2);
+        let h = w.v2.unwrap_generic(nalgebra::U2, nalgebra::U2);
+        Ok(EnergyDerivatives {
+            w: w.re,
+            w_a: g[0],
+            w_b: g[1],
+            w_aa: h[(0, 0)],
+            w_ab: h[(0, 1)],
+            w_bb: h[(1, 1)],
         })
     }
 }

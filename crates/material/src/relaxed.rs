@@ -93,6 +93,9 @@ impl<L: MembraneLaw> MembraneLaw for Relaxed<L> {
     fn shear_modulus(&self) -> f64 {
         self.law.shear_modulus()
     }
+    fn locking_limit(&self) -> Option<f64> {
+        self.law.locking_limit()
+    }
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
         match self.regime(a, b)? {
             Regime::Taut => self.law.derivatives_ab(a, b),
