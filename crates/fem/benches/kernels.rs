@@ -4,10 +4,11 @@
 //! `cargo bench -p tubemem-fem --bench kernels`
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
-use tubemem_fem::contact::{contact_kernel, Plane};
-use tubemem_fem::element::{membrane_kernel, RefElement};
-use tubemem_fem::volume::volume_kernel;
+use tubemem_fem::contact::{Contact, Plane};
+use tubemem_fem::element::{membrane_kernel, Matrix12, Vector12};
+use tubemem_fem::geometry::{RefElement, Vec3};
 use tubemem_material::{MaterialSpec, Wrinkling};
+use tubemem_mesh::volume::volume_kernel;
 
 fn bench(c: &mut Criterion) {
     let law = MaterialSpec::Abb {
@@ -24,25 +25,33 @@ fn bench(c: &mut Criterion) {
     ];
     let x = x0.map(|p| [1.3 * p[0] + 0.1 * p[1], 1.15 * p[1], p[2] + 0.2 * p[0]]);
     let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
-    let mut r = [0.0; 12];
-    let mut k = [0.0; 144];
+    let x = x.map(Vec3::from);
+    let mut r = Vector12::zeros();
+    let mut k = Matrix12::zeros();
     c.bench_function("membrane_kernel_with_tangent", |b| {
-        b.iter(|| membrane_kernel(law.as_ref(), &re, black_box(&x), &mut r, Some(&mut k)).unwrap())
+        b.iter(|| {
+            r = Vector12::zeros();
+            k = Matrix12::zeros();
+            membrane_kernel(law.as_ref(), &re, black_box(&x), &mut r, Some(&mut k)).unwrap()
+        })
     });
-    let mut g = [0.0; 12];
-    let mut h = [0.0; 144];
+    let mut g = Vector12::zeros();
+    let mut h = Matrix12::zeros();
     c.bench_function("volume_kernel_with_hessian", |b| {
-        b.iter(|| volume_kernel(black_box(&x), &mut g, Some(&mut h)))
+        b.iter(|| volume_kernel(black_box(&x), Some(&mut g), Some(&mut h)))
     });
-    let plane = [Plane {
-        normal: [0.0, -1.0, 0.0],
-        offset: -1.0,
-    }];
+    let contact = Contact {
+        planes: vec![Plane {
+            normal: [0.0, -1.0, 0.0],
+            offset: -1.0,
+        }],
+        penalty: 1e3,
+    };
     c.bench_function("contact_kernel_with_tangent", |b| {
         b.iter(|| {
-            r.fill(0.0);
-            k.fill(0.0);
-            contact_kernel(&re, black_box(&x), &plane, 1e3, &mut r, Some(&mut k))
+            r = Vector12::zeros();
+            k = Matrix12::zeros();
+            contact.kernel(&re, black_box(&x), &mut r, Some(&mut k))
         })
     });
 }

@@ -7,8 +7,9 @@
 //!    split into assembly, factorization and solve (median of 5), and the peak resident memory;
 //! 2. the whole λs* = 1.3 inflation (eighth model, 96 around: mid-span ϖ error 5.4e-4 < 1e-3).
 use std::time::Instant;
-use tubemem_fem::model::{nearest_node, run_stage, Control, Model, Stage};
+use tubemem_fem::model::{nearest_node, Load, Loading, Model};
 use tubemem_fem::post::midspan;
+use tubemem_fem::stepping::{run_stage, Stage, StepSettings};
 use tubemem_material::laws::AnssariBenamBucchi;
 use tubemem_mesh::{tube::capped_tube, Symmetry};
 
@@ -35,41 +36,40 @@ fn main() {
     let mesh = capped_tube(1.0, 20.0, 96, 240, Symmetry::Eighth).unwrap();
     let mut model =
         Model::new(mesh, Box::new(AnssariBenamBucchi::new(1.0, 30.0).unwrap())).unwrap();
-    let node = nearest_node(&model.mesh, [1.0, 0.0, 0.0]);
+    let node = nearest_node(model.mesh(), [1.0, 0.0, 0.0]);
     let mut st = model.reference_state();
     let mut newton = 0;
     let stage = Stage {
         index: 1,
         from: 1.0,
         to: 1.3,
-        initial_steps: 6,
-        max_cuts: 12,
+        settings: StepSettings {
+            initial_steps: 6,
+            ..Default::default()
+        },
     };
     run_stage(
         &mut model,
         &mut st,
         &stage,
-        |v| Control::Node {
-            node,
-            component: 0,
-            target: v,
+        |v| {
+            Load::new(Loading::Node {
+                node,
+                component: 0,
+                target: v,
+            })
         },
-        |_, _, _, _, info| {
-            newton += info.iterations;
-            Ok(())
+        |_, _, info| {
+            newton += info.newton.iterations;
+            Ok::<(), std::convert::Infallible>(())
         },
     )
     .unwrap();
     let ms = midspan(&model, &st).unwrap();
-    let gps = tubemem_gps::inflate(
-        model.law.as_ref(),
-        tubemem_gps::Hypothesis::Gps,
-        ms.lambda_s,
-    )
-    .unwrap();
+    let gps = tubemem_gps::inflate(model.law(), tubemem_gps::Hypothesis::Gps, ms.lambda_s).unwrap();
     println!(
         "whole λs*=1.3 case, eighth model, 96 around × 240 along: {} equations, {:.3} s (mesh + {} Newton iterations), mid-span ϖ error {:.2e}, λz error {:.1e} [{threads} threads]",
-        model.n_eq,
+        model.n_eq(),
         t.elapsed().as_secs_f64(),
         newton,
         ms.w / gps.w - 1.0,
@@ -83,7 +83,7 @@ fn main() {
         Model::new(mesh, Box::new(AnssariBenamBucchi::new(1.0, 30.0).unwrap())).unwrap();
     let setup = t.elapsed().as_secs_f64();
     let mut st = model.reference_state();
-    model.solve(&mut st, Control::Pressure(0.3)).unwrap();
+    model.solve(&mut st, &Load::pressure(0.3)).unwrap();
     let mut runs: Vec<_> = (0..5).map(|_| model.time_iteration(&st).unwrap()).collect();
     let med = |f: &dyn Fn(&tubemem_fem::model::IterationTiming) -> f64,
                r: &mut Vec<tubemem_fem::model::IterationTiming>| {
@@ -95,8 +95,8 @@ fn main() {
     let s = med(&|x| x.solve, &mut runs);
     println!(
         "full tube 128 around × 224 along: {} elements, {} equations, setup (mesh, pattern, symbolic) {:.2} s; per Newton iteration (median of 5): assembly {:.3} s, factorization {:.3} s, solve {:.3} s; factor nnz {}; negative pivots {}; peak RSS {:.0} MiB [{threads} threads]",
-        model.mesh.quads.len(),
-        model.n_eq,
+        model.mesh().quads.len(),
+        model.n_eq(),
         setup,
         a,
         f,

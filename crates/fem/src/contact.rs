@@ -1,5 +1,6 @@
 //! Frictionless penalty contact with rigid planes, integrated at the Gauss points of the
-//! membrane elements (reference-area weights).
+//! membrane elements (reference-area weights). [`Contact`] is the one owner of the planes and
+//! the penalty: the assembly, the outputs and the closed-form comparison all read them from it.
 //!
 //! ```text
 //! plane {x : n·x = d}, n the unit normal pointing to the allowed side; gap g = n·x − d
@@ -9,14 +10,16 @@
 //! ```
 //! Frictionless: the force is along n only. The contact pressure per current area is
 //! κ⟨−g⟩ dA0/da; the penetration at a contact pressure p is about p J/κ (J = da/dA0), so κ is
-//! chosen from the pressure, the area stretch and a stated penetration tolerance (`penalty_for`).
+//! chosen from the pressure, the area stretch and a stated penetration tolerance
+//! ([`penalty_for`]).
 
-use crate::element::RefElement;
-use tubemem_mesh::dot;
+use crate::element::{Matrix12, Vector12};
+use crate::geometry::{RefElement, Vec3};
+use serde::Serialize;
 
 /// A rigid plane {x : normal·x = offset}; `normal` is a unit vector pointing to the side where
 /// the membrane may be.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Plane {
     pub normal: [f64; 3],
     pub offset: f64,
@@ -24,7 +27,98 @@ pub struct Plane {
 
 impl Plane {
     pub fn gap(&self, x: [f64; 3]) -> f64 {
-        dot(self.normal, x) - self.offset
+        self.gap_at(&Vec3::from(x))
+    }
+
+    fn gap_at(&self, x: &Vec3) -> f64 {
+        Vec3::from(self.normal).dot(x) - self.offset
+    }
+}
+
+/// The rigid planes of a step and the penalty that enforces them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Contact {
+    pub planes: Vec<Plane>,
+    /// κ, per unit μH/R² (see [`penalty_for`])
+    pub penalty: f64,
+}
+
+impl Contact {
+    /// Two plates y = ±`half_gap` (normals ∓e_y), the squeeze of the paper's Sec. 4.
+    pub fn plates(half_gap: f64, penalty: f64) -> Self {
+        Self {
+            planes: vec![
+                Plane {
+                    normal: [0.0, -1.0, 0.0],
+                    offset: -half_gap,
+                },
+                Plane {
+                    normal: [0.0, 1.0, 0.0],
+                    offset: -half_gap,
+                },
+            ],
+            penalty,
+        }
+    }
+
+    /// The top plate's height h for two plates made by [`Contact::plates`].
+    pub fn half_gap(&self) -> Option<f64> {
+        self.planes
+            .iter()
+            .find(|p| p.normal == [0.0, -1.0, 0.0])
+            .map(|p| -p.offset)
+    }
+
+    /// Contact traction per reference area at a gap (κ⟨−g⟩).
+    pub fn traction(&self, gap: f64) -> f64 {
+        if gap < 0.0 {
+            -self.penalty * gap
+        } else {
+            0.0
+        }
+    }
+
+    /// Add the contact energy, residual and (if asked) stiffness of one element.
+    pub fn kernel(
+        &self,
+        re: &RefElement,
+        xe: &[Vec3; 4],
+        r: &mut Vector12,
+        mut k: Option<&mut Matrix12>,
+    ) -> f64 {
+        let mut energy = 0.0;
+        for (g, gp) in re.gauss.iter().enumerate() {
+            let n = &gp.n;
+            let p = re.position(g, xe);
+            for plane in &self.planes {
+                let gap = plane.gap_at(&p);
+                if gap >= 0.0 {
+                    continue;
+                }
+                let w = gp.w * self.penalty;
+                energy += 0.5 * w * gap * gap;
+                // u = ∂g/∂x_e: u[3a + i] = N_a n_i, so r += w g u and K += w u uᵀ (rank one)
+                let u = Vector12::from_fn(|row, _| n[row / 3] * plane.normal[row % 3]);
+                r.axpy(w * gap, &u, 1.0);
+                if let Some(k) = k.as_deref_mut() {
+                    k.ger(w, &u, &u, 1.0);
+                }
+            }
+        }
+        energy
+    }
+
+    /// Mean contact pressure per current area of an element (for output).
+    pub fn element_pressure(&self, re: &RefElement, xe: &[Vec3; 4]) -> f64 {
+        let mut s = 0.0;
+        for g in 0..4 {
+            let p = re.position(g, xe);
+            let da = re.area_ratio(g, xe);
+            for pl in &self.planes {
+                s += 0.25 * self.traction(pl.gap_at(&p)) / da;
+            }
+        }
+        s
     }
 }
 
@@ -33,55 +127,4 @@ impl Plane {
 /// per reference area, so the penetration is p J/κ and κ = ϖ J / tolerance.
 pub fn penalty_for(pressure: f64, area_stretch: f64, tolerance: f64) -> f64 {
     pressure * area_stretch / tolerance
-}
-
-/// Add the contact energy, residual and (if asked) stiffness of one element.
-pub fn contact_kernel(
-    re: &RefElement,
-    x: &[[f64; 3]; 4],
-    planes: &[Plane],
-    kappa: f64,
-    r: &mut [f64; 12],
-    mut k: Option<&mut [f64; 144]>,
-) -> f64 {
-    let mut energy = 0.0;
-    for g in 0..4 {
-        let n = &re.n[g];
-        let p = [0, 1, 2].map(|c| (0..4).map(|a| n[a] * x[a][c]).sum::<f64>());
-        for plane in planes {
-            let gap = plane.gap(p);
-            if gap >= 0.0 {
-                continue;
-            }
-            let w = re.w[g] * kappa;
-            energy += 0.5 * w * gap * gap;
-            for a in 0..4 {
-                for c in 0..3 {
-                    r[3 * a + c] += w * gap * n[a] * plane.normal[c];
-                }
-            }
-            if let Some(k) = k.as_deref_mut() {
-                for a in 0..4 {
-                    for b in 0..4 {
-                        for i in 0..3 {
-                            for j in 0..3 {
-                                k[(3 * a + i) * 12 + 3 * b + j] +=
-                                    w * n[a] * n[b] * plane.normal[i] * plane.normal[j];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
-    energy
-}
-
-/// Contact traction at one Gauss point: (force per reference area, per current area).
-pub fn traction(gap: f64, kappa: f64) -> f64 {
-    if gap < 0.0 {
-        -kappa * gap
-    } else {
-        0.0
-    }
 }

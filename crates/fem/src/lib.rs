@@ -1,12 +1,23 @@
 //! # tubemem-fem — nonlinear membrane finite elements
 //!
 //! A 3D membrane solver on quadrilateral surface meshes that assumes nothing about translation
-//! invariance: hyperelastic incompressible membrane ([`element`]), exact enclosed volume
-//! ([`volume`]) for pressure, volume and closed-gas loading, assembled in parallel into a faer
-//! sparse matrix and solved by Newton with a sparse LDLᵀ factorization ([`linsolve`]).
+//! invariance. The crate is split along its seams:
 //!
-//! Kernels, assembly and solver are apart: an element kernel reads nodal positions and writes a
-//! local vector and matrix; only [`model`] touches global structures.
+//! | module | what it owns |
+//! |---|---|
+//! | [`geometry`] | Gauss-point geometry: shape functions, reference frame, position, gradient, area ratio |
+//! | [`element`] | the hyperelastic membrane kernel (residual, tangent) and the Gauss-point state |
+//! | [`contact`] | rigid planes with their penalty ([`contact::Contact`]) and the contact kernel |
+//! | [`dofs`] | equation numbering: symmetry planes, rigid-body pins, rigid plugs |
+//! | [`pattern`] | the sparsity pattern, built once |
+//! | [`linsolve`] | sparse LDLᵀ on faer (symbolic once, numeric per iteration), inertia |
+//! | [`model`] | assembly as a sum of [`model::Term`]s plus the enclosed volume; loads; the membrane problem |
+//! | [`newton`] | a damped Newton driver that knows nothing of membranes |
+//! | [`stepping`] | load stepping with cut-back and growth |
+//! | [`post`] | mid-span values, profiles, contact values, cell values |
+//!
+//! The enclosed volume with its gradient and Hessian is `tubemem_mesh::volume` (one
+//! implementation for the mesh checks, the loading and the output).
 //! All quantities are per unit μH (energies, forces, resultants), with lengths in units of R.
 
 // Kernels index nodes, components and Gauss points explicitly, as the formulas are written;
@@ -14,30 +25,48 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod contact;
+pub mod dofs;
 pub mod element;
+pub mod geometry;
 pub mod linsolve;
 pub mod model;
+pub mod newton;
+pub mod pattern;
 pub mod post;
-pub mod volume;
+pub mod stepping;
+
+pub use newton::NewtonSettings;
+
+#[cfg(test)]
+mod tests;
 
 use thiserror::Error;
 use tubemem_material::MaterialError;
 use tubemem_mesh::MeshError;
 
-/// What went wrong, and where.
+/// What went wrong, and where. Wrapping variants keep their cause as `source()` and do not
+/// repeat it in their own message; print the chain (e.g. `anyhow`'s `{:#}`) to see all of it.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum FemError {
     #[error(transparent)]
     Mesh(#[from] MeshError),
     #[error("element {element} is degenerate at Gauss point {gauss_point} of the reference configuration")]
     DegenerateElement { element: usize, gauss_point: usize },
-    #[error("element {element}, Gauss point {gauss_point}: {source}")]
+    #[error("element {element}, Gauss point {gauss_point}")]
     Material {
         element: usize,
         gauss_point: usize,
         #[source]
         source: MaterialError,
     },
+    #[error("node {node} belongs to no element: every node must be a corner of a quad")]
+    UnusedNode { node: usize },
+    #[error("the controlled dof (node {node}, component {component}) is fixed by a constraint")]
+    FixedControlDof { node: usize, component: usize },
+    #[error("zero pivot {index} ({value:e}) in the LDLᵀ factorization: the tangent is singular")]
+    ZeroPivot { index: usize, value: f64 },
+    #[error("tangent matrix entry {entry} is not finite")]
+    NonFiniteEntry { entry: usize },
     #[error("sparse factorization failed: {reason}")]
     Factorization { reason: String },
     #[error("invalid parameter `{name}` = {value}: {requirement}")]
@@ -46,23 +75,68 @@ pub enum FemError {
         value: f64,
         requirement: &'static str,
     },
-    /// Writing the results of a converged step failed (the run stops; earlier steps are kept).
-    #[error("stage {stage}, step {step}: writing results failed: {reason}")]
-    Output {
+    /// A stage could not reach its next step. `material` is the material error that rejected
+    /// an earlier attempt at the same step (e.g. locking) when the last attempt failed
+    /// otherwise: near a locking limit the cut-back attempts stop hitting the limit itself and
+    /// fail to converge instead.
+    #[error("step {step} (load parameter {value:.6}): no convergence even with {cuts} step cut-backs{}{}; last attempt",
+        near_locking.as_ref().map(|l| format!(" — {l}")).unwrap_or_default(),
+        material.as_ref().map(|m| format!(" (earlier attempts at this step were rejected: {})", error_chain(m.as_ref()))).unwrap_or_default())]
+    Stage {
         stage: usize,
         step: usize,
-        reason: String,
-    },
-    #[error("stage {stage}, step {step}: Newton did not converge after {iterations} iterations (residual {residual:.3e}, tolerance {tolerance:.1e}) even with {cuts} step cut-backs")]
-    NoConvergence {
-        stage: usize,
-        step: usize,
-        iterations: usize,
-        residual: f64,
-        tolerance: f64,
+        value: f64,
         cuts: usize,
+        material: Option<Box<FemError>>,
+        /// the last converged state's closest approach to the law's locking limit, when it is
+        /// within [`model::NEAR_LOCKING`] of it
+        near_locking: Option<model::LockingProximity>,
+        #[source]
+        source: Box<newton::NewtonError<FemError>>,
     },
 }
 
-#[cfg(test)]
-mod tests;
+impl FemError {
+    /// The element where a failed stage met the law's locking limit: a locking error, or a last
+    /// converged state within [`model::NEAR_LOCKING`] of the limit.
+    pub fn locking_element(&self) -> Option<usize> {
+        if let Some((e, MaterialError::Locking { .. })) = self.material_cause() {
+            return Some(e);
+        }
+        match self {
+            FemError::Stage {
+                near_locking: Some(l),
+                ..
+            } => Some(l.element),
+            _ => None,
+        }
+    }
+
+    /// The material error at the root of this one, if any (e.g. locking).
+    pub fn material_cause(&self) -> Option<(usize, &MaterialError)> {
+        match self {
+            FemError::Material {
+                element, source, ..
+            } => Some((*element, source)),
+            FemError::Stage {
+                source, material, ..
+            } => source
+                .cause()
+                .and_then(|e| e.material_cause())
+                .or_else(|| material.as_ref().and_then(|m| m.material_cause())),
+            _ => None,
+        }
+    }
+}
+
+/// The message of an error followed by its causes, ": "-separated.
+pub fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut s = e.to_string();
+    let mut cur = e.source();
+    while let Some(c) = cur {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        cur = c.source();
+    }
+    s
+}

@@ -102,10 +102,8 @@ impl SparseLdlt {
     pub fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
         assert_eq!(values.len(), self.entries, "one value per pattern entry");
         self.factorized = false;
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(FemError::Factorization {
-                reason: format!("matrix entry {i} is not finite"),
-            });
+        if let Some(entry) = values.iter().position(|v| !v.is_finite()) {
+            return Err(FemError::NonFiniteEntry { entry });
         }
         let mat = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
             .map_err(|e| FemError::Factorization {
@@ -137,9 +135,10 @@ impl SparseLdlt {
                 reason: format!("LDLᵀ breakdown: {e:?} (singular tangent)"),
             })?;
         let d = self.pivots();
-        if d.iter().any(|v| !v.is_finite() || *v == 0.0) {
-            return Err(FemError::Factorization {
-                reason: "zero or non-finite pivot (singular tangent)".into(),
+        if let Some(index) = d.iter().position(|v| !v.is_finite() || *v == 0.0) {
+            return Err(FemError::ZeroPivot {
+                index,
+                value: d[index],
             });
         }
         self.factorized = true;

@@ -1,4 +1,5 @@
-//! Global model: constraints, parallel assembly, Newton with loading control, continuation.
+//! The finite element model of one mesh and one law: dofs, pattern, reference elements, the
+//! assembly as a sum of terms, and the membrane problem that the Newton driver solves.
 //!
 //! Loading (all per unit μH, lengths in R; p is the reduced pressure ϖ):
 //! ```text
@@ -17,18 +18,22 @@
 //! #neg(K + c ggᵀ) = #neg(K) − [1 + c gᵀK⁻¹g < 0], and on the constraint subspace
 //! #neg = #neg(K) − [hᵀK⁻¹g < 0].
 
-use crate::contact::{contact_kernel, Plane};
-use crate::element::{membrane_kernel, RefElement};
+use crate::contact::Contact;
+use crate::dofs::DofMap;
+use crate::element::{membrane_kernel, Matrix12, Vector12};
+use crate::geometry::{RefElement, Vec3};
 use crate::linsolve::SparseLdlt;
-use crate::volume::volume_kernel;
+use crate::newton::{self, Evaluation, Inertia, Linearization, NewtonError, NewtonSettings};
+use crate::pattern::Pattern;
 use crate::FemError;
 use rayon::prelude::*;
 use tubemem_material::MembraneLaw;
+use tubemem_mesh::volume::volume_kernel;
 use tubemem_mesh::Mesh;
 
-/// How the load is controlled during a stage.
+/// How the enclosed gas is loaded.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Control {
+pub enum Loading {
     /// prescribed reduced pressure ϖ
     Pressure(f64),
     /// prescribed total enclosed volume (whole tube, all symmetry copies)
@@ -41,33 +46,36 @@ pub enum Control {
     },
     /// closed isothermal gas: p · V_total = `pv` (Boyle's constant)
     Gas { pv: f64 },
-    /// closed gas and two rigid plates y = ±`half_gap` (normal ∓e_y), displacement controlled
-    Squeeze { pv: f64, half_gap: f64 },
 }
 
-impl Control {
-    /// Boyle's constant, for the closed-gas controls.
-    pub fn gas(&self) -> Option<f64> {
-        match *self {
-            Control::Gas { pv } | Control::Squeeze { pv, .. } => Some(pv),
-            _ => None,
+/// Everything that loads the model at one step: the gas loading and the rigid planes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Load {
+    pub loading: Loading,
+    pub contact: Option<Contact>,
+}
+
+impl Load {
+    pub fn new(loading: Loading) -> Self {
+        Self {
+            loading,
+            contact: None,
         }
     }
-
-    /// The rigid plates this control places.
-    pub fn plates(&self) -> Vec<Plane> {
-        match *self {
-            Control::Squeeze { half_gap, .. } => vec![
-                Plane {
-                    normal: [0.0, -1.0, 0.0],
-                    offset: -half_gap,
-                },
-                Plane {
-                    normal: [0.0, 1.0, 0.0],
-                    offset: -half_gap,
-                },
-            ],
-            _ => vec![],
+    pub fn pressure(p: f64) -> Self {
+        Self::new(Loading::Pressure(p))
+    }
+    pub fn with_contact(loading: Loading, contact: Contact) -> Self {
+        Self {
+            loading,
+            contact: Some(contact),
+        }
+    }
+    /// Boyle's constant, for closed gas.
+    pub fn gas(&self) -> Option<f64> {
+        match self.loading {
+            Loading::Gas { pv } => Some(pv),
+            _ => None,
         }
     }
 }
@@ -80,42 +88,60 @@ pub struct State {
     pub p: f64,
 }
 
-/// What one Newton solve did.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NewtonInfo {
-    pub iterations: usize,
-    pub residual: f64,
-    pub negative_pivots: usize,
-    /// diagonal shift that had to be added to factorize (0 in regular states)
-    pub shift: f64,
+/// One element's contribution to the energy, the residual and the tangent.
+pub trait Term: Sync {
+    /// Add the energy (returned), residual and, if asked, the stiffness of element `e`.
+    fn add(
+        &self,
+        e: usize,
+        el: &RefElement,
+        xe: &[Vec3; 4],
+        r: &mut Vector12,
+        k: Option<&mut Matrix12>,
+    ) -> Result<f64, FemError>;
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NewtonSettings {
-    /// ‖R‖₂ ≤ rtol · max(‖f_int‖₂, ‖p g‖₂)
-    pub rtol: f64,
-    pub max_iterations: usize,
-    /// the largest nodal displacement per iteration (in R); longer steps are scaled down
-    pub max_step: f64,
+/// The hyperelastic membrane ([`crate::element`]).
+pub struct MembraneTerm<'a>(pub &'a dyn MembraneLaw);
+
+impl Term for MembraneTerm<'_> {
+    fn add(
+        &self,
+        e: usize,
+        el: &RefElement,
+        xe: &[Vec3; 4],
+        r: &mut Vector12,
+        k: Option<&mut Matrix12>,
+    ) -> Result<f64, FemError> {
+        membrane_kernel(self.0, el, xe, r, k).map_err(|(gp, source)| FemError::Material {
+            element: e,
+            gauss_point: gp,
+            source,
+        })
+    }
 }
 
-impl Default for NewtonSettings {
-    fn default() -> Self {
-        Self {
-            rtol: 1e-9,
-            max_iterations: 30,
-            max_step: 0.25,
-        }
+/// Penalty contact with rigid planes ([`crate::contact`]).
+impl Term for Contact {
+    fn add(
+        &self,
+        _e: usize,
+        el: &RefElement,
+        xe: &[Vec3; 4],
+        r: &mut Vector12,
+        k: Option<&mut Matrix12>,
+    ) -> Result<f64, FemError> {
+        Ok(self.kernel(el, xe, r, k))
     }
 }
 
 struct Local {
     energy: f64,
-    r: [f64; 12],
-    k: [f64; 144],
+    r: Vector12,
+    k: Matrix12,
     v: f64,
-    g: [f64; 12],
-    h: [f64; 144],
+    g: Vector12,
+    h: Matrix12,
 }
 
 /// Global quantities at a configuration.
@@ -127,144 +153,78 @@ pub struct Assembled {
     pub volume: f64,
     /// ∂V_part/∂x on the free dofs
     pub g: Vec<f64>,
-    k_int: Vec<f64>,
-    k_vol: Vec<f64>,
+    /// values of K_int and of ∂²V/∂x² in pattern order (empty without the tangent)
+    pub k_int: Vec<f64>,
+    pub k_vol: Vec<f64>,
 }
 
 /// The finite element model of one mesh and one law.
 pub struct Model {
-    pub mesh: Mesh,
-    pub law: Box<dyn MembraneLaw>,
-    pub elements: Vec<RefElement>,
-    /// equation number of each dof (3 per node), `None` where fixed
-    pub eq: Vec<Option<usize>>,
-    pub n_eq: usize,
-    /// per element: (local row, local col) of each matrix entry, in pattern order
-    entries: Vec<Vec<(u8, u8)>>,
-    diag: Vec<usize>,
-    /// equation of each rigid plug's axial translation (None if fixed)
-    plug_eq: Vec<Option<usize>>,
+    mesh: Mesh,
+    law: Box<dyn MembraneLaw>,
+    elements: Vec<RefElement>,
+    dofs: DofMap,
+    pattern: Pattern,
     ldlt: SparseLdlt,
-    pub settings: NewtonSettings,
-    /// rigid planes always present (any number, any orientation)
-    pub planes: Vec<Plane>,
-    /// contact penalty κ (per unit μH/R², see `contact::penalty_for`)
-    pub penalty: f64,
+    settings: NewtonSettings,
 }
 
 impl Model {
-    /// Build the model: check the mesh, fix the symmetry-plane normal displacements and pin the
-    /// remaining rigid-body modes on nodes whose motion the symmetry of the problem already
-    /// forbids (so the pins carry no load): u_x = u_y = 0 on the axis x = y = 0, u_x = 0 at the
-    /// node of largest y on the line x = z = 0, u_z = 0 at one node on z = 0.
+    /// Check the mesh, number the dofs ([`DofMap`]), build the reference elements, the pattern
+    /// and its symbolic factorization.
     pub fn new(mesh: Mesh, law: Box<dyn MembraneLaw>) -> Result<Self, FemError> {
         mesh.check()?;
-        let nn = mesh.nodes.len();
-        let mut fixed = vec![false; 3 * nn];
-        let on: Vec<Vec<bool>> = (0..3).map(|ax| mesh.on_plane(ax)).collect();
-        for &ax in mesh.symmetry.planes() {
-            for i in 0..nn {
-                if on[ax][i] {
-                    fixed[3 * i + ax] = true;
-                }
-            }
+        let dofs = DofMap::new(&mesh);
+        let elements = mesh
+            .quads
+            .iter()
+            .enumerate()
+            .map(|(e, q)| RefElement::new(e, *q, &q.map(|i| mesh.nodes[i])))
+            .collect::<Result<Vec<_>, _>>()?;
+        let pattern = Pattern::new(&dofs, &elements);
+        if let Some(k) = pattern.diagonal().iter().position(|&d| d == usize::MAX) {
+            let node = (0..mesh.nodes.len())
+                .find(|&i| (0..3).any(|c| dofs.eq(i, c) == Some(k)))
+                .unwrap_or(usize::MAX);
+            return Err(FemError::UnusedNode { node });
         }
-        let planes = mesh.symmetry.planes();
-        // translations x, y and rotations about x, y
-        if !planes.contains(&0) || !planes.contains(&1) {
-            for i in 0..nn {
-                if on[0][i] && on[1][i] {
-                    fixed[3 * i] = true;
-                    fixed[3 * i + 1] = true;
-                }
-            }
-        }
-        // rotation about z
-        if !planes.contains(&0) && !planes.contains(&1) {
-            if let Some(i) = (0..nn)
-                .filter(|&i| on[0][i] && on[2][i])
-                .max_by(|&a, &b| mesh.nodes[a][1].total_cmp(&mesh.nodes[b][1]))
-            {
-                fixed[3 * i] = true;
-            }
-        }
-        // translation z
-        if !planes.contains(&2) {
-            if let Some(i) = (0..nn).find(|&i| on[2][i]) {
-                fixed[3 * i + 2] = true;
-            }
-        }
-        // Rigid plugs: the ring nodes keep x and y (tied to the disc) and share one axial dof,
-        // the disc's translation.
-        let mut plug_of = vec![usize::MAX; nn];
-        for (k, ring) in mesh.plugs.iter().enumerate() {
-            for &i in ring {
-                fixed[3 * i] = true;
-                fixed[3 * i + 1] = true;
-                plug_of[i] = k;
-            }
-        }
-        let mut eq = vec![None; 3 * nn];
-        let mut plug_eq = vec![None; mesh.plugs.len()];
-        let mut n_eq = 0;
-        for (d, f) in fixed.iter().enumerate() {
-            if *f {
-                continue;
-            }
-            let node = d / 3;
-            if d % 3 == 2 && plug_of[node] != usize::MAX {
-                let k = plug_of[node];
-                eq[d] = Some(*plug_eq[k].get_or_insert_with(|| {
-                    n_eq += 1;
-                    n_eq - 1
-                }));
-            } else {
-                eq[d] = Some(n_eq);
-                n_eq += 1;
-            }
-        }
-        let mut elements = Vec::with_capacity(mesh.quads.len());
-        for (e, q) in mesh.quads.iter().enumerate() {
-            elements.push(RefElement::new(e, *q, &q.map(|i| mesh.nodes[i]))?);
-        }
-        let mut entries = Vec::with_capacity(elements.len());
-        let mut pairs = Vec::new();
-        let mut diag = vec![usize::MAX; n_eq];
-        for el in &elements {
-            let mut list = Vec::new();
-            for i in 0..12 {
-                for j in 0..12 {
-                    if let (Some(a), Some(b)) = (
-                        eq[3 * el.nodes[i / 3] + i % 3],
-                        eq[3 * el.nodes[j / 3] + j % 3],
-                    ) {
-                        if a >= b {
-                            if a == b && diag[a] == usize::MAX {
-                                diag[a] = pairs.len();
-                            }
-                            pairs.push((a, b));
-                            list.push((i as u8, j as u8));
-                        }
-                    }
-                }
-            }
-            entries.push(list);
-        }
-        let ldlt = SparseLdlt::new(n_eq, &pairs)?;
+        let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
         Ok(Self {
             mesh,
             law,
             elements,
-            eq,
-            n_eq,
-            entries,
-            diag,
-            plug_eq,
+            dofs,
+            pattern,
             ldlt,
             settings: NewtonSettings::default(),
-            planes: vec![],
-            penalty: 0.0,
         })
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+    pub fn law(&self) -> &dyn MembraneLaw {
+        self.law.as_ref()
+    }
+    pub fn elements(&self) -> &[RefElement] {
+        &self.elements
+    }
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+    /// The number of equations.
+    pub fn n_eq(&self) -> usize {
+        self.dofs.len()
+    }
+    pub fn settings(&self) -> &NewtonSettings {
+        &self.settings
+    }
+    pub fn set_settings(&mut self, settings: NewtonSettings) {
+        self.settings = settings;
+    }
+    /// The number of nonzeros of the sparse factor.
+    pub fn factor_nnz(&self) -> usize {
+        self.ldlt.factor_nnz()
     }
 
     /// The symmetry multiplicity (copies of the model in the whole tube).
@@ -280,76 +240,69 @@ impl Model {
         }
     }
 
+    /// The total enclosed volume (all symmetry copies) at `x`.
+    pub fn total_volume(&self, x: &[[f64; 3]]) -> f64 {
+        self.multiplicity() * self.mesh.volume_at(x)
+    }
+
     /// Assemble energy, internal force, volume and its gradient, and (if `tangent`) the matrix
-    /// values. Element kernels run in parallel; every sum is taken in element order, so the result
-    /// does not depend on the number of threads.
-    pub fn assemble(&self, x: &[[f64; 3]], tangent: bool) -> Result<Assembled, FemError> {
-        self.assemble_with(x, tangent, &[])
-    }
-
-    /// All contact planes for a control: the model's own and the control's plates.
-    pub fn contact_planes(&self, control: Control) -> Vec<Plane> {
-        let mut p = self.planes.clone();
-        p.extend(control.plates());
-        p
-    }
-
-    /// [`Model::assemble`] with contact against `extra` planes (added to the model's own).
-    pub fn assemble_with(
+    /// values, from the membrane and the contact (if any). Element kernels run in parallel;
+    /// every sum is taken in element order, so the result does not depend on the number of
+    /// threads.
+    pub fn assemble(
         &self,
         x: &[[f64; 3]],
         tangent: bool,
-        extra: &[Plane],
+        contact: Option<&Contact>,
     ) -> Result<Assembled, FemError> {
-        let law = self.law.as_ref();
-        let planes: Vec<Plane> = self.planes.iter().chain(extra).copied().collect();
-        let kappa = self.penalty;
+        let membrane = MembraneTerm(self.law.as_ref());
+        let mut terms: Vec<&dyn Term> = vec![&membrane];
+        if let Some(c) = contact {
+            terms.push(c);
+        }
+        self.assemble_terms(x, tangent, &terms)
+    }
+
+    /// [`Model::assemble`] for any list of terms (plus the enclosed volume, always).
+    pub fn assemble_terms(
+        &self,
+        x: &[[f64; 3]],
+        tangent: bool,
+        terms: &[&dyn Term],
+    ) -> Result<Assembled, FemError> {
         let locals: Vec<Result<Local, FemError>> = self
             .elements
             .par_iter()
             .enumerate()
             .map(|(e, el)| {
-                let xe = el.nodes.map(|i| x[i]);
+                let xe = el.gather(x);
                 let mut l = Local {
                     energy: 0.0,
-                    r: [0.0; 12],
-                    k: [0.0; 144],
+                    r: Vector12::zeros(),
+                    k: Matrix12::zeros(),
                     v: 0.0,
-                    g: [0.0; 12],
-                    h: [0.0; 144],
+                    g: Vector12::zeros(),
+                    h: Matrix12::zeros(),
                 };
-                l.energy = membrane_kernel(law, el, &xe, &mut l.r, tangent.then_some(&mut l.k))
-                    .map_err(|(gp, source)| FemError::Material {
-                        element: e,
-                        gauss_point: gp,
-                        source,
-                    })?;
-                if !planes.is_empty() {
-                    l.energy += contact_kernel(
-                        el,
-                        &xe,
-                        &planes,
-                        kappa,
-                        &mut l.r,
-                        tangent.then_some(&mut l.k),
-                    );
+                for term in terms {
+                    l.energy += term.add(e, el, &xe, &mut l.r, tangent.then_some(&mut l.k))?;
                 }
-                l.v = volume_kernel(&xe, &mut l.g, tangent.then_some(&mut l.h));
+                l.v = volume_kernel(&xe, Some(&mut l.g), tangent.then_some(&mut l.h));
                 Ok(l)
             })
             .collect();
+        let n_eq = self.n_eq();
         let mut out = Assembled {
             energy: 0.0,
-            f_int: vec![0.0; self.n_eq],
+            f_int: vec![0.0; n_eq],
             volume: 0.0,
-            g: vec![0.0; self.n_eq],
+            g: vec![0.0; n_eq],
             k_int: Vec::new(),
             k_vol: Vec::new(),
         };
         if tangent {
-            let n: usize = self.entries.iter().map(|l| l.len()).sum();
-            out.k_int.reserve(n);
-            out.k_vol.reserve(n);
+            out.k_int.reserve(self.pattern.len());
+            out.k_vol.reserve(self.pattern.len());
         }
         for (e, l) in locals.into_iter().enumerate() {
             let l = l?;
@@ -357,23 +310,24 @@ impl Model {
             out.volume += l.v;
             let el = &self.elements[e];
             for i in 0..12 {
-                if let Some(a) = self.eq[3 * el.nodes[i / 3] + i % 3] {
+                if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {
                     out.f_int[a] += l.r[i];
                     out.g[a] += l.g[i];
                 }
             }
             if tangent {
-                for &(i, j) in &self.entries[e] {
-                    let idx = i as usize * 12 + j as usize;
-                    out.k_int.push(l.k[idx]);
-                    out.k_vol.push(l.h[idx]);
+                for &(i, j) in self.pattern.element_entries(e) {
+                    let (i, j) = (i as usize, j as usize);
+                    out.k_int.push(l.k[(i, j)]);
+                    out.k_vol.push(l.h[(i, j)]);
                 }
             }
         }
         // Rigid plug faces close the surface: V_face = (1/3) z_d A sign, linear in the disc
         // translation z_d (A is fixed, the ring being tied to the disc), so no Hessian term.
-        for (ring, eq) in self.mesh.plugs.iter().zip(&self.plug_eq) {
-            let face = tubemem_mesh::plug_face(x, ring);
+        let closed = self.mesh.symmetry.rings_closed();
+        for (ring, eq) in self.mesh.plugs.iter().zip(self.dofs.plug_equations()) {
+            let face = tubemem_mesh::plug_face(x, ring, closed);
             out.volume += face.volume();
             if let Some(k) = eq {
                 out.g[*k] += face.area * face.sign / 3.0;
@@ -382,8 +336,10 @@ impl Model {
         Ok(out)
     }
 
-    /// Factorize K = K_int − p H (+ a diagonal shift if K is singular); returns (#neg, shift).
+    /// Factorize K = K_int − p H; if K is singular, retry with diagonal shifts of 1e-10 …
+    /// 1e-4 of its largest diagonal entry. Returns (#neg, shift).
     fn factorize(&mut self, a: &Assembled, p: f64) -> Result<(usize, f64), FemError> {
+        const SHIFTS: [f64; 4] = [1e-10, 1e-8, 1e-6, 1e-4];
         let mut vals: Vec<f64> = a
             .k_int
             .iter()
@@ -393,16 +349,16 @@ impl Model {
         match self.ldlt.factorize(&vals) {
             Ok(neg) => Ok((neg, 0.0)),
             Err(first) => {
-                let scale = self
-                    .diag
+                let diag = self.pattern.diagonal();
+                let scale = diag
                     .iter()
                     .map(|&d| vals[d].abs())
                     .fold(0.0, f64::max)
                     .max(1e-300);
                 let mut applied = 0.0;
-                for rel in [1e-10, 1e-8, 1e-6, 1e-4] {
+                for rel in SHIFTS {
                     let s = rel * scale;
-                    for &d in &self.diag {
+                    for &d in diag {
                         vals[d] += s - applied;
                     }
                     applied = s;
@@ -415,178 +371,26 @@ impl Model {
         }
     }
 
-    fn apply(&self, x: &mut [[f64; 3]], dx: &[f64], t: f64) {
-        for (d, e) in self.eq.iter().enumerate() {
-            if let Some(k) = e {
-                x[d / 3][d % 3] += t * dx[*k];
-            }
-        }
-    }
-
-    /// Newton iterations at fixed control; `state` is the initial guess and, on success, the
+    /// Newton iterations under `load`; `state` is the initial guess and, on success, the
     /// converged state.
     pub fn solve(
         &mut self,
         state: &mut State,
-        control: Control,
-    ) -> Result<NewtonInfo, (usize, f64)> {
-        let m = self.multiplicity();
-        let settings = self.settings;
-        let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
-        if let Control::Pressure(p) = control {
+        load: &Load,
+    ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
+        if let Loading::Pressure(p) = load.loading {
             state.p = p;
         }
-        let plates = control.plates();
-        let mut last = f64::INFINITY;
-        for it in 0..=settings.max_iterations {
-            let a = match self.assemble_with(&state.x, true, &plates) {
-                Ok(a) => a,
-                Err(_) => return Err((it, f64::INFINITY)),
-            };
-            if let Some(pv) = control.gas() {
-                state.p = pv / (m * a.volume);
-            }
-            let p = state.p;
-            let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
-            let (c, h): (f64, Option<Vec<f64>>) = match control {
-                Control::Volume(v) => (m * a.volume - v, Some(a.g.iter().map(|g| m * g).collect())),
-                Control::Node {
-                    node,
-                    component,
-                    target,
-                } => {
-                    let k = self.eq[3 * node + component].ok_or((it, f64::INFINITY))?;
-                    let mut e = vec![0.0; self.n_eq];
-                    e[k] = 1.0;
-                    (state.x[node][component] - target, Some(e))
-                }
-                _ => (0.0, None),
-            };
-            let reference = norm(&a.f_int).max(p.abs() * norm(&a.g)).max(1e-12);
-            let res = norm(&r) / reference;
-            let cscale = match control {
-                Control::Volume(v) => v.abs().max(1e-300),
-                _ => 1.0,
-            };
-            last = res + c.abs() / cscale;
-            let (neg, shift) = match self.factorize(&a, p) {
-                Ok(v) => v,
-                Err(_) => return Err((it, last)),
-            };
-            let converged = res <= settings.rtol && c.abs() <= 1e-12 * cscale;
-            // the Newton correction
-            let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
-            self.ldlt.solve(&mut dx);
-            let mut dp = 0.0;
-            let mut negative = neg;
-            match (control, &h) {
-                (c, _) if c.gas().is_some() => {
-                    let cc = p / a.volume;
-                    let mut b = a.g.clone();
-                    self.ldlt.solve(&mut b);
-                    let gb: f64 = a.g.iter().zip(&b).map(|(x, y)| x * y).sum();
-                    let gdx: f64 = a.g.iter().zip(&dx).map(|(x, y)| x * y).sum();
-                    let denom = 1.0 + cc * gb;
-                    if denom < 0.0 {
-                        negative = negative.saturating_sub(1);
-                    }
-                    for (d, bb) in dx.iter_mut().zip(&b) {
-                        *d -= cc * bb * gdx / denom;
-                    }
-                }
-                (_, Some(h)) => {
-                    let mut b = a.g.clone();
-                    self.ldlt.solve(&mut b);
-                    let hb: f64 = h.iter().zip(&b).map(|(x, y)| x * y).sum();
-                    let ha: f64 = h.iter().zip(&dx).map(|(x, y)| x * y).sum();
-                    if hb < 0.0 {
-                        negative = negative.saturating_sub(1);
-                    }
-                    dp = (-c - ha) / hb;
-                    for (d, bb) in dx.iter_mut().zip(&b) {
-                        *d += dp * bb;
-                    }
-                }
-                _ => {}
-            }
-            if converged {
-                return Ok(NewtonInfo {
-                    iterations: it,
-                    residual: res,
-                    negative_pivots: negative,
-                    shift,
-                });
-            }
-            if it == settings.max_iterations {
-                break;
-            }
-            // limit the step, then backtrack on the residual
-            let maxd = (0..self.mesh.nodes.len())
-                .map(|i| {
-                    (0..3)
-                        .map(|k| self.eq[3 * i + k].map_or(0.0, |e| dx[e] * dx[e]))
-                        .sum::<f64>()
-                        .sqrt()
-                })
-                .fold(0.0, f64::max);
-            let mut t = if maxd > settings.max_step {
-                settings.max_step / maxd
-            } else {
-                1.0
-            };
-            if !dx.iter().all(|v| v.is_finite()) || !dp.is_finite() {
-                return Err((it, last));
-            }
-            let x0 = state.x.clone();
-            let p0 = state.p;
-            // potential and its slope along dx (∂Π/∂x = R)
-            let pi0 = potential(control, a.energy, a.volume, p);
-            let slope: f64 = r.iter().zip(&dx).map(|(ri, di)| ri * di).sum();
-            let mut accepted = false;
-            for _ in 0..8 {
-                state.x.clone_from(&x0);
-                self.apply(&mut state.x, &dx, t);
-                state.p = p0 + t * dp;
-                if let Ok(trial) = self.assemble_with(&state.x, false, &plates) {
-                    let pt = match control {
-                        c if c.gas().is_some() => c.gas().unwrap_or(0.0) / (m * trial.volume),
-                        _ => state.p,
-                    };
-                    let rt: Vec<f64> = trial
-                        .f_int
-                        .iter()
-                        .zip(&trial.g)
-                        .map(|(f, g)| f - pt * g)
-                        .collect();
-                    let reft = norm(&trial.f_int).max(pt.abs() * norm(&trial.g)).max(1e-12);
-                    // Bordered controls: accept full steps (the merit mixes R and c). Potential
-                    // controls (pressure, gas, squeeze): accept a decrease of the residual or of
-                    // the total potential Π (Armijo on the directional derivative −Rᵀdx·t).
-                    let pi_t = potential(control, trial.energy, trial.volume, pt);
-                    let armijo = pi0 + 1e-4 * t * slope;
-                    if h.is_some() || norm(&rt) / reft < res || pi_t < armijo || t < 1e-3 {
-                        accepted = true;
-                        break;
-                    }
-                }
-                t *= 0.5;
-            }
-            if !accepted {
-                state.x = x0;
-                state.p = p0;
-                return Err((it, last));
-            }
-        }
-        Err((settings.max_iterations, last))
+        let settings = self.settings;
+        let mut problem = MembraneProblem { model: self, load };
+        newton::solve(&mut problem, state, &settings)
     }
-}
 
-impl Model {
     /// The residual R = f_int − p ∂V/∂x on the free dofs, with p = `p` or, for closed gas,
     /// p = pv/(m V_part) (for tests and diagnostics).
-    pub fn residual(&self, x: &[[f64; 3]], control: Control, p: f64) -> Result<Vec<f64>, FemError> {
-        let a = self.assemble_with(x, false, &control.plates())?;
-        let p = match control.gas() {
+    pub fn residual(&self, x: &[[f64; 3]], load: &Load, p: f64) -> Result<Vec<f64>, FemError> {
+        let a = self.assemble(x, false, load.contact.as_ref())?;
+        let p = match load.gas() {
             Some(pv) => pv / (self.multiplicity() * a.volume),
             _ => p,
         };
@@ -598,40 +402,259 @@ impl Model {
     pub fn tangent_times(
         &self,
         x: &[[f64; 3]],
-        control: Control,
+        load: &Load,
         p: f64,
         v: &[f64],
     ) -> Result<Vec<f64>, FemError> {
-        let a = self.assemble_with(x, true, &control.plates())?;
-        let p = match control.gas() {
+        let a = self.assemble(x, true, load.contact.as_ref())?;
+        let p = match load.gas() {
             Some(pv) => pv / (self.multiplicity() * a.volume),
             _ => p,
         };
-        let mut out = vec![0.0; self.n_eq];
+        let mut out = vec![0.0; self.n_eq()];
         let mut k = 0;
-        for (e, list) in self.entries.iter().enumerate() {
-            let el = &self.elements[e];
-            for &(i, j) in list {
+        for (e, el) in self.elements.iter().enumerate() {
+            for &(i, j) in self.pattern.element_entries(e) {
                 let (i, j) = (i as usize, j as usize);
-                let ra = self.eq[3 * el.nodes[i / 3] + i % 3].expect("entries hold free dofs");
-                let cb = self.eq[3 * el.nodes[j / 3] + j % 3].expect("entries hold free dofs");
+                let (Some(ra), Some(cb)) = (
+                    self.dofs.eq(el.nodes[i / 3], i % 3),
+                    self.dofs.eq(el.nodes[j / 3], j % 3),
+                ) else {
+                    continue;
+                };
                 let val = a.k_int[k] - p * a.k_vol[k];
                 out[ra] += val * v[cb];
-                if i != j && ra == cb {
-                    // both (i, j) and (j, i) are stored when they share an equation
-                } else if ra != cb {
+                // both (i, j) and (j, i) are stored when they share an equation
+                if ra != cb {
                     out[cb] += val * v[ra];
                 }
                 k += 1;
             }
         }
-        if control.gas().is_some() {
+        if load.gas().is_some() {
             let gv: f64 = a.g.iter().zip(v).map(|(g, v)| g * v).sum();
             for (o, g) in out.iter_mut().zip(&a.g) {
                 *o += p / a.volume * g * gv;
             }
         }
         Ok(out)
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|a| a * a).sum::<f64>().sqrt()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The total potential of the modelled part: Π = W_int + E_contact − p V_part (pressure) or
+/// − (pv/m) ln V_part (closed gas; by Boyle's law pv/m = p V_part at every state).
+fn potential(loading: Loading, energy: f64, v_part: f64, p: f64) -> f64 {
+    match loading {
+        Loading::Gas { .. } => energy - p * v_part * v_part.ln(),
+        _ => energy - p * v_part,
+    }
+}
+
+/// The membrane equilibrium under one load, as a [`newton::Problem`]: the state is (x, p), the
+/// step (Δx on the free dofs, Δp).
+struct MembraneProblem<'a> {
+    model: &'a mut Model,
+    load: &'a Load,
+}
+
+impl MembraneProblem<'_> {
+    fn pressure(&self, state_p: f64, volume: f64) -> f64 {
+        match self.load.gas() {
+            Some(pv) => pv / (self.model.multiplicity() * volume),
+            None => state_p,
+        }
+    }
+}
+
+impl newton::Problem for MembraneProblem<'_> {
+    type State = State;
+    type Step = (Vec<f64>, f64);
+    type Error = FemError;
+
+    fn linearize(&mut self, state: &mut State) -> Result<Linearization<Self::Step>, FemError> {
+        let m = self.model.multiplicity();
+        let a = self
+            .model
+            .assemble(&state.x, true, self.load.contact.as_ref())?;
+        state.p = self.pressure(state.p, a.volume);
+        let p = state.p;
+        let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
+        let (c, h): (f64, Option<Vec<f64>>) = match self.load.loading {
+            Loading::Volume(v) => (m * a.volume - v, Some(a.g.iter().map(|g| m * g).collect())),
+            Loading::Node {
+                node,
+                component,
+                target,
+            } => {
+                let k = self
+                    .model
+                    .dofs
+                    .eq(node, component)
+                    .ok_or(FemError::FixedControlDof { node, component })?;
+                let mut e = vec![0.0; self.model.n_eq()];
+                e[k] = 1.0;
+                (state.x[node][component] - target, Some(e))
+            }
+            _ => (0.0, None),
+        };
+        let reference = norm(&a.f_int).max(p.abs() * norm(&a.g)).max(1e-12);
+        let res = norm(&r) / reference;
+        let cscale = match self.load.loading {
+            Loading::Volume(v) => v.abs().max(1e-300),
+            _ => 1.0,
+        };
+        let merit = res + c.abs() / cscale;
+        let (neg, shift) = self.model.factorize(&a, p)?;
+        let converged = res <= self.model.settings.rtol && c.abs() <= 1e-12 * cscale;
+        // the Newton correction
+        let ldlt = &self.model.ldlt;
+        let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
+        ldlt.solve(&mut dx);
+        let mut dp = 0.0;
+        let mut negative = neg;
+        if self.load.gas().is_some() {
+            let cc = p / a.volume;
+            let mut b = a.g.clone();
+            ldlt.solve(&mut b);
+            let gb = dot(&a.g, &b);
+            let gdx = dot(&a.g, &dx);
+            let denom = 1.0 + cc * gb;
+            if denom < 0.0 {
+                negative = negative.saturating_sub(1);
+            }
+            for (d, bb) in dx.iter_mut().zip(&b) {
+                *d -= cc * bb * gdx / denom;
+            }
+        } else if let Some(h) = &h {
+            let mut b = a.g.clone();
+            ldlt.solve(&mut b);
+            let hb = dot(h, &b);
+            let ha = dot(h, &dx);
+            if hb < 0.0 {
+                negative = negative.saturating_sub(1);
+            }
+            dp = (-c - ha) / hb;
+            for (d, bb) in dx.iter_mut().zip(&b) {
+                *d += dp * bb;
+            }
+        }
+        let slope = dot(&r, &dx);
+        Ok(Linearization {
+            residual: res,
+            merit,
+            converged,
+            potential: potential(self.load.loading, a.energy, a.volume, p),
+            slope,
+            step: (dx, dp),
+            bordered: h.is_some(),
+            inertia: Inertia {
+                negative_pivots: negative,
+                shift,
+            },
+        })
+    }
+
+    fn evaluate(&self, state: &State) -> Result<Evaluation, FemError> {
+        let trial = self
+            .model
+            .assemble(&state.x, false, self.load.contact.as_ref())?;
+        let pt = self.pressure(state.p, trial.volume);
+        let rt: Vec<f64> = trial
+            .f_int
+            .iter()
+            .zip(&trial.g)
+            .map(|(f, g)| f - pt * g)
+            .collect();
+        let reft = norm(&trial.f_int).max(pt.abs() * norm(&trial.g)).max(1e-12);
+        Ok(Evaluation {
+            residual: norm(&rt) / reft,
+            potential: potential(self.load.loading, trial.energy, trial.volume, pt),
+        })
+    }
+
+    fn update(&self, base: &State, step: &Self::Step, t: f64, state: &mut State) {
+        state.x.clone_from(&base.x);
+        self.model.dofs.apply(&mut state.x, &step.0, t);
+        state.p = base.p + t * step.1;
+    }
+
+    fn step_size(&self, step: &Self::Step) -> f64 {
+        self.model.dofs.max_nodal_norm(&step.0)
+    }
+
+    fn step_is_finite(&self, step: &Self::Step) -> bool {
+        step.0.iter().all(|v| v.is_finite()) && step.1.is_finite()
+    }
+}
+
+/// The fraction of a law's extensible range, (I1 − 3)/(I1,lim − 3), from which a failed solve is
+/// attributed to locking: the ABB energy's stiffness grows as 1/(1 − fraction)², 400× its
+/// small-strain value at 0.95, and Newton steps from such a state overshoot the limit or stall.
+pub const NEAR_LOCKING: f64 = 0.95;
+
+/// Where a state comes closest to the law's locking limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LockingProximity {
+    pub element: usize,
+    pub gauss_point: usize,
+    /// I1 = tr C + 1/det C there
+    pub i1: f64,
+    /// the law's limit of I1
+    pub limit: f64,
+}
+
+impl LockingProximity {
+    /// (I1 − 3)/(I1,lim − 3): 0 unstretched, 1 locked.
+    pub fn fraction(&self) -> f64 {
+        (self.i1 - 3.0) / (self.limit - 3.0)
+    }
+}
+
+impl std::fmt::Display for LockingProximity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the last converged state is at {:.1} % of the law's locking range (I1 = {:.4} of the locking limit {:.4}) at element {}, Gauss point {}: the membrane is locking",
+            100.0 * self.fraction(),
+            self.i1,
+            self.limit,
+            self.element,
+            self.gauss_point
+        )
+    }
+}
+
+impl Model {
+    /// The Gauss point of largest I1 at `x` against the law's locking limit (`None` for a law
+    /// without one).
+    pub fn locking_proximity(&self, x: &[[f64; 3]]) -> Option<LockingProximity> {
+        let limit = self.law.locking_limit()?;
+        let mut best: Option<LockingProximity> = None;
+        for (e, el) in self.elements.iter().enumerate() {
+            let xe = el.gather(x);
+            for g in 0..4 {
+                let c = crate::element::cauchy_green(&el.gradient(g, &xe));
+                let det = c[0] * c[1] - c[2] * c[2];
+                let i1 = c[0] + c[1] + 1.0 / det;
+                if i1.is_finite() && best.is_none_or(|b| i1 > b.i1) {
+                    best = Some(LockingProximity {
+                        element: e,
+                        gauss_point: g,
+                        i1,
+                        limit,
+                    });
+                }
+            }
+        }
+        best
     }
 }
 
@@ -649,7 +672,7 @@ impl Model {
     /// Time one Newton iteration at `state` under pressure control (for benchmarks).
     pub fn time_iteration(&mut self, state: &State) -> Result<IterationTiming, FemError> {
         let t0 = std::time::Instant::now();
-        let a = self.assemble(&state.x, true)?;
+        let a = self.assemble(&state.x, true, None)?;
         let t1 = std::time::Instant::now();
         let (neg, _) = self.factorize(&a, state.p)?;
         let t2 = std::time::Instant::now();
@@ -671,110 +694,7 @@ impl Model {
     }
 }
 
-/// The total potential of the modelled part for the potential-based controls:
-/// Π = W_int + E_contact − p V_part (pressure) or − (pv/m) ln V_part (closed gas, squeeze; by
-/// Boyle's law pv/m = p V_part at every state).
-fn potential(control: Control, energy: f64, v_part: f64, p: f64) -> f64 {
-    match control {
-        Control::Gas { .. } | Control::Squeeze { .. } => energy - p * v_part * v_part.ln(),
-        _ => energy - p * v_part,
-    }
-}
-
-/// One stage of a run: its number (for messages), the control value at its start and end, and
-/// how to step between them.
-pub struct Stage {
-    pub index: usize,
-    pub from: f64,
-    pub to: f64,
-    pub initial_steps: usize,
-    pub max_cuts: usize,
-}
-
-/// Run one stage: the control moves linearly from `stage.from` to `stage.to` (built by
-/// `control(value)`), with step cut-back on failure and growth after easy steps.
-/// `on_step(model, step, value, state, info)` is called for every converged step, so results can be
-/// written as the run goes; an error names the stage, the step, the iterations and the residual.
-pub fn run_stage(
-    model: &mut Model,
-    state: &mut State,
-    stage: &Stage,
-    control: impl Fn(f64) -> Control,
-    mut on_step: impl FnMut(&Model, usize, f64, &State, &NewtonInfo) -> Result<(), String>,
-) -> Result<(), FemError> {
-    let (from, to) = (stage.from, stage.to);
-    // A stress-free membrane has no stiffness against inextensional modes, and a bordered
-    // control (volume, node) amplifies them: from an unloaded state, first take a small
-    // pressure-controlled step (ϖ = 0.01, a hoop strain of about 0.25 %), which converges from
-    // the reference and gives the membrane its geometric stiffness.
-    if state.p == 0.0 && !matches!(control(from), Control::Pressure(_)) {
-        let mut p0 = 0.01;
-        loop {
-            let mut trial = state.clone();
-            if model.solve(&mut trial, Control::Pressure(p0)).is_ok() {
-                *state = trial;
-                break;
-            }
-            p0 *= 0.5;
-            if p0 < 1e-6 {
-                return Err(FemError::NoConvergence {
-                    stage: stage.index,
-                    step: 0,
-                    iterations: model.settings.max_iterations,
-                    residual: f64::NAN,
-                    tolerance: model.settings.rtol,
-                    cuts: 14,
-                });
-            }
-        }
-    }
-    let mut lambda = 0.0;
-    let mut dl = 1.0 / stage.initial_steps.max(1) as f64;
-    let mut step = 0;
-    let mut cuts = 0;
-    while lambda < 1.0 {
-        // snap to the end when within rounding of it (no zero-length last step)
-        let next = if lambda + dl >= 1.0 - 1e-9 {
-            1.0
-        } else {
-            lambda + dl
-        };
-        let value = from + (to - from) * next;
-        let mut trial = state.clone();
-        match model.solve(&mut trial, control(value)) {
-            Ok(info) => {
-                step += 1;
-                lambda = next;
-                *state = trial;
-                on_step(model, step, value, state, &info).map_err(|reason| FemError::Output {
-                    stage: stage.index,
-                    step,
-                    reason,
-                })?;
-                if info.iterations <= 5 {
-                    dl = (dl * 1.5).min(0.25);
-                }
-            }
-            Err((iterations, residual)) => {
-                cuts += 1;
-                dl *= 0.5;
-                if cuts > stage.max_cuts {
-                    return Err(FemError::NoConvergence {
-                        stage: stage.index,
-                        step: step + 1,
-                        iterations,
-                        residual,
-                        tolerance: model.settings.rtol,
-                        cuts: cuts - 1,
-                    });
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The node of the model closest to `p` (reference configuration).
+/// The node of the mesh closest to `p` (reference configuration).
 pub fn nearest_node(mesh: &Mesh, p: [f64; 3]) -> usize {
     (0..mesh.nodes.len())
         .min_by(|&a, &b| {

@@ -1,4 +1,5 @@
-//! Mid-span extraction at the cross-section Z = 0 (reference) of a capped tube.
+//! Mid-span extraction at the cross-section Z = 0 (reference) of a capped tube, profiles along
+//! it, contact values and per-element output values.
 //!
 //! ```text
 //! λs   = (current length of the mid-span ring polygon) / (its reference length)
@@ -10,13 +11,16 @@
 //!        made horizontal) and a the axial direction in the tangent plane
 //! ϖ    = the reduced pressure,  volume = total enclosed volume (all symmetry copies)
 //! ```
+use crate::contact::Contact;
 use crate::element::point_state;
+use crate::geometry::Vec3;
 use crate::model::{Model, State};
 use crate::FemError;
-use tubemem_mesh::{cross, dot};
+use serde::Serialize;
+pub use tubemem_material::relaxed::Regime;
 
 /// Mid-span values, dimensionless (resultants per μH).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct MidSpan {
     pub w: f64,
     pub lambda_s: f64,
@@ -27,57 +31,75 @@ pub struct MidSpan {
     pub volume: f64,
 }
 
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let n = dot(a, a).sqrt();
-    a.map(|v| v / n)
-}
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    (Vec3::from(a) - Vec3::from(b)).norm()
 }
 
-/// The nodes of the reference ring at height `z` (on the cylinder), sorted by angle.
-pub fn ring_at(model: &Model, z: f64) -> Vec<usize> {
-    let tol = 1e-9 * model.mesh.scale();
-    let mut ring: Vec<usize> = (0..model.mesh.nodes.len())
-        .filter(|&i| (model.mesh.nodes[i][2] - z).abs() <= tol)
-        .collect();
-    ring.sort_by(|&a, &b| {
-        let ang = |i: usize| model.mesh.nodes[i][1].atan2(model.mesh.nodes[i][0]);
-        ang(a).total_cmp(&ang(b))
-    });
-    ring
+/// A ring of nodes around the axis at one reference height: the one owner of ring topology.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ring {
+    /// the nodes, sorted by angle
+    pub nodes: Vec<usize>,
+    /// whether the ring goes all the way round (no symmetry plane through the axis cuts it)
+    pub closed: bool,
 }
 
-/// The reference-ring nodes at Z = 0, sorted by angle.
-pub fn midspan_ring(model: &Model) -> Vec<usize> {
-    ring_at(model, 0.0)
+impl Ring {
+    /// The nodes of the reference ring at height `z` (on the cylinder), sorted by angle.
+    pub fn at(model: &Model, z: f64) -> Self {
+        let mesh = model.mesh();
+        let tol = 1e-9 * mesh.scale();
+        let mut nodes: Vec<usize> = (0..mesh.nodes.len())
+            .filter(|&i| (mesh.nodes[i][2] - z).abs() <= tol)
+            .collect();
+        nodes.sort_by(|&a, &b| {
+            let ang = |i: usize| mesh.nodes[i][1].atan2(mesh.nodes[i][0]);
+            ang(a).total_cmp(&ang(b))
+        });
+        Self {
+            nodes,
+            closed: mesh.symmetry.rings_closed(),
+        }
+    }
+
+    /// The reference ring at Z = 0.
+    pub fn midspan(model: &Model) -> Self {
+        Self::at(model, 0.0)
+    }
+
+    /// The ring's segments (pairs of consecutive nodes; the closing one if closed).
+    pub fn segments(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let n = self.nodes.len();
+        let segs = if self.closed { n } else { n.saturating_sub(1) };
+        (0..segs).map(move |k| (self.nodes[k], self.nodes[(k + 1) % n]))
+    }
+
+    fn contains_set(&self) -> std::collections::HashSet<usize> {
+        self.nodes.iter().copied().collect()
+    }
 }
 
 /// Mid-span values: [`ring_state`] at Z = 0.
 pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
-    ring_state(model, state, &midspan_ring(model))
+    ring_state(model, state, &Ring::midspan(model))
 }
 
-/// The values of the module header at one ring of nodes (sorted by angle): perimeter ratio,
-/// meridian stretch of the edges leaving the ring, and resultants averaged over the Gauss
-/// points of the elements that touch it. `volume` is the total enclosed volume.
-pub fn ring_state(model: &Model, state: &State, ring: &[usize]) -> Result<MidSpan, FemError> {
-    let mesh = &model.mesh;
-    let closed = mesh.symmetry.planes().iter().all(|&ax| ax == 2); // x = 0 / y = 0 cut the ring
+/// The values of the module header at one ring of nodes: perimeter ratio, meridian stretch of
+/// the edges leaving the ring, and resultants averaged over the Gauss points of the elements
+/// that touch it. `volume` is the total enclosed volume.
+pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, FemError> {
+    let mesh = model.mesh();
     let mut cur = 0.0;
     let mut reference = 0.0;
-    let n = ring.len();
-    let segments = if closed { n } else { n.saturating_sub(1) };
-    for k in 0..segments {
-        let (a, b) = (ring[k], ring[(k + 1) % n]);
+    for (a, b) in ring.segments() {
         cur += dist(state.x[a], state.x[b]);
         reference += dist(mesh.nodes[a], mesh.nodes[b]);
     }
-    let on_ring: std::collections::HashSet<usize> = ring.iter().copied().collect();
+    let on_ring = ring.contains_set();
     let mut lz_sum = 0.0;
     let mut lz_n = 0usize;
     let (mut ns, mut nz, mut nsz, mut ng) = (0.0, 0.0, 0.0, 0usize);
-    for (e, el) in model.elements.iter().enumerate() {
+    for (e, el) in model.elements().iter().enumerate() {
         let q = el.nodes;
         if !q.iter().any(|i| on_ring.contains(i)) {
             continue;
@@ -90,35 +112,26 @@ pub fn ring_state(model: &Model, state: &State, ring: &[usize]) -> Result<MidSpa
                 lz_n += 1;
             }
         }
-        let xe = q.map(|i| state.x[i]);
+        let xe = el.gather(&state.x);
+        let x0 = el.gather(&mesh.nodes);
         for g in 0..4 {
-            let ps = point_state(model.law.as_ref(), el, g, &xe).map_err(|source| {
-                FemError::Material {
-                    element: e,
-                    gauss_point: g,
-                    source,
-                }
+            let ps = point_state(model.law(), el, g, &xe).map_err(|source| FemError::Material {
+                element: e,
+                gauss_point: g,
+                source,
             })?;
             // reference hoop direction at the Gauss point and its image F T
-            let xr = [0, 1, 2].map(|c| {
-                (0..4)
-                    .map(|a| el.n[g][a] * mesh.nodes[q[a]][c])
-                    .sum::<f64>()
-            });
-            let t_ref = unit([-xr[1], xr[0], 0.0]);
+            let xr = el.position(g, &x0);
+            let t_ref = Vec3::new(-xr[1], xr[0], 0.0).normalize();
             let f = el.gradient(g, &xe);
-            let [e1, e2] = el.frame[g];
-            let (c1, c2) = (dot(e1, t_ref), dot(e2, t_ref));
-            let ft = [0, 1, 2].map(|c| f[0][c] * c1 + f[1][c] * c2);
-            let t = unit([ft[0], ft[1], 0.0]);
-            let normal = unit(cross(f[0], f[1]));
-            let ez = [0.0, 0.0, 1.0];
-            let a = unit([0, 1, 2].map(|c| ez[c] - dot(ez, normal) * normal[c]));
-            let nt = [0, 1, 2].map(|r| dot(ps.cauchy[r], t));
-            let na = [0, 1, 2].map(|r| dot(ps.cauchy[r], a));
-            ns += dot(t, nt);
-            nz += dot(a, na);
-            nsz += dot(t, na);
+            let ft = el.push_forward(g, &f, &t_ref);
+            let t = Vec3::new(ft[0], ft[1], 0.0).normalize();
+            let normal = f[0].cross(&f[1]).normalize();
+            let ez = Vec3::z();
+            let a = (ez - normal * ez.dot(&normal)).normalize();
+            ns += t.dot(&(ps.cauchy * t));
+            nz += a.dot(&(ps.cauchy * a));
+            nsz += t.dot(&(ps.cauchy * a));
             ng += 1;
         }
     }
@@ -130,7 +143,7 @@ pub fn ring_state(model: &Model, state: &State, ring: &[usize]) -> Result<MidSpa
         n_s: ns / ng,
         n_z: nz / ng,
         n_sz: nsz / ng,
-        volume: model.multiplicity() * mesh.volume_at(&state.x),
+        volume: model.total_volume(&state.x),
     })
 }
 
@@ -147,68 +160,63 @@ pub struct CellValues {
 }
 
 impl CellValues {
-    /// 0 taut (both principal resultants positive), 1 wrinkled (N1 > 0 ≥ N2: tension in one
-    /// direction only; with the relaxed law N2 is then exactly 0), 2 slack (N1 ≤ 0: no tension).
+    /// Taut (both principal resultants positive), wrinkled (N1 > 0 ≥ N2: tension in one
+    /// direction only; with the relaxed law N2 is then exactly 0), slack (N1 ≤ 0: no tension).
     /// A tolerance of 1e-10 (|N1| + |N2|) separates "zero" from positive.
-    pub fn state(&self) -> u8 {
+    pub fn regime(&self) -> Regime {
         let tol = 1e-10 * (self.n1.abs() + self.n2.abs()) + 1e-14;
         if self.n1 <= tol {
-            2
+            Regime::Slack
         } else if self.n2 <= tol {
-            1
+            Regime::Wrinkled
         } else {
-            0
+            Regime::Taut
         }
     }
+}
 
-    /// Wrinkled or slack: the membrane carries no tension in at least one direction.
-    pub fn wrinkled(&self) -> bool {
-        self.state() != 0
+/// The VTU code of a regime: 0 taut, 1 wrinkled, 2 slack.
+pub fn regime_code(r: Regime) -> f64 {
+    match r {
+        Regime::Taut => 0.0,
+        Regime::Wrinkled => 1.0,
+        Regime::Slack => 2.0,
     }
 }
 
 /// Element values for output (VTU cell data).
 pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemError> {
-    let mesh = &model.mesh;
+    let mesh = model.mesh();
     model
-        .elements
+        .elements()
         .iter()
         .enumerate()
         .map(|(e, el)| {
-            let xe = el.nodes.map(|i| state.x[i]);
+            let xe = el.gather(&state.x);
+            let x0 = el.gather(&mesh.nodes);
             let mut c = CellValues::default();
             for g in 0..4 {
-                let ps = point_state(model.law.as_ref(), el, g, &xe).map_err(|source| {
-                    FemError::Material {
+                let ps =
+                    point_state(model.law(), el, g, &xe).map_err(|source| FemError::Material {
                         element: e,
                         gauss_point: g,
                         source,
-                    }
-                })?;
-                let xr = [0, 1, 2].map(|k| {
-                    (0..4)
-                        .map(|a| el.n[g][a] * mesh.nodes[el.nodes[a]][k])
-                        .sum::<f64>()
-                });
-                let [e1, e2] = el.frame[g];
-                let normal = cross(e1, e2);
-                let horizontal = [-xr[1], xr[0], 0.0];
-                let t = if dot(horizontal, horizontal) > 1e-20 {
-                    unit(horizontal)
+                    })?;
+                let xr = el.position(g, &x0);
+                let [e1, e2] = el.gauss[g].frame;
+                let normal = e1.cross(&e2);
+                let horizontal = Vec3::new(-xr[1], xr[0], 0.0);
+                let t = if horizontal.dot(&horizontal) > 1e-20 {
+                    horizontal.normalize()
                 } else {
                     e1
                 };
                 // project onto the reference tangent plane
-                let t = unit([0, 1, 2].map(|k| t[k] - dot(t, normal) * normal[k]));
-                let m = cross(normal, t);
+                let t = (t - normal * t.dot(&normal)).normalize();
+                let m = normal.cross(&t);
                 let f = el.gradient(g, &xe);
-                let image = |v: [f64; 3]| {
-                    let (c1, c2) = (dot(e1, v), dot(e2, v));
-                    let w = [0, 1, 2].map(|k| f[0][k] * c1 + f[1][k] * c2);
-                    dot(w, w).sqrt()
-                };
-                c.hoop_stretch += 0.25 * image(t);
-                c.axial_stretch += 0.25 * image(m);
+                c.hoop_stretch += 0.25 * el.push_forward(g, &f, &t).norm();
+                c.axial_stretch += 0.25 * el.push_forward(g, &f, &m).norm();
                 c.n1 += 0.25 * ps.principal[0];
                 c.n2 += 0.25 * ps.principal[1];
             }
@@ -218,7 +226,7 @@ pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemE
 }
 
 /// One ring of the cylinder at reference height Z: the [`ring_state`] values there.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct RingValues {
     /// reference height Z (in R)
     pub z_ref: f64,
@@ -232,7 +240,7 @@ pub struct RingValues {
 /// Profiles along the cylinder: one entry per ring of nodes at the reference radius (the
 /// cylinder and the cap equators), from the lowest Z to the highest.
 pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, FemError> {
-    let mesh = &model.mesh;
+    let mesh = model.mesh();
     let tol = 1e-9 * mesh.scale();
     let radius = mesh
         .nodes
@@ -250,12 +258,13 @@ pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, Fem
     heights
         .into_iter()
         .map(|z| {
-            let ring = ring_at(model, z);
-            let n = ring.len() as f64;
+            let ring = Ring::at(model, z);
+            let n = ring.nodes.len() as f64;
             Ok(RingValues {
                 z_ref: z,
-                z: ring.iter().map(|&i| state.x[i][2]).sum::<f64>() / n,
+                z: ring.nodes.iter().map(|&i| state.x[i][2]).sum::<f64>() / n,
                 radius: ring
+                    .nodes
                     .iter()
                     .map(|&i| state.x[i][0].hypot(state.x[i][1]))
                     .sum::<f64>()
@@ -266,8 +275,8 @@ pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, Fem
         .collect()
 }
 
-/// Mid-span contact values of a squeeze (plates y = ±h), dimensionless.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Mid-span contact values of a squeeze, dimensionless.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ContactValues {
     /// ρ = h/R
     pub rho: f64,
@@ -289,22 +298,20 @@ pub struct ContactValues {
     pub total_force: f64,
 }
 
-/// Contact at mid-span against the top plate y = h (normal −e_y).
-pub fn midspan_contact(model: &Model, state: &State, h: f64) -> ContactValues {
-    let mesh = &model.mesh;
+/// Contact at mid-span against the top plate y = h of two plates made by
+/// [`Contact::plates`]; `None` if `contact` has no such plate.
+pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Option<ContactValues> {
+    let h = contact.half_gap()?;
+    let mesh = model.mesh();
     let planes = mesh.symmetry.planes();
     let x_copies = if planes.contains(&0) { 2.0 } else { 1.0 };
     let z_copies = if planes.contains(&2) { 2.0 } else { 1.0 };
-    let kappa = model.penalty;
     let gap = |p: [f64; 3]| h - p[1];
     // contact width along the mid-span ring polygon (zero crossings interpolated linearly)
-    let ring = midspan_ring(model);
-    let closed = planes.iter().all(|&ax| ax == 2);
-    let n = ring.len();
-    let segs = if closed { n } else { n.saturating_sub(1) };
+    let ring = Ring::midspan(model);
     let mut c = 0.0;
-    for k in 0..segs {
-        let (a, b) = (state.x[ring[k]], state.x[ring[(k + 1) % n]]);
+    for (ia, ib) in ring.segments() {
+        let (a, b) = (state.x[ia], state.x[ib]);
         let (ga, gb) = (gap(a), gap(b));
         let len = dist(a, b);
         c += match (ga < 0.0, gb < 0.0) {
@@ -314,29 +321,26 @@ pub fn midspan_contact(model: &Model, state: &State, h: f64) -> ContactValues {
             _ => 0.0,
         };
     }
-    let on_ring: std::collections::HashSet<usize> = ring.iter().copied().collect();
+    let on_ring = ring.contains_set();
     // force per unit length from the element rows next to the ring, side by side
     let mut side_force = [0.0; 2];
     let mut side_extent = [(0.0, 0usize); 2];
     let (mut pc_sum, mut pc_n) = (0.0, 0usize);
     let (mut total, mut penetration) = (0.0, 0.0_f64);
-    for el in &model.elements {
-        let xe = el.nodes.map(|i| state.x[i]);
+    for el in model.elements() {
+        let xe = el.gather(&state.x);
         let touches = el.nodes.iter().any(|i| on_ring.contains(i));
         let zc = el.nodes.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0;
         let side = usize::from(zc < 0.0);
         let mut fe = 0.0;
         for g in 0..4 {
-            let p = [0, 1, 2].map(|k| (0..4).map(|a| el.n[g][a] * xe[a][k]).sum::<f64>());
-            let gp_gap = gap(p);
+            let gp_gap = gap(el.position(g, &xe).into());
             if gp_gap < 0.0 {
-                let t = crate::contact::traction(gp_gap, kappa);
-                fe += el.w[g] * t;
+                let t = contact.traction(gp_gap);
+                fe += el.gauss[g].w * t;
                 penetration = penetration.max(-gp_gap);
                 if touches {
-                    let f = el.gradient(g, &xe);
-                    let da = dot(cross(f[0], f[1]), cross(f[0], f[1])).sqrt();
-                    pc_sum += t / da;
+                    pc_sum += t / el.area_ratio(g, &xe);
                     pc_n += 1;
                 }
             }
@@ -371,7 +375,7 @@ pub fn midspan_contact(model: &Model, state: &State, h: f64) -> ContactValues {
     }
     let f_per_len = if sides > 0.0 { f_per_len / sides } else { 0.0 };
     let pi = std::f64::consts::PI;
-    ContactValues {
+    Some(ContactValues {
         rho: h,
         chi: if state.p > 0.0 {
             x_copies * f_per_len / (pi * state.p)
@@ -379,34 +383,21 @@ pub fn midspan_contact(model: &Model, state: &State, h: f64) -> ContactValues {
             0.0
         },
         chi_geometric: x_copies * c / pi,
-        force: x_copies * f_per_len / std::f64::consts::PI,
+        force: x_copies * f_per_len / pi,
         contact_pressure: if pc_n > 0 { pc_sum / pc_n as f64 } else { 0.0 },
         penetration,
         total_force: x_copies * z_copies * total,
-    }
+    })
 }
 
 /// Mean contact pressure per current area of each element (VTU cell data).
-pub fn cell_contact_pressure(
-    model: &Model,
-    state: &State,
-    planes: &[crate::contact::Plane],
-) -> Vec<f64> {
+pub fn cell_contact_pressure(model: &Model, state: &State, contact: Option<&Contact>) -> Vec<f64> {
     model
-        .elements
+        .elements()
         .iter()
-        .map(|el| {
-            let xe = el.nodes.map(|i| state.x[i]);
-            let mut s = 0.0;
-            for g in 0..4 {
-                let p = [0, 1, 2].map(|k| (0..4).map(|a| el.n[g][a] * xe[a][k]).sum::<f64>());
-                let f = el.gradient(g, &xe);
-                let da = dot(cross(f[0], f[1]), cross(f[0], f[1])).sqrt();
-                for pl in planes {
-                    s += 0.25 * crate::contact::traction(pl.gap(p), model.penalty) / da;
-                }
-            }
-            s
+        .map(|el| match contact {
+            Some(c) => c.element_pressure(el, &el.gather(&state.x)),
+            None => 0.0,
         })
         .collect()
 }

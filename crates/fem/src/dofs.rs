@@ -1,0 +1,134 @@
+//! Degrees of freedom and constraints: which nodal components are free, and their equation
+//! numbers.
+//!
+//! * Symmetry planes: the normal displacement is fixed on each symmetry plane of the mesh.
+//! * Rigid-body modes left by the symmetry are pinned on nodes whose motion the symmetry of the
+//!   problem already forbids (so the pins carry no load): u_x = u_y = 0 on the axis x = y = 0,
+//!   u_x = 0 at the node of largest y on the line x = z = 0, u_z = 0 at one node on z = 0.
+//! * Rigid plugs: the ring nodes keep x and y (tied to the disc) and share one axial equation,
+//!   the disc's translation.
+
+use tubemem_mesh::Mesh;
+
+/// The equation number of every dof (3 per node) and of every plug's axial translation.
+#[derive(Clone, Debug)]
+pub struct DofMap {
+    eq: Vec<Option<usize>>,
+    n_eq: usize,
+    plug_eq: Vec<Option<usize>>,
+}
+
+impl DofMap {
+    /// Number the dofs of a checked mesh.
+    pub fn new(mesh: &Mesh) -> Self {
+        let nn = mesh.nodes.len();
+        let mut fixed = vec![false; 3 * nn];
+        let on: Vec<Vec<bool>> = (0..3).map(|ax| mesh.on_plane(ax)).collect();
+        let planes = mesh.symmetry.planes();
+        for &ax in planes {
+            for i in 0..nn {
+                if on[ax][i] {
+                    fixed[3 * i + ax] = true;
+                }
+            }
+        }
+        // translations x, y and rotations about x, y
+        if !planes.contains(&0) || !planes.contains(&1) {
+            for i in 0..nn {
+                if on[0][i] && on[1][i] {
+                    fixed[3 * i] = true;
+                    fixed[3 * i + 1] = true;
+                }
+            }
+        }
+        // rotation about z
+        if !planes.contains(&0) && !planes.contains(&1) {
+            if let Some(i) = (0..nn)
+                .filter(|&i| on[0][i] && on[2][i])
+                .max_by(|&a, &b| mesh.nodes[a][1].total_cmp(&mesh.nodes[b][1]))
+            {
+                fixed[3 * i] = true;
+            }
+        }
+        // translation z
+        if !planes.contains(&2) {
+            if let Some(i) = (0..nn).find(|&i| on[2][i]) {
+                fixed[3 * i + 2] = true;
+            }
+        }
+        let mut plug_of = vec![None; nn];
+        for (k, ring) in mesh.plugs.iter().enumerate() {
+            for &i in ring {
+                fixed[3 * i] = true;
+                fixed[3 * i + 1] = true;
+                plug_of[i] = Some(k);
+            }
+        }
+        let mut eq = vec![None; 3 * nn];
+        let mut plug_eq = vec![None; mesh.plugs.len()];
+        let mut n_eq = 0;
+        for (d, f) in fixed.iter().enumerate() {
+            if *f {
+                continue;
+            }
+            match plug_of[d / 3] {
+                Some(k) if d % 3 == 2 => {
+                    eq[d] = Some(*plug_eq[k].get_or_insert_with(|| {
+                        n_eq += 1;
+                        n_eq - 1
+                    }));
+                }
+                _ => {
+                    eq[d] = Some(n_eq);
+                    n_eq += 1;
+                }
+            }
+        }
+        Self { eq, n_eq, plug_eq }
+    }
+
+    /// The number of equations.
+    pub fn len(&self) -> usize {
+        self.n_eq
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.n_eq == 0
+    }
+
+    /// The equation of component `component` of node `node`, `None` where it is fixed.
+    pub fn eq(&self, node: usize, component: usize) -> Option<usize> {
+        self.eq[3 * node + component]
+    }
+
+    /// The equation of dof `d` = 3·node + component.
+    pub fn eq_of_dof(&self, d: usize) -> Option<usize> {
+        self.eq[d]
+    }
+
+    /// The axial equation of each plug.
+    pub fn plug_equations(&self) -> &[Option<usize>] {
+        &self.plug_eq
+    }
+
+    /// x ← x + t·dx on the free dofs.
+    pub fn apply(&self, x: &mut [[f64; 3]], dx: &[f64], t: f64) {
+        for (d, e) in self.eq.iter().enumerate() {
+            if let Some(k) = e {
+                x[d / 3][d % 3] += t * dx[*k];
+            }
+        }
+    }
+
+    /// The largest nodal displacement of an increment dx.
+    pub fn max_nodal_norm(&self, dx: &[f64]) -> f64 {
+        (0..self.eq.len() / 3)
+            .map(|i| {
+                (0..3)
+                    .map(|k| self.eq[3 * i + k].map_or(0.0, |e| dx[e] * dx[e]))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+    }
+}

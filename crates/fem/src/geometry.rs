@@ -1,0 +1,136 @@
+//! Gauss-point geometry of the 4-node element: the one owner of shape-function values, reference
+//! derivatives, area weights, the local reference frame, and of the current position, in-plane
+//! deformation gradient and area ratio at a Gauss point.
+//!
+//! ```text
+//! Reference frame at a Gauss point: e1 = G1/|G1|, e3 = G1×G2/|G1×G2|, e2 = e3 × e1,
+//! J_iα = e_i·G_α (2×2), ∂N_a/∂X_i = Σ_α ∂N_a/∂ξ_α (J⁻¹)_αi, dA0 = det J dξdη.
+//! position       x(ξ) = Σ_a N_a x_a
+//! gradient       f_i = Σ_a x_a ∂N_a/∂X_i          (3-vectors, i = 1, 2)
+//! area ratio     J = da/dA0 = |f_1 × f_2|
+//! ```
+//! Node numbering of a quad (counter-clockwise seen from outside, so that G1 × G2 points out):
+//! ```text
+//!  3 ───── 2
+//!  │       │
+//!  0 ───── 1
+//! ```
+
+use crate::FemError;
+use nalgebra::{Matrix2, Vector3};
+use tubemem_mesh::{shape, GAUSS2};
+
+/// A 3-vector.
+pub type Vec3 = Vector3<f64>;
+
+/// Reference data at one Gauss point.
+#[derive(Clone, Debug)]
+pub struct GaussPoint {
+    /// shape-function values N_a
+    pub n: [f64; 4],
+    /// ∂N_a/∂X_i in the local orthonormal reference frame
+    pub dn: [[f64; 2]; 4],
+    /// reference area weight dA0
+    pub w: f64,
+    /// the local orthonormal reference frame (e1, e2)
+    pub frame: [Vec3; 2],
+}
+
+/// Reference data of one element at its four Gauss points.
+#[derive(Clone, Debug)]
+pub struct RefElement {
+    pub nodes: [usize; 4],
+    pub gauss: [GaussPoint; 4],
+}
+
+impl RefElement {
+    /// The reference geometry of element `id` with nodes `nodes` at reference positions `x`.
+    pub fn new(id: usize, nodes: [usize; 4], x: &[[f64; 3]; 4]) -> Result<Self, FemError> {
+        let xv = x.map(Vec3::from);
+        let mut gauss = Vec::with_capacity(4);
+        for (g, &(xi, eta)) in GAUSS2.iter().enumerate() {
+            let (n, d) = shape(xi, eta);
+            let mut g1 = Vec3::zeros();
+            let mut g2 = Vec3::zeros();
+            for a in 0..4 {
+                g1 += xv[a] * d[a][0];
+                g2 += xv[a] * d[a][1];
+            }
+            let n3 = g1.cross(&g2);
+            let area = n3.norm();
+            if !(area > 1e-14 * g1.norm() * g2.norm()) {
+                return Err(FemError::DegenerateElement {
+                    element: id,
+                    gauss_point: g,
+                });
+            }
+            let e1 = g1 / g1.norm();
+            let e3 = n3 / area;
+            let e2 = e3.cross(&e1);
+            let j = Matrix2::new(e1.dot(&g1), e1.dot(&g2), e2.dot(&g1), e2.dot(&g2));
+            let det = j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)];
+            let inv = Matrix2::new(
+                j[(1, 1)] / det,
+                -j[(0, 1)] / det,
+                -j[(1, 0)] / det,
+                j[(0, 0)] / det,
+            );
+            let mut dn = [[0.0; 2]; 4];
+            for a in 0..4 {
+                for i in 0..2 {
+                    dn[a][i] = d[a][0] * inv[(0, i)] + d[a][1] * inv[(1, i)];
+                }
+            }
+            gauss.push(GaussPoint {
+                n,
+                dn,
+                w: det,
+                frame: [e1, e2],
+            });
+        }
+        let gauss: [GaussPoint; 4] = gauss.try_into().map_err(|_| FemError::DegenerateElement {
+            element: id,
+            gauss_point: 0,
+        })?;
+        Ok(Self { nodes, gauss })
+    }
+
+    /// The element's nodal positions taken from the global array `x`.
+    pub fn gather(&self, x: &[[f64; 3]]) -> [Vec3; 4] {
+        self.nodes.map(|i| Vec3::from(x[i]))
+    }
+
+    /// x at Gauss point `g`.
+    pub fn position(&self, g: usize, xe: &[Vec3; 4]) -> Vec3 {
+        let n = &self.gauss[g].n;
+        let mut p = Vec3::zeros();
+        for a in 0..4 {
+            p += xe[a] * n[a];
+        }
+        p
+    }
+
+    /// The in-plane deformation gradient columns f_1, f_2 at Gauss point `g`.
+    pub fn gradient(&self, g: usize, xe: &[Vec3; 4]) -> [Vec3; 2] {
+        let dn = &self.gauss[g].dn;
+        let mut f = [Vec3::zeros(); 2];
+        for a in 0..4 {
+            for i in 0..2 {
+                f[i] += xe[a] * dn[a][i];
+            }
+        }
+        f
+    }
+
+    /// The area ratio J = da/dA0 = |f_1 × f_2| at Gauss point `g`.
+    pub fn area_ratio(&self, g: usize, xe: &[Vec3; 4]) -> f64 {
+        let f = self.gradient(g, xe);
+        f[0].cross(&f[1]).norm()
+    }
+
+    /// The image F v of a vector v of the reference tangent plane at Gauss point `g`.
+    pub fn push_forward(&self, g: usize, f: &[Vec3; 2], v: &Vec3) -> Vec3 {
+        let [e1, e2] = &self.gauss[g].frame;
+        f[0] * e1.dot(v) + f[1] * e2.dot(v)
+    }
+}

@@ -1,0 +1,379 @@
+//! A damped Newton driver that knows nothing of membranes.
+//!
+//! A [`Problem`] linearizes itself at a state (residual measure, convergence test, Newton
+//! correction) and evaluates trial states; the driver caps the step length, backtracks, and
+//! returns a typed report with the residual history, or a typed error.
+//!
+//! ```text
+//! for it = 0, 1, …, max_iterations:
+//!     lin = problem.linearize(x)               (assembly, factorization, correction dx)
+//!     if lin.converged: return
+//!     t = min(1, max_step / |dx|_node)          (step cap)
+//!     repeat up to `backtracks` times:          (line search on x + t dx)
+//!         accept if the problem is bordered (full steps), or the residual fell, or the
+//!         potential fell by Armijo's rule Π(x + t dx) ≤ Π(x) + c t Rᵀdx, or t < min_fraction
+//!         t ← t/2
+//! ```
+
+use std::fmt;
+
+/// The driver's settings. Every number the iteration uses is here, named.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// converged when the problem's scaled residual is at most `rtol`
+    pub rtol: f64,
+    pub max_iterations: usize,
+    /// the largest nodal displacement per iteration (in R); longer corrections are scaled down
+    pub max_step: f64,
+    /// halvings of the step in one line search before the iteration gives up
+    pub backtracks: usize,
+    /// Armijo's sufficient-decrease constant c
+    pub armijo: f64,
+    /// a step fraction below which the trial is taken whatever it gives
+    pub min_fraction: f64,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-9,
+            max_iterations: 30,
+            max_step: 0.25,
+            backtracks: 8,
+            armijo: 1e-4,
+            min_fraction: 1e-3,
+        }
+    }
+}
+
+/// What the problem reports at the linearization point.
+pub struct Linearization<S> {
+    /// the scaled residual tested against `rtol`
+    pub residual: f64,
+    /// the residual plus the scaled constraint violation (reported on failure)
+    pub merit: f64,
+    pub converged: bool,
+    /// the Newton correction
+    pub step: S,
+    /// the total potential Π at the point (for the Armijo test)
+    pub potential: f64,
+    /// Rᵀ·step, the potential's slope along the correction
+    pub slope: f64,
+    /// bordered (constrained) problems accept full steps: the merit mixes R and c
+    pub bordered: bool,
+    /// the problem-specific inertia data of the operator solved
+    pub inertia: Inertia,
+}
+
+/// The stability data of the factorized operator.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Inertia {
+    /// negative eigenvalues of the operator actually solved
+    pub negative_pivots: usize,
+    /// the diagonal shift that had to be added to factorize (0 in regular states)
+    pub shift: f64,
+}
+
+/// A trial state's residual and potential.
+pub struct Evaluation {
+    pub residual: f64,
+    pub potential: f64,
+}
+
+/// A nonlinear problem the driver can solve.
+pub trait Problem {
+    type State: Clone;
+    type Step;
+    type Error;
+    /// Linearize at `state` (which the problem may update, e.g. a pressure that follows from it).
+    fn linearize(
+        &mut self,
+        state: &mut Self::State,
+    ) -> Result<Linearization<Self::Step>, Self::Error>;
+    /// Evaluate a trial state without the tangent.
+    fn evaluate(&self, state: &Self::State) -> Result<Evaluation, Self::Error>;
+    /// `state` ← `base` + t·`step`.
+    fn update(&self, base: &Self::State, step: &Self::Step, t: f64, state: &mut Self::State);
+    /// The step's largest nodal displacement (for the step cap).
+    fn step_size(&self, step: &Self::Step) -> f64;
+    /// Whether every entry of the step is finite.
+    fn step_is_finite(&self, step: &Self::Step) -> bool;
+}
+
+/// A converged solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewtonReport {
+    pub iterations: usize,
+    pub residual: f64,
+    /// the scaled residual (merit) at every linearization
+    pub history: Vec<f64>,
+    pub inertia: Inertia,
+}
+
+/// Why a solve failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NewtonError<E> {
+    /// the problem could not be linearized or evaluated (assembly, factorization)
+    Problem { iteration: usize, source: E },
+    /// the correction has non-finite entries
+    NonFinite { iteration: usize, history: Vec<f64> },
+    /// no step length along the correction reduced the residual or the potential;
+    /// `rejected` is why the last trial state that could not even be evaluated failed (e.g. a
+    /// stretch beyond the law's locking limit)
+    NoDescent {
+        iteration: usize,
+        history: Vec<f64>,
+        rejected: Option<Box<E>>,
+    },
+    /// the iteration limit was reached; `rejected` as for `NoDescent`, from any line search
+    NoConvergence {
+        iterations: usize,
+        tolerance: f64,
+        history: Vec<f64>,
+        rejected: Option<Box<E>>,
+    },
+}
+
+impl<E> NewtonError<E> {
+    /// The residual history up to the failure.
+    pub fn history(&self) -> &[f64] {
+        match self {
+            NewtonError::Problem { .. } => &[],
+            NewtonError::NonFinite { history, .. }
+            | NewtonError::NoDescent { history, .. }
+            | NewtonError::NoConvergence { history, .. } => history,
+        }
+    }
+
+    /// The last residual, if any was computed.
+    pub fn last_residual(&self) -> Option<f64> {
+        self.history().last().copied()
+    }
+
+    /// The problem's own error behind this one: the failed linearization, or the last trial
+    /// state that could not be evaluated.
+    pub fn cause(&self) -> Option<&E> {
+        match self {
+            NewtonError::Problem { source, .. } => Some(source),
+            NewtonError::NoDescent { rejected, .. }
+            | NewtonError::NoConvergence { rejected, .. } => rejected.as_deref(),
+            NewtonError::NonFinite { .. } => None,
+        }
+    }
+}
+
+/// The residual history, the first three and the last five when it is longer than ten.
+fn fmt_history(h: &[f64]) -> String {
+    let f = |r: &f64| format!("{r:.2e}");
+    if h.len() <= 10 {
+        h.iter().map(f).collect::<Vec<_>>().join(", ")
+    } else {
+        let head: Vec<String> = h[..3].iter().map(f).collect();
+        let tail: Vec<String> = h[h.len() - 5..].iter().map(f).collect();
+        format!("{}, …, {}", head.join(", "), tail.join(", "))
+    }
+}
+
+impl<E: fmt::Display> fmt::Display for NewtonError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            NewtonError::Problem { iteration, .. } => {
+                write!(f, "Newton iteration {iteration}")
+            }
+            NewtonError::NonFinite { iteration, .. } => write!(
+                f,
+                "Newton iteration {iteration}: the correction is not finite (singular tangent)"
+            ),
+            NewtonError::NoDescent {
+                iteration,
+                history,
+                rejected,
+            } => write!(
+                f,
+                "Newton iteration {iteration}: no step length reduces the residual or the potential (residuals {}){}",
+                fmt_history(history),
+                if rejected.is_some() { "; a trial state was rejected" } else { "" }
+            ),
+            NewtonError::NoConvergence {
+                iterations,
+                tolerance,
+                history,
+                rejected,
+            } => write!(
+                f,
+                "Newton did not converge in {iterations} iterations (residual {:.3e}, tolerance {tolerance:.1e}; residuals {}){}",
+                history.last().copied().unwrap_or(f64::NAN),
+                fmt_history(history),
+                if rejected.is_some() { "; a trial state was rejected" } else { "" }
+            ),
+        }
+    }
+}
+
+impl<E: std::error::Error + 'static> std::error::Error for NewtonError<E> {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.cause()
+            .map(|e| e as &(dyn std::error::Error + 'static))
+    }
+}
+
+/// Solve `problem` from `state`; on success `state` is the converged state, on failure it is
+/// the last accepted iterate.
+pub fn solve<P: Problem>(
+    problem: &mut P,
+    state: &mut P::State,
+    settings: &NewtonSettings,
+) -> Result<NewtonReport, NewtonError<P::Error>> {
+    let mut history = Vec::new();
+    let mut rejected = None;
+    for it in 0..=settings.max_iterations {
+        let lin = problem
+            .linearize(state)
+            .map_err(|source| NewtonError::Problem {
+                iteration: it,
+                source,
+            })?;
+        history.push(lin.merit);
+        if lin.converged {
+            return Ok(NewtonReport {
+                iterations: it,
+                residual: lin.residual,
+                history,
+                inertia: lin.inertia,
+            });
+        }
+        if it == settings.max_iterations {
+            break;
+        }
+        let size = problem.step_size(&lin.step);
+        let mut t = if size > settings.max_step {
+            settings.max_step / size
+        } else {
+            1.0
+        };
+        if !problem.step_is_finite(&lin.step) {
+            return Err(NewtonError::NonFinite {
+                iteration: it,
+                history,
+            });
+        }
+        let base = state.clone();
+        let armijo = |t: f64| lin.potential + settings.armijo * t * lin.slope;
+        let mut accepted = false;
+        for _ in 0..settings.backtracks {
+            problem.update(&base, &lin.step, t, state);
+            match problem.evaluate(state) {
+                Ok(trial) => {
+                    if lin.bordered
+                        || trial.residual < lin.residual
+                        || trial.potential < armijo(t)
+                        || t < settings.min_fraction
+                    {
+                        accepted = true;
+                        break;
+                    }
+                }
+                Err(e) => rejected = Some(Box::new(e)),
+            }
+            t *= 0.5;
+        }
+        if !accepted {
+            *state = base;
+            return Err(NewtonError::NoDescent {
+                iteration: it,
+                history,
+                rejected,
+            });
+        }
+    }
+    Err(NewtonError::NoConvergence {
+        iterations: settings.max_iterations,
+        tolerance: settings.rtol,
+        history,
+        rejected,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f(x) = x³ − 2 (root 2^(1/3)), Π = x⁴/4 − 2x: the driver converges quadratically and
+    /// records its history; a problem whose linearization fails reports the failure with its
+    /// iteration, and a problem with too few iterations reports no convergence.
+    struct Cubic {
+        fail_at: Option<f64>,
+    }
+    impl Problem for Cubic {
+        type State = f64;
+        type Step = f64;
+        type Error = String;
+        fn linearize(&mut self, x: &mut f64) -> Result<Linearization<f64>, String> {
+            if let Some(limit) = self.fail_at {
+                if *x > limit {
+                    return Err(format!("x = {x} beyond {limit}"));
+                }
+            }
+            let r = *x * *x * *x - 2.0;
+            let step = -r / (3.0 * *x * *x);
+            Ok(Linearization {
+                residual: r.abs() / 2.0,
+                merit: r.abs() / 2.0,
+                converged: r.abs() / 2.0 <= 1e-14,
+                step,
+                potential: x.powi(4) / 4.0 - 2.0 * *x,
+                slope: r * step,
+                bordered: false,
+                inertia: Inertia::default(),
+            })
+        }
+        fn evaluate(&self, x: &f64) -> Result<Evaluation, String> {
+            Ok(Evaluation {
+                residual: (x.powi(3) - 2.0).abs() / 2.0,
+                potential: x.powi(4) / 4.0 - 2.0 * x,
+            })
+        }
+        fn update(&self, base: &f64, step: &f64, t: f64, x: &mut f64) {
+            *x = base + t * step;
+        }
+        fn step_size(&self, step: &f64) -> f64 {
+            step.abs()
+        }
+        fn step_is_finite(&self, step: &f64) -> bool {
+            step.is_finite()
+        }
+    }
+
+    #[test]
+    fn newton_driver_converges_and_reports_failures() {
+        let settings = NewtonSettings {
+            max_step: 10.0,
+            ..Default::default()
+        };
+        let mut x = 1.0;
+        let rep = solve(&mut Cubic { fail_at: None }, &mut x, &settings).unwrap();
+        assert!((x - 2f64.cbrt()).abs() < 1e-14);
+        assert_eq!(rep.history.len(), rep.iterations + 1);
+        // quadratic convergence: each residual at most ~ the square of the previous one (×10)
+        let h = &rep.history;
+        assert!(h[h.len() - 2] <= 10.0 * h[h.len() - 3].powi(2));
+
+        let mut x = 1.0;
+        let err = solve(&mut Cubic { fail_at: Some(1.1) }, &mut x, &settings).unwrap_err();
+        assert!(
+            matches!(err, NewtonError::Problem { iteration: 1, .. }),
+            "{err:?}"
+        );
+
+        let few = NewtonSettings {
+            max_iterations: 2,
+            ..settings
+        };
+        let mut x = 1.0;
+        let err = solve(&mut Cubic { fail_at: None }, &mut x, &few).unwrap_err();
+        match err {
+            NewtonError::NoConvergence { history, .. } => assert_eq!(history.len(), 3),
+            e => panic!("{e:?}"),
+        }
+    }
+}

@@ -1,0 +1,74 @@
+//! The sparsity pattern of the global tangent, built once per mesh: for every element, the
+//! positions of its 12 × 12 entries in the lower triangle of the global matrix (in pattern
+//! order), and the position of every diagonal entry (for shifts).
+
+use crate::dofs::DofMap;
+use crate::geometry::RefElement;
+
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    /// per element: (local row, local col) of each entry it contributes, in pattern order
+    entries: Vec<Vec<(u8, u8)>>,
+    /// (row, col) of every entry, row ≥ col, in the order values are given
+    pairs: Vec<(usize, usize)>,
+    /// the position in `pairs` of one entry of each diagonal
+    diag: Vec<usize>,
+}
+
+impl Pattern {
+    pub fn new(dofs: &DofMap, elements: &[RefElement]) -> Self {
+        let mut entries = Vec::with_capacity(elements.len());
+        let mut pairs = Vec::new();
+        let mut diag = vec![usize::MAX; dofs.len()];
+        for el in elements {
+            let mut list = Vec::new();
+            for i in 0..12 {
+                for j in 0..12 {
+                    if let (Some(a), Some(b)) = (
+                        dofs.eq(el.nodes[i / 3], i % 3),
+                        dofs.eq(el.nodes[j / 3], j % 3),
+                    ) {
+                        if a >= b {
+                            if a == b && diag[a] == usize::MAX {
+                                diag[a] = pairs.len();
+                            }
+                            pairs.push((a, b));
+                            list.push((i as u8, j as u8));
+                        }
+                    }
+                }
+            }
+            entries.push(list);
+        }
+        Self {
+            entries,
+            pairs,
+            diag,
+        }
+    }
+
+    /// The local (row, col) entries of element `e`, in pattern order.
+    pub fn element_entries(&self, e: usize) -> &[(u8, u8)] {
+        &self.entries[e]
+    }
+
+    /// Every (row, col) of the lower triangle, one per value, duplicates included.
+    pub fn pairs(&self) -> &[(usize, usize)] {
+        &self.pairs
+    }
+
+    /// The number of values.
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+
+    /// The value positions of the diagonal entries (one each; `usize::MAX` for an equation that
+    /// no element reaches, which [`crate::model::Model::new`] rejects).
+    pub fn diagonal(&self) -> &[usize] {
+        &self.diag
+    }
+}

@@ -1,0 +1,185 @@
+//! Load stepping: a stage moves a scalar load parameter from `from` to `to` through
+//! [`Model::solve`], with step cut-back on failure and growth after easy steps.
+//!
+//! ```text
+//! Δλ₀ = 1/initial_steps;  on success: λ ← λ + Δλ, and Δλ ← min(growth·Δλ, max_fraction) when
+//! the step took ≤ easy_iterations; on failure: Δλ ← Δλ/2 (at most max_cuts times per stage).
+//! ```
+
+use crate::model::{Load, Loading, Model, State};
+use crate::newton::NewtonReport;
+use crate::FemError;
+
+/// The stepping settings. Every number the stepping uses is here, named.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSettings {
+    /// initial number of steps over the stage
+    pub initial_steps: usize,
+    /// cut-backs allowed in a stage before it fails
+    pub max_cuts: usize,
+    /// step growth factor after an easy step
+    pub growth: f64,
+    /// a step is easy when Newton took at most this many iterations
+    pub easy_iterations: usize,
+    /// the largest step as a fraction of the stage
+    pub max_fraction: f64,
+    /// the pre-stress pressure ϖ taken out of a stress-free state before a bordered or
+    /// gas-controlled stage (a hoop strain of about 0.25 % at ϖ = 0.01), halved on failure…
+    pub prestress: f64,
+    /// … down to this value
+    pub min_prestress: f64,
+}
+
+impl Default for StepSettings {
+    fn default() -> Self {
+        Self {
+            initial_steps: 8,
+            max_cuts: 12,
+            growth: 1.5,
+            easy_iterations: 5,
+            max_fraction: 0.25,
+            prestress: 0.01,
+            min_prestress: 1e-6,
+        }
+    }
+}
+
+/// One stage of a run: its number (for messages), the load parameter at its start and end.
+pub struct Stage {
+    pub index: usize,
+    pub from: f64,
+    pub to: f64,
+    pub settings: StepSettings,
+}
+
+/// A converged step as the stepping reports it to its caller.
+pub struct StepInfo<'a> {
+    pub step: usize,
+    /// the load parameter
+    pub value: f64,
+    /// the fraction of the stage done
+    pub fraction: f64,
+    pub load: &'a Load,
+    pub newton: &'a NewtonReport,
+}
+
+/// Run one stage: the load parameter moves linearly from `stage.from` to `stage.to` (the load
+/// built by `load(value)`). `on_step(model, state, info)` is called for every converged step, so
+/// results can be written as the run goes; an error of the callback stops the stage.
+///
+/// A stress-free membrane has no stiffness against inextensional modes, and a bordered or gas
+/// control amplifies them: from an unloaded state, first take a small pressure-controlled step
+/// ([`StepSettings::prestress`]), which converges from the reference and gives the membrane its
+/// geometric stiffness.
+pub fn run_stage<E>(
+    model: &mut Model,
+    state: &mut State,
+    stage: &Stage,
+    load: impl Fn(f64) -> Load,
+    mut on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
+) -> Result<(), StageError<E>> {
+    let (from, to) = (stage.from, stage.to);
+    let set = &stage.settings;
+    if state.p == 0.0 && !matches!(load(from).loading, Loading::Pressure(_)) {
+        let mut p0 = set.prestress;
+        loop {
+            let mut trial = state.clone();
+            match model.solve(&mut trial, &Load::pressure(p0)) {
+                Ok(_) => {
+                    *state = trial;
+                    break;
+                }
+                Err(e) => {
+                    p0 *= 0.5;
+                    if p0 < set.min_prestress {
+                        return Err(StageError::Solve(FemError::Stage {
+                            stage: stage.index,
+                            step: 0,
+                            value: p0,
+                            cuts: 0,
+                            material: None,
+                            near_locking: None,
+                            source: Box::new(e),
+                        }));
+                    }
+                }
+            }
+        }
+    }
+    let mut lambda = 0.0;
+    let mut dl = 1.0 / set.initial_steps.max(1) as f64;
+    let mut step = 0;
+    let mut cuts = 0;
+    // the last material error that rejected an attempt at the current step
+    let mut material: Option<FemError> = None;
+    while lambda < 1.0 {
+        // snap to the end when within rounding of it (no zero-length last step)
+        let next = if lambda + dl >= 1.0 - 1e-9 {
+            1.0
+        } else {
+            lambda + dl
+        };
+        let value = from + (to - from) * next;
+        let mut trial = state.clone();
+        let l = load(value);
+        match model.solve(&mut trial, &l) {
+            Ok(report) => {
+                material = None;
+                step += 1;
+                lambda = next;
+                *state = trial;
+                let info = StepInfo {
+                    step,
+                    value,
+                    fraction: next,
+                    load: &l,
+                    newton: &report,
+                };
+                on_step(model, state, &info).map_err(|source| StageError::Observer {
+                    stage: stage.index,
+                    step,
+                    source,
+                })?;
+                if report.iterations <= set.easy_iterations {
+                    dl = (dl * set.growth).min(set.max_fraction);
+                }
+            }
+            Err(e) => {
+                if let Some(m) = e.cause().filter(|c| c.material_cause().is_some()) {
+                    material = Some(m.clone());
+                }
+                cuts += 1;
+                dl *= 0.5;
+                if cuts > set.max_cuts {
+                    let own = e.cause().is_some_and(|c| c.material_cause().is_some());
+                    let near_locking = model
+                        .locking_proximity(&state.x)
+                        .filter(|l| l.fraction() >= crate::model::NEAR_LOCKING);
+                    return Err(StageError::Solve(FemError::Stage {
+                        stage: stage.index,
+                        step: step + 1,
+                        value,
+                        cuts: cuts - 1,
+                        material: if own { None } else { material.map(Box::new) },
+                        near_locking,
+                        source: Box::new(e),
+                    }));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Why a stage stopped.
+#[derive(Debug)]
+pub enum StageError<E> {
+    /// the solve failed (a [`FemError::Stage`] naming stage, step and load)
+    Solve(FemError),
+    /// the step callback failed (e.g. writing the results)
+    Observer {
+        stage: usize,
+        step: usize,
+        source: E,
+    },
+}
