@@ -1,0 +1,10 @@
+//! Cross-crate verification: the 3D membrane FE (`tubemem-fem`) against the closed form
+//! (`tubemem-gps`, the paper's equations) and against analytic solutions. One test binary; each
+//! module opens with the source of truth of its tests.
+//!
+//! The reference paper: S. Lopez-Pamies-style GPS analysis of pressurized membranes as cited in
+//! the README ("References"); equation numbers below are the paper's.
+
+mod sphere;
+mod squeeze;
+mod tube;
