@@ -1,15 +1,22 @@
 //! `tubemem gps …` and the default job.
 use crate::material_args::MaterialArgs;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use serde::Serialize;
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use tubemem_gps::limits::{limit_points, Limits};
-use tubemem_gps::{
-    flatten, flattening_curve, inflate, inflation_curve, FlatteningState, Hypothesis,
-    InflationState,
+use std::path::PathBuf;
+use tubemem_app::curves::{
+    flattening_values, inflation_values, FLATTENING_HEADER, INFLATION_HEADER,
 };
+use tubemem_gps::limits::{limit_points, Limits};
+use tubemem_gps::{flatten, flattening_curve, inflate, inflation_curve, Hypothesis};
+
+fn write_csv(
+    path: &std::path::Path,
+    header: &str,
+    rows: impl Iterator<Item = Vec<f64>>,
+) -> Result<()> {
+    tubemem_app::curves::write_csv(path, header, rows).map_err(|e| anyhow::anyhow!(e.chain()))
+}
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
 pub enum Hyp {
@@ -109,47 +116,6 @@ fn ensure_finite(values: &[f64]) -> Result<()> {
     } else {
         bail!("internal error: a non-finite value was computed ({values:?}); please report this input")
     }
-}
-
-pub fn inflation_values(s: &InflationState) -> Vec<f64> {
-    vec![s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z]
-}
-pub fn flattening_values(s: &FlatteningState) -> Vec<f64> {
-    vec![
-        s.w,
-        s.lambda_s,
-        s.lambda_z,
-        s.n_s,
-        s.n_z,
-        s.rho,
-        s.chi,
-        s.force,
-        s.displacement,
-    ]
-}
-pub const INFLATION_HEADER: &str = "w,lambda_s,lambda_z,n_s,n_z";
-pub const FLATTENING_HEADER: &str = "w,lambda_s,lambda_z,n_s,n_z,rho,chi,force,displacement";
-
-/// Write rows of numbers as CSV (shortest round-trip representation).
-pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create folder {}", dir.display()))?;
-    }
-    let mut out = String::with_capacity(1 << 16);
-    out.push_str(header);
-    out.push('\n');
-    for row in rows {
-        ensure_finite(&row)?;
-        let line: Vec<String> = row.iter().map(|v| v.to_string()).collect();
-        out.push_str(&line.join(","));
-        out.push('\n');
-    }
-    let mut f =
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    f.write_all(out.as_bytes())
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
 }
 
 fn print_state<T: Serialize>(state: &T, json: bool) -> Result<()> {

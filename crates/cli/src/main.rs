@@ -3,11 +3,16 @@
 //! With no arguments it runs the main job (`main_job`): the paper's example in 3D on the
 //! embedded default case, against GPS and PS, and the figures, written to `tubemem-out/`.
 
+use anyhow::Context;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use tubemem_cli::{figures, gps_cmd, main_job, run_cmd};
+use tubemem_app::case::Case;
+use tubemem_app::output::RunWriter;
+use tubemem_app::run::Observer;
+use tubemem_cli::console::Console;
+use tubemem_cli::gps_cmd;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -50,13 +55,59 @@ enum Command {
     },
 }
 
+/// An application error as an `anyhow` chain (its causes kept).
+fn app(e: tubemem_app::AppError) -> anyhow::Error {
+    anyhow::Error::new(e)
+}
+
+fn main_job() -> Result<()> {
+    println!("tubemem — the paper's example (Anssari-Benam–Bucchi membrane, 𝒩 = 30; ϖ = pR/μH)\n");
+    let mut console = Console::default();
+    let job =
+        tubemem_app::main_job::run_main_job(&PathBuf::from("tubemem-out"), &mut [&mut console])
+            .map_err(app)?;
+    println!("\n{}\n", job.limits_text());
+    println!("{}", job.table());
+    for p in &job.figures {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn run_case(case_path: &std::path::Path, out: &std::path::Path) -> Result<()> {
+    let case = Case::read(case_path).map_err(|e| app(e.into()))?;
+    let mut writer = RunWriter::new(out);
+    let mut console = Console::default();
+    let outcome = tubemem_app::run::run(
+        &case,
+        &case_path.display().to_string(),
+        &mut [&mut writer as &mut dyn Observer, &mut console],
+    );
+    match outcome.error {
+        None => {
+            println!(
+                "wrote {}/steps.csv, summary.json, profiles/, tube.pvd ({} VTU frames)",
+                out.display(),
+                writer.frames()
+            );
+            Ok(())
+        }
+        Some(e) => Err(app(e)).with_context(|| {
+            format!(
+                "the run stopped; its converged steps are in {}",
+                out.display()
+            )
+        }),
+    }
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => main_job::run(&PathBuf::from("tubemem-out")),
+        None => main_job(),
         Some(Command::Gps { command }) => gps_cmd::run(command),
-        Some(Command::Run { case, out }) => run_cmd::run(&case, &out),
+        Some(Command::Run { case, out }) => run_case(&case, &out),
         Some(Command::Figures { out, kuhn, overlay }) => {
-            let written = figures::write_all(&out, kuhn, &overlay)?;
+            let written = tubemem_app::figures::write_all(&out, kuhn, &overlay).map_err(app)?;
             for p in written {
                 println!("wrote {}", p.display());
             }

@@ -213,28 +213,44 @@ fn resultants(l1: f64, l2: f64, material: Option<&Bound<'_, PyAny>>) -> PyResult
     Ok((n1, n2))
 }
 
-fn read_summary<'py>(py: Python<'py>, out: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
-    let text = std::fs::read_to_string(out.join("summary.json")).map_err(|e| {
-        TubememError::new_err(format!(
-            "cannot read {}: {e}",
-            out.join("summary.json").display()
-        ))
-    })?;
-    py.import("json")?.call_method1("loads", (text,))
+/// A run's outcome as Python: the summary dict (summary.json's content, from the typed report,
+/// not read back from disk), or `TubememError` with the whole cause chain.
+fn run_outcome<'py>(
+    py: Python<'py>,
+    outcome: tubemem_app::run::RunOutcome,
+    out: &std::path::Path,
+) -> PyResult<Bound<'py, PyAny>> {
+    match outcome.error {
+        None => to_py(py, &outcome.report.summary()),
+        Some(e) => Err(TubememError::new_err(format!(
+            "{}; the converged steps are in {}",
+            e.chain(),
+            out.display()
+        ))),
+    }
 }
 
-fn run_err(e: anyhow::Error) -> PyErr {
-    TubememError::new_err(format!("{e:#}"))
+fn run_parsed<'py>(
+    py: Python<'py>,
+    case: &tubemem_app::case::Case,
+    label: &str,
+    out: &std::path::Path,
+) -> PyResult<Bound<'py, PyAny>> {
+    let outcome = py.detach(|| {
+        let mut writer = tubemem_app::output::RunWriter::new(out);
+        tubemem_app::run::run(case, label, &mut [&mut writer])
+    });
+    run_outcome(py, outcome, out)
 }
 
 /// Run a case file (TOML, as for `tubemem run`), writing steps.csv, summary.json, profiles/ and
-/// the VTU series to `out`; returns summary.json as a dict. On failure the converged steps are
-/// already in `out` and `TubememError` says which stage, step and residual.
+/// the VTU series to `out`; returns the summary as a dict. On failure the converged steps are
+/// already in `out` and `TubememError` says which stage, step and residual, and why.
 #[pyfunction]
 fn run_case<'py>(py: Python<'py>, case: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyAny>> {
-    py.detach(|| tubemem_cli::run_cmd::run(&case, &out))
-        .map_err(run_err)?;
-    read_summary(py, &out)
+    let parsed = tubemem_app::case::Case::read(&case)
+        .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
+    run_parsed(py, &parsed, &case.display().to_string(), &out)
 }
 
 /// Run a case given as TOML text (user mesh files are looked up relative to `base_dir`); as
@@ -247,18 +263,20 @@ fn run_case_text<'py>(
     out: PathBuf,
     base_dir: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let mut case = tubemem_cli::case::Case::parse(text)
-        .map_err(|e| PyValueError::new_err(format!("in the case text: {e:#}")))?;
+    let mut case = tubemem_app::case::Case::parse(text).map_err(|e| {
+        PyValueError::new_err(format!(
+            "in the case text: {}",
+            tubemem_app::error_chain(&e)
+        ))
+    })?;
     case.base_dir = base_dir.unwrap_or_default();
-    py.detach(|| tubemem_cli::run_cmd::run_case(&case, "case text from Python", &out))
-        .map_err(run_err)?;
-    read_summary(py, &out)
+    run_parsed(py, &case, "case text from Python", &out)
 }
 
 /// The embedded default case (`cases/squeeze_abb30_ls1.3.toml`, the main job's) as TOML text.
 #[pyfunction]
 fn default_case() -> &'static str {
-    tubemem_cli::main_job::DEFAULT_CASE
+    tubemem_app::main_job::DEFAULT_CASE
 }
 
 #[pymodule]

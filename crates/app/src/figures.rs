@@ -5,10 +5,10 @@
 //! Figs. 6 and 7: reduced force ϖχ versus reduced displacement λs* − ρ (eqs. 80–81) for
 //! λs* = 1.3 and 6.0. The flattening runs to ρ = λs*/2.
 
-use crate::gps_cmd::{
+use crate::curves::{
     flattening_values, inflation_values, write_csv, FLATTENING_HEADER, INFLATION_HEADER,
 };
-use anyhow::{anyhow, Context, Result};
+use crate::{AppError, Result};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
@@ -20,13 +20,19 @@ use tubemem_material::laws::AnssariBenamBucchi;
 static FONT: Once = Once::new();
 const FONT_BYTES: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() -> Result<()> {
-    let mut result = Ok(());
+fn register_font(path: &Path) -> Result<()> {
+    let mut ok = true;
     FONT.call_once(|| {
-        result = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES)
-            .map_err(|_| anyhow!("the bundled DejaVu Sans font could not be loaded"));
+        ok = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES).is_ok();
     });
-    result
+    if ok {
+        Ok(())
+    } else {
+        Err(AppError::Figure {
+            path: path.to_path_buf(),
+            message: "the bundled DejaVu Sans font could not be loaded".into(),
+        })
+    }
 }
 
 const GPS_COLOR: RGBColor = RGBColor(31, 90, 180);
@@ -70,7 +76,7 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
 
 /// Draw `fig` to a PNG at `path`.
 pub fn draw(path: &Path, fig: &Figure) -> Result<()> {
-    register_font()?;
+    register_font(path)?;
     let all = || {
         fig.series
             .iter()
@@ -80,7 +86,10 @@ pub fn draw(path: &Path, fig: &Figure) -> Result<()> {
     let (x0, x1) = range(all().map(|p| p.0), false);
     let (y0, y1) = range(all().map(|p| p.1), true);
     let root = BitMapBackend::new(path, (1100, 760)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Display| anyhow!("drawing {}: {e}", path.display());
+    let err = |e: &dyn std::fmt::Display| AppError::Figure {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(fig.title, ("sans-serif", 26))
@@ -156,11 +165,14 @@ struct RunPoints {
 
 fn read_run(dir: &Path) -> Result<RunPoints> {
     let path = dir.join("steps.csv");
-    let text = std::fs::read_to_string(&path).with_context(|| {
-        format!(
-            "cannot read {} (is this a tubemem run folder?)",
-            path.display()
-        )
+    let overlay = |message: String| AppError::Overlay {
+        path: path.clone(),
+        message,
+    };
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        overlay(format!(
+            "cannot read it ({e}): is this a tubemem run folder?"
+        ))
     })?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
@@ -168,7 +180,7 @@ fn read_run(dir: &Path) -> Result<RunPoints> {
         header
             .iter()
             .position(|h| *h == name)
-            .with_context(|| format!("{}: no column `{name}`", path.display()))
+            .ok_or_else(|| overlay(format!("no column `{name}`")))
     };
     let (cw, cls, crho, cdisp, cforce) = (
         col("w")?,
@@ -189,13 +201,8 @@ fn read_run(dir: &Path) -> Result<RunPoints> {
         let num = |i: usize| -> Result<f64> {
             f.get(i)
                 .and_then(|v| v.parse::<f64>().ok())
-                .with_context(|| {
-                    format!(
-                        "{}: row {}: column {i} is not a number",
-                        path.display(),
-                        k + 2
-                    )
-                })
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| overlay(format!("row {}: column {i} is not a finite number", k + 2)))
         };
         if f.get(crho).is_some_and(|v| !v.is_empty()) {
             let (ls, w, rho, d, force) =
@@ -221,8 +228,7 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
         .iter()
         .map(|d| read_run(d))
         .collect::<Result<_>>()?;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create folder {}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
     let law = AnssariBenamBucchi::new(1.0, kuhn)?;
     let mut written = vec![];
     let hyps = [(Hypothesis::Gps, GPS_COLOR), (Hypothesis::Ps, PS_COLOR)];
@@ -230,7 +236,8 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
 
     let mut inflation = vec![];
     for (h, _) in hyps {
-        let c = inflation_curve(&law, h, 1.0, 7.5, 651)?;
+        let c = inflation_curve(&law, h, 1.0, 7.5, 651)
+            .map_err(|e| AppError::gps("the inflation curve", e))?;
         let p = dir.join(format!("inflation_{}.csv", h.label().to_lowercase()));
         write_csv(&p, INFLATION_HEADER, c.iter().map(inflation_values))?;
         written.push(p);
@@ -241,7 +248,8 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
     for ls0 in starts {
         let mut per = vec![];
         for (h, _) in hyps {
-            let c = flattening_curve(&law, h, ls0, 0.5 * ls0, 201)?;
+            let c = flattening_curve(&law, h, ls0, 0.5 * ls0, 201)
+                .map_err(|e| AppError::gps("the flattening curve", e))?;
             let p = dir.join(format!(
                 "flattening_ls{ls0:.1}_{}.csv",
                 h.label().to_lowercase()
@@ -252,7 +260,8 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
         }
         flattening.push(per);
     }
-    let limits = limit_points(&law, Hypothesis::Gps)?;
+    let limits =
+        limit_points(&law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))?;
 
     // Fig. 5
     let mut series = vec![];

@@ -32,11 +32,39 @@
 //! steps = 6             # initial number of load steps (adaptive afterwards)
 //! ```
 
-use anyhow::{bail, Context, Result};
-use serde::Deserialize;
-use std::path::Path;
-use tubemem_material::{MaterialSpec, Wrinkling};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+use tubemem_material::{MaterialError, MaterialSpec, Wrinkling};
 use tubemem_mesh::Symmetry;
+
+/// Why a case was rejected: the TOML reader's message (with line and column), or the table,
+/// stage and key at fault.
+#[derive(Debug, Error)]
+pub enum CaseError {
+    #[error("cannot read case file {}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("in case file {}", path.display())]
+    In {
+        path: PathBuf,
+        #[source]
+        source: Box<CaseError>,
+    },
+    #[error("{0}")]
+    Syntax(String),
+    #[error("{0}")]
+    Invalid(String),
+    #[error("[material]")]
+    Material(#[source] MaterialError),
+}
+
+macro_rules! invalid {
+    ($($arg:tt)*) => { return Err(CaseError::Invalid(format!($($arg)*))) };
+}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -51,6 +79,9 @@ pub struct Case {
     pub solver: SolverSpec,
     #[serde(rename = "stage")]
     pub stages: Vec<StageSpec>,
+    /// the stages resolved by validation (filled by [`Case::parse`])
+    #[serde(skip)]
+    plan: Vec<StagePlan>,
 }
 
 /// `[solver]`: optional.
@@ -99,7 +130,7 @@ fn one() -> f64 {
     1.0
 }
 
-#[derive(Debug, Deserialize, Default, PartialEq, Eq, Clone, Copy)]
+#[derive(Debug, Deserialize, Serialize, Default, PartialEq, Eq, Clone, Copy)]
 #[serde(rename_all = "kebab-case")]
 pub enum Caps {
     #[default]
@@ -161,7 +192,8 @@ fn default_steps() -> usize {
 }
 
 /// What a stage drives, once validated.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "control", content = "value", rename_all = "kebab-case")]
 pub enum Target {
     /// reduced pressure ϖ, pressure control
     Pressure(f64),
@@ -173,8 +205,63 @@ pub enum Target {
     Rho(f64),
 }
 
+impl Target {
+    /// The stage label in words, for progress lines.
+    pub fn describe(&self) -> String {
+        match self {
+            Target::Pressure(p) => format!("inflate, pressure control to ϖ = {p}"),
+            Target::Stretch(s) => format!("inflate, mid-span stretch control to λs = {s}"),
+            Target::VolumeRatio(r) => format!("inflate, volume control to V/V0 = {r}"),
+            Target::Rho(r) => format!("squeeze, closed gas, plates to ρ = {r}"),
+        }
+    }
+}
+
+/// How the contact penalty of a squeeze is set.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PenaltySpec {
+    /// κ given
+    Value(f64),
+    /// κ = ϖ J / tolerance at the start of the squeeze (`contact::penalty_for`)
+    Tolerance(f64),
+}
+
+/// A stage resolved once by validation: what the run executes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StagePlan {
+    /// 1-based
+    pub index: usize,
+    pub target: Target,
+    pub steps: usize,
+    /// squeeze stages only
+    pub penalty: Option<PenaltySpec>,
+}
+
+/// The penetration tolerance (in R) that sets the penalty when a squeeze gives neither
+/// `penalty` nor `penetration_tolerance`: penalty converged below 1e-4 in the README's study.
+pub const DEFAULT_PENETRATION_TOLERANCE: f64 = 1e-3;
+
 impl StageSpec {
-    pub fn target(&self, i: usize) -> Result<Target> {
+    /// Resolve the stage (`i` is 0-based).
+    pub fn plan(&self, i: usize) -> Result<StagePlan, CaseError> {
+        let target = self.target(i)?;
+        let penalty = match (self.kind, self.penalty, self.penetration_tolerance) {
+            (Kind::Squeeze, Some(k), _) => Some(PenaltySpec::Value(k)),
+            (Kind::Squeeze, None, t) => Some(PenaltySpec::Tolerance(
+                t.unwrap_or(DEFAULT_PENETRATION_TOLERANCE),
+            )),
+            _ => None,
+        };
+        Ok(StagePlan {
+            index: i + 1,
+            target,
+            steps: self.steps,
+            penalty,
+        })
+    }
+
+    fn target(&self, i: usize) -> Result<Target, CaseError> {
         let which = (
             self.target_pressure,
             self.target_stretch,
@@ -185,20 +272,20 @@ impl StageSpec {
             (Kind::Inflate, Some(ControlKind::Pressure), (Some(p), None, None, None)) => Target::Pressure(p),
             (Kind::Inflate, Some(ControlKind::Volume), (None, Some(s), None, None)) => Target::Stretch(s),
             (Kind::Inflate, Some(ControlKind::Volume), (None, None, Some(v), None)) => Target::VolumeRatio(v),
-            (Kind::Inflate, None, _) => bail!("[[stage]] {}: kind = \"inflate\" needs `control` (\"pressure\" or \"volume\")", i + 1),
+            (Kind::Inflate, None, _) => invalid!("[[stage]] {}: kind = \"inflate\" needs `control` (\"pressure\" or \"volume\")", i + 1),
             (Kind::Inflate, Some(ControlKind::Pressure), _) => {
-                bail!("[[stage]] {}: control = \"pressure\" takes exactly one target, `target_pressure`", i + 1)
+                invalid!("[[stage]] {}: control = \"pressure\" takes exactly one target, `target_pressure`", i + 1)
             }
-            (Kind::Inflate, Some(ControlKind::Volume), _) => bail!(
+            (Kind::Inflate, Some(ControlKind::Volume), _) => invalid!(
                 "[[stage]] {}: control = \"volume\" takes exactly one target, `target_stretch` (mid-span λs*) or `target_volume_ratio`",
                 i + 1
             ),
-            (Kind::Squeeze, Some(_), _) => bail!(
+            (Kind::Squeeze, Some(_), _) => invalid!(
                 "[[stage]] {}: a squeeze keeps the gas closed (Boyle); it takes no `control`",
                 i + 1
             ),
             (Kind::Squeeze, None, (None, None, None, Some(r))) => Target::Rho(r),
-            (Kind::Squeeze, None, _) => bail!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
+            (Kind::Squeeze, None, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
         };
         let (name, v, ok) = match t {
             Target::Pressure(p) => ("target_pressure", p, p.is_finite() && p >= 0.0),
@@ -207,25 +294,25 @@ impl StageSpec {
             Target::Rho(r) => ("target_rho", r, r.is_finite() && r > 0.0),
         };
         if !ok {
-            bail!(
+            invalid!(
                 "[[stage]] {}: `{name}` = {v} is out of range (pressure ≥ 0, stretch ≥ 1, volume ratio ≥ 1, rho > 0)",
                 i + 1
             );
         }
         if self.steps == 0 {
-            bail!("[[stage]] {}: `steps` must be ≥ 1", i + 1);
+            invalid!("[[stage]] {}: `steps` must be ≥ 1", i + 1);
         }
         if self.kind == Kind::Inflate
             && (self.penalty.is_some() || self.penetration_tolerance.is_some())
         {
-            bail!(
+            invalid!(
                 "[[stage]] {}: `penalty` and `penetration_tolerance` belong to squeeze stages",
                 i + 1
             );
         }
         if let Some(t) = self.penetration_tolerance {
             if !(t.is_finite() && t > 0.0 && t < 0.1) {
-                bail!(
+                invalid!(
                     "[[stage]] {}: `penetration_tolerance` = {t}: must be in (0, 0.1) (in R)",
                     i + 1
                 );
@@ -233,7 +320,7 @@ impl StageSpec {
         }
         if let Some(k) = self.penalty {
             if !(k.is_finite() && k > 0.0) {
-                bail!(
+                invalid!(
                     "[[stage]] {}: `penalty` = {k}: must be finite and > 0",
                     i + 1
                 );
@@ -244,22 +331,33 @@ impl StageSpec {
 }
 
 impl Case {
-    pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read case file {}", path.display()))?;
-        let mut case =
-            Self::parse(&text).with_context(|| format!("in case file {}", path.display()))?;
+    /// Read and validate a case file; user mesh paths are relative to its folder.
+    pub fn read(path: &Path) -> Result<Self, CaseError> {
+        let text = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut case = Self::parse(&text).map_err(|e| CaseError::In {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })?;
         case.base_dir = path.parent().map(|p| p.to_path_buf()).unwrap_or_default();
         Ok(case)
     }
 
-    pub fn parse(text: &str) -> Result<Self> {
-        let case: Case = toml::from_str(text).map_err(|e| anyhow::anyhow!("{e}"))?;
-        case.validate()?;
+    /// Parse and validate case text (TOML).
+    pub fn parse(text: &str) -> Result<Self, CaseError> {
+        let mut case: Case = toml::from_str(text).map_err(|e| CaseError::Syntax(e.to_string()))?;
+        case.plan = case.validate()?;
         Ok(case)
     }
 
-    fn validate(&self) -> Result<()> {
+    /// The resolved stages.
+    pub fn plan(&self) -> &[StagePlan] {
+        &self.plan
+    }
+
+    fn validate(&self) -> Result<Vec<StagePlan>, CaseError> {
         let g = &self.geometry;
         for (k, v) in [
             ("radius", g.radius),
@@ -267,39 +365,40 @@ impl Case {
             ("thickness", g.thickness),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                bail!("[geometry] `{k}` = {v}: must be finite and > 0");
+                invalid!("[geometry] `{k}` = {v}: must be finite and > 0");
             }
         }
         let m = &self.mesh;
         match (&m.file, m.around, m.along) {
             (Some(_), None, None) if m.cap_rows.is_none() && m.symmetry == Symmetry::None => {}
-            (Some(_), ..) => bail!(
+            (Some(_), ..) => invalid!(
                 "[mesh] `file` gives the whole mesh: drop `around`, `along`, `cap_rows` and `symmetry` (the file sets its own symmetry)"
             ),
             (None, Some(_), Some(_)) => {}
-            (None, ..) => bail!("[mesh] needs `around` and `along` (a generated tube) or `file` (a user mesh)"),
+            (None, ..) => invalid!("[mesh] needs `around` and `along` (a generated tube) or `file` (a user mesh)"),
         }
         if self.stages.is_empty() {
-            bail!("the case has no [[stage]]");
+            invalid!("the case has no [[stage]]");
         }
+        let mut plan = Vec::with_capacity(self.stages.len());
         for (i, s) in self.stages.iter().enumerate() {
-            s.target(i)?;
+            plan.push(s.plan(i)?);
             if s.kind == Kind::Squeeze && i == 0 {
-                bail!(
+                invalid!(
                     "[[stage]] 1: a squeeze needs an inflated tube: put an inflate stage before it"
                 );
             }
         }
-        self.material.build().context("[material]")?;
+        self.material.build().map_err(CaseError::Material)?;
         if !(self.solver.rtol > 0.0 && self.solver.rtol < 1e-2) {
-            bail!(
+            invalid!(
                 "[solver] `rtol` = {}: must be in (0, 1e-2)",
                 self.solver.rtol
             );
         }
         if self.solver.max_iterations == 0 {
-            bail!("[solver] `max_iterations` must be ≥ 1");
+            invalid!("[solver] `max_iterations` must be ≥ 1");
         }
-        Ok(())
+        Ok(plan)
     }
 }

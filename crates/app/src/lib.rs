@@ -1,0 +1,130 @@
+//! # tubemem-app — the application layer
+//!
+//! Everything between a case file and the files a run leaves behind, as a library that the
+//! `tubemem` binary and the Python module call (neither reads back what a run wrote):
+//!
+//! ```text
+//! case (TOML, validated) → plan (resolved stages) → mesh → model → stepping
+//!        → typed RunReport (StageReport, StepRecord: Serialize)
+//!        → observers: RunWriter (steps.csv, summary.json, profiles/, VTU/PVD), progress, …
+//! ```
+//!
+//! * [`case`]: the case file and its validation into a [`case::Plan`] (stage targets resolved
+//!   once).
+//! * [`run`]: the FE run: [`run::run`] returns a [`report::RunReport`] and calls
+//!   [`run::Observer`]s at every converged step and stage end.
+//! * [`output`]: the writer that turns the report into files while the run goes on.
+//! * [`curves`], [`figures`], [`main_job`]: closed-form curves, the paper's figures, and the
+//!   main job on the embedded default case.
+//!
+//! Errors are typed ([`AppError`], [`case::CaseError`]) and keep their cause as `source()`.
+
+pub mod case;
+pub mod curves;
+pub mod figures;
+pub mod main_job;
+pub mod output;
+pub mod report;
+pub mod run;
+
+use std::path::PathBuf;
+use thiserror::Error;
+
+pub use tubemem_fem::error_chain;
+
+/// A failure of the application layer, with the stage, file or key it concerns.
+#[derive(Debug, Error)]
+pub enum AppError {
+    #[error(transparent)]
+    Case(#[from] case::CaseError),
+    #[error("[mesh] file = {file:?}")]
+    MeshFile {
+        file: String,
+        #[source]
+        source: tubemem_mesh::MeshError,
+    },
+    #[error("[mesh]")]
+    Mesh(#[source] tubemem_mesh::MeshError),
+    #[error("building the finite element model")]
+    Model(#[source] tubemem_fem::FemError),
+    #[error("[[stage]] {stage}: {message}")]
+    StageInput { stage: usize, message: String },
+    #[error("stage {stage} of {stages} failed")]
+    Stage {
+        stage: usize,
+        stages: usize,
+        #[source]
+        source: tubemem_fem::FemError,
+    },
+    #[error("stage {stage}, step {step}: a non-finite mid-span value was computed: {values:?}")]
+    NonFinite {
+        stage: usize,
+        step: usize,
+        values: Vec<f64>,
+    },
+    #[error("stage {stage}: post-processing")]
+    Post {
+        stage: usize,
+        #[source]
+        source: tubemem_fem::FemError,
+    },
+    #[error("{context}")]
+    Gps {
+        context: String,
+        #[source]
+        source: tubemem_gps::GpsError,
+    },
+    #[error("[material]")]
+    Material(#[from] tubemem_material::MaterialError),
+    #[error("{}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("writing {what}")]
+    Output {
+        what: String,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    #[error("figure {}: {message}", path.display())]
+    Figure { path: PathBuf, message: String },
+    #[error("overlay {}: {message}", path.display())]
+    Overlay { path: PathBuf, message: String },
+    #[error("an observer stopped the run at stage {stage}, step {step}")]
+    Observer {
+        stage: usize,
+        step: usize,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+}
+
+impl AppError {
+    pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        AppError::Io {
+            path: path.into(),
+            source,
+        }
+    }
+    pub(crate) fn gps(context: impl Into<String>, source: tubemem_gps::GpsError) -> Self {
+        AppError::Gps {
+            context: context.into(),
+            source,
+        }
+    }
+    /// The material error at the root of a failed stage (e.g. locking), with its element.
+    pub fn material_cause(&self) -> Option<(usize, &tubemem_material::MaterialError)> {
+        match self {
+            AppError::Stage { source, .. } => source.material_cause(),
+            _ => None,
+        }
+    }
+    /// The whole message, cause after cause.
+    pub fn chain(&self) -> String {
+        error_chain(self)
+    }
+}
+
+pub type Result<T, E = AppError> = std::result::Result<T, E>;

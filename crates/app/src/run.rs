@@ -1,0 +1,585 @@
+//! The FE run of a case: plan → mesh → model → stepping → [`RunReport`], with observers called
+//! at every converged step (writers, progress displays, interrupt checks).
+
+use crate::case::{Caps, Case, PenaltySpec, StagePlan, Target};
+use crate::report::*;
+use crate::{AppError, Result};
+use tubemem_fem::contact::{penalty_for, Contact};
+use tubemem_fem::model::{nearest_node, Load, Loading, Model, State};
+use tubemem_fem::post::{cell_values, midspan, midspan_contact, ring_profile, Regime};
+use tubemem_fem::stepping::{run_stage, Stage, StageError, StepSettings};
+use tubemem_fem::NewtonSettings;
+use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
+use tubemem_material::MembraneLaw;
+use tubemem_mesh::tube::{capped_tube_with_cap_rows, plugged_tube};
+use tubemem_mesh::Mesh;
+
+/// An observer's error: it stops the run (which then reports it with stage and step).
+pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
+
+/// What an observer sees at a converged step.
+pub struct StepView<'a> {
+    pub model: &'a Model,
+    pub state: &'a State,
+    pub load: &'a Load,
+    pub plan: &'a StagePlan,
+    pub stages: usize,
+    pub record: &'a StepRecord,
+    /// the fraction of the stage done
+    pub fraction: f64,
+}
+
+/// Called by [`run`] as it goes. Every method has a no-op default.
+pub trait Observer {
+    /// The model is built and `state` is the reference configuration.
+    fn started(
+        &mut self,
+        _report: &RunReport,
+        _model: &Model,
+        _state: &State,
+    ) -> Result<(), BoxError> {
+        Ok(())
+    }
+    fn stage_started(&mut self, _plan: &StagePlan, _stages: usize) {}
+    /// A converged step; an error stops the run.
+    fn step(&mut self, _view: &StepView) -> Result<(), BoxError> {
+        Ok(())
+    }
+    /// A stage finished; its report is the last of `report.stages`.
+    fn stage_finished(&mut self, _report: &RunReport) -> Result<(), BoxError> {
+        Ok(())
+    }
+    fn finished(&mut self, _report: &RunReport) -> Result<(), BoxError> {
+        Ok(())
+    }
+    /// The run failed; `report` holds every converged step, and the failed stage's error.
+    fn failed(&mut self, _report: &RunReport, _error: &AppError) {}
+}
+
+/// A run's outcome: the report (always, with every converged step) and the error if it failed.
+pub struct RunOutcome {
+    pub report: RunReport,
+    pub error: Option<AppError>,
+}
+
+impl RunOutcome {
+    pub fn into_result(self) -> Result<RunReport> {
+        match self.error {
+            None => Ok(self.report),
+            Some(e) => Err(e),
+        }
+    }
+}
+
+/// Build the mesh a case asks for.
+pub fn build_mesh(case: &Case) -> Result<Mesh> {
+    let g = &case.geometry;
+    let ll = g.length / g.radius;
+    match (&case.mesh.file, case.mesh.around, case.mesh.along) {
+        (Some(file), ..) => {
+            let path = case.base_dir.join(file);
+            tubemem_mesh::io::read_json(&path, g.radius).map_err(|source| AppError::MeshFile {
+                file: file.clone(),
+                source,
+            })
+        }
+        (None, Some(around), Some(along)) => {
+            let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
+            match g.caps {
+                Caps::Hemisphere => {
+                    capped_tube_with_cap_rows(1.0, ll, around, along, cap_rows, case.mesh.symmetry)
+                }
+                Caps::RigidPlug => plugged_tube(1.0, ll, around, along, case.mesh.symmetry),
+            }
+            .map_err(AppError::Mesh)
+        }
+        _ => Err(crate::case::CaseError::Invalid(
+            "[mesh] needs `around` and `along`, or `file`".into(),
+        )
+        .into()),
+    }
+}
+
+/// The closed form at one step (see [`StepClosedForm`]).
+fn step_closed_form(
+    law: &dyn MembraneLaw,
+    ms: &tubemem_fem::post::MidSpan,
+    squeeze: Option<(&tubemem_fem::post::ContactValues, f64)>,
+) -> StepClosedForm {
+    match squeeze {
+        None => StepClosedForm {
+            gps_inflation: inflate(law, Hypothesis::Gps, ms.lambda_s).ok(),
+            gps_flattening: None,
+            local: None,
+        },
+        Some((c, ls0)) => {
+            let g = flatten(law, Hypothesis::Gps, ls0, c.rho).ok();
+            let local = g.map(|g| {
+                section_at_pressure(law, c.rho, ms.w, [g.lambda_s, g.lambda_z])
+                    .map_err(|e| e.to_string())
+            });
+            StepClosedForm {
+                gps_inflation: None,
+                gps_flattening: g,
+                local,
+            }
+        }
+    }
+}
+
+/// Distance (in R) from the cap junction (or plug) at which λs comes within `tol` of its
+/// mid-span value and stays there all the way to mid-span; `None` if it never does.
+pub fn boundary_layer(
+    rings: &[tubemem_fem::post::RingValues],
+    half_length: f64,
+    mid: f64,
+    tol: f64,
+) -> Option<f64> {
+    let mut side: Vec<_> = rings.iter().filter(|r| r.z_ref >= -1e-12).collect();
+    side.sort_by(|a, b| b.z_ref.total_cmp(&a.z_ref)); // from the junction inwards
+    let within =
+        |r: &&tubemem_fem::post::RingValues| ((r.values.lambda_s - mid) / mid).abs() <= tol;
+    let first_inside = side.iter().position(within)?;
+    if side[first_inside..].iter().all(within) {
+        Some(half_length - side[first_inside].z_ref)
+    } else {
+        None
+    }
+}
+
+/// Where the membrane is wrinkled or slack at the end of a stage.
+fn wrinkle_report(model: &Model, state: &State, stage: usize) -> Result<Wrinkling> {
+    let cells = cell_values(model, state).map_err(|source| AppError::Post { stage, source })?;
+    let mesh = model.mesh();
+    let extent = |regime: Regime| {
+        let zs: Vec<f64> = cells
+            .iter()
+            .zip(&mesh.quads)
+            .filter(|(c, _)| c.regime() == regime)
+            .map(|(_, q)| q.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0)
+            .collect();
+        let (lo, hi) = zs
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &z| {
+                (a.min(z), b.max(z))
+            });
+        RegimeExtent {
+            elements: zs.len(),
+            z_ref_min: (!zs.is_empty()).then_some(lo),
+            z_ref_max: (!zs.is_empty()).then_some(hi),
+        }
+    };
+    Ok(Wrinkling {
+        wrinkled: extent(Regime::Wrinkled),
+        slack: extent(Regime::Slack),
+    })
+}
+
+/// The closed-form comparison of a stage's final state: GPS and PS, and for a squeeze the
+/// section at the FE's pressure (as solved for the last step).
+#[allow(clippy::type_complexity)]
+fn stage_closed_form(
+    law: &dyn MembraneLaw,
+    ms: &tubemem_fem::post::MidSpan,
+    contact: Option<&ContactRecord>,
+    local: Option<&std::result::Result<tubemem_gps::SectionState, String>>,
+) -> Result<(
+    [(ClosedFormState, RelativeErrors); 2],
+    Option<LocalSection>,
+    Option<RelativeErrors>,
+)> {
+    let one = |hyp: Hypothesis| -> Result<(ClosedFormState, RelativeErrors)> {
+        Ok(match contact {
+            None => {
+                let s = inflate(law, hyp, ms.lambda_s).map_err(|e| {
+                    AppError::gps(format!("{} inflation at the FE's λs", hyp.label()), e)
+                })?;
+                (
+                    ClosedFormState::Inflation(s),
+                    RelativeErrors {
+                        w: Some(rel(ms.w, s.w)),
+                        lambda_z: Some(rel(ms.lambda_z, s.lambda_z)),
+                        n_s: Some(rel(ms.n_s, s.n_s)),
+                        n_z: Some(rel(ms.n_z, s.n_z)),
+                        ..Default::default()
+                    },
+                )
+            }
+            Some(c) => {
+                let s = flatten(law, hyp, c.initial_stretch, c.values.rho).map_err(|e| {
+                    AppError::gps(format!("{} flattening at the FE's ρ", hyp.label()), e)
+                })?;
+                (
+                    ClosedFormState::Flattening(s),
+                    RelativeErrors {
+                        w: Some(rel(ms.w, s.w)),
+                        lambda_s: Some(rel(ms.lambda_s, s.lambda_s)),
+                        lambda_z: Some(rel(ms.lambda_z, s.lambda_z)),
+                        chi: Some(rel(c.values.chi, s.chi)),
+                        force: Some(rel(c.values.force, s.force)),
+                        ..Default::default()
+                    },
+                )
+            }
+        })
+    };
+    let both = [one(Hypothesis::Gps)?, one(Hypothesis::Ps)?];
+    let (section, errors) = match (contact, local) {
+        (Some(c), Some(Ok(l))) => (
+            Some(LocalSection::Solved(*l)),
+            Some(RelativeErrors {
+                w: None,
+                lambda_s: Some(rel(ms.lambda_s, l.lambda_s)),
+                lambda_z: Some(rel(ms.lambda_z, l.lambda_z)),
+                chi: Some(rel(c.values.chi, l.chi)),
+                force: Some(rel(c.values.force, l.force)),
+                ..Default::default()
+            }),
+        ),
+        (Some(_), Some(Err(e))) => (Some(LocalSection::Failed { error: e.clone() }), None),
+        _ => (None, None),
+    };
+    Ok((both, section, errors))
+}
+
+/// Run a validated case; `label` names it in the report. Observers see every converged step as
+/// it comes. The outcome always carries the report (every converged step) and, if the run
+/// failed, the error, which every observer has also been told of.
+pub fn run(case: &Case, label: &str, observers: &mut [&mut dyn Observer]) -> RunOutcome {
+    let mut report = None;
+    let error = run_inner(case, label, observers, &mut report).err();
+    let report = report.unwrap_or_else(|| RunReport {
+        case: label.to_string(),
+        mesh: MeshInfo {
+            nodes: 0,
+            elements: 0,
+            equations: 0,
+            symmetry: String::new(),
+        },
+        material: String::new(),
+        material_spec: case.material,
+        geometry: GeometryInfo {
+            radius: case.geometry.radius,
+            length: case.geometry.length,
+            thickness: case.geometry.thickness,
+            caps: String::new(),
+        },
+        units: UNITS,
+        stages: vec![],
+    });
+    if let Some(e) = &error {
+        for o in observers.iter_mut() {
+            o.failed(&report, e);
+        }
+    }
+    RunOutcome { report, error }
+}
+
+fn run_inner(
+    case: &Case,
+    label: &str,
+    observers: &mut [&mut dyn Observer],
+    slot: &mut Option<RunReport>,
+) -> Result<()> {
+    let g = &case.geometry;
+    let half = 0.5 * g.length / g.radius;
+    let mesh = build_mesh(case)?;
+    let symmetry = mesh.symmetry;
+    let law = case.material.build_with(case.solver.wrinkling)?;
+    let closed_form_law = case.material.build()?;
+    let mut model = Model::new(mesh, law).map_err(AppError::Model)?;
+    model.set_settings(NewtonSettings {
+        rtol: case.solver.rtol,
+        max_iterations: case.solver.max_iterations,
+        ..NewtonSettings::default()
+    });
+    let mut state = model.reference_state();
+    let v0 = model.multiplicity() * model.mesh().volume();
+    let node = nearest_node(model.mesh(), [1.0, 0.0, 0.0]);
+    let report = slot.insert(RunReport {
+        case: label.to_string(),
+        mesh: MeshInfo {
+            nodes: model.mesh().nodes.len(),
+            elements: model.mesh().quads.len(),
+            equations: model.n_eq(),
+            symmetry: format!("{symmetry:?}").to_lowercase(),
+        },
+        material: model.law().name(),
+        material_spec: case.material,
+        geometry: GeometryInfo {
+            radius: g.radius,
+            length: g.length,
+            thickness: g.thickness,
+            caps: format!("{:?}", g.caps).to_lowercase(),
+        },
+        units: UNITS,
+        stages: vec![],
+    });
+    for o in observers.iter_mut() {
+        o.started(report, &model, &state)
+            .map_err(|source| AppError::Observer {
+                stage: 0,
+                step: 0,
+                source,
+            })?;
+    }
+    let stages = case.plan().len();
+    for plan in case.plan() {
+        let i = plan.index;
+        for o in observers.iter_mut() {
+            o.stage_started(plan, stages);
+        }
+        // for a squeeze: the inflated mid-span stretch λs* and the gas constant at its start
+        let start =
+            midspan(&model, &state).map_err(|source| AppError::Post { stage: i, source })?;
+        let pv = state.p * model.multiplicity() * model.mesh().volume_at(&state.x);
+        let fail_input = |report: &mut RunReport, message: String| {
+            report.stages.push(StageReport {
+                plan: *plan,
+                steps: vec![],
+                outcome: StageOutcome::Failed(StageFailure {
+                    index: i,
+                    error: format!("[[stage]] {i}: {message}"),
+                    last_converged: None,
+                }),
+                profile: vec![],
+            });
+            AppError::StageInput { stage: i, message }
+        };
+        let (from, to, load): (f64, f64, Box<dyn Fn(f64) -> Load>) = match plan.target {
+            Target::Pressure(p) => (state.p, p, Box::new(Load::pressure)),
+            Target::Stretch(s) => (
+                state.x[node][0],
+                s,
+                Box::new(move |v| {
+                    Load::new(Loading::Node {
+                        node,
+                        component: 0,
+                        target: v,
+                    })
+                }),
+            ),
+            Target::VolumeRatio(r) => (
+                model.multiplicity() * model.mesh().volume_at(&state.x),
+                r * v0,
+                Box::new(|v| Load::new(Loading::Volume(v))),
+            ),
+            Target::Rho(rho) => {
+                if state.p.is_nan() || state.p <= 0.0 {
+                    return Err(fail_input(
+                        report,
+                        format!(
+                            "the tube holds no gas pressure to squeeze (ϖ = {})",
+                            state.p
+                        ),
+                    ));
+                }
+                let h0 = state.x.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+                if rho >= h0 {
+                    return Err(fail_input(report, format!("`target_rho` = {rho} must be below the current half-height {h0:.6} of the tube")));
+                }
+                let penalty = match plan.penalty {
+                    Some(PenaltySpec::Value(k)) => k,
+                    Some(PenaltySpec::Tolerance(t)) => {
+                        penalty_for(state.p, start.lambda_s * start.lambda_z, t)
+                    }
+                    None => penalty_for(
+                        state.p,
+                        start.lambda_s * start.lambda_z,
+                        crate::case::DEFAULT_PENETRATION_TOLERANCE,
+                    ),
+                };
+                (
+                    h0,
+                    rho,
+                    Box::new(move |h| {
+                        Load::with_contact(Loading::Gas { pv }, Contact::plates(h, penalty))
+                    }),
+                )
+            }
+        };
+        let stage = Stage {
+            index: i,
+            from,
+            to,
+            settings: StepSettings {
+                initial_steps: plan.steps,
+                ..StepSettings::default()
+            },
+        };
+        let mut steps: Vec<StepRecord> = vec![];
+        let result = run_stage(&mut model, &mut state, &stage, &load, |m, st, info| {
+            let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
+            let contact = info.load.contact.as_ref().and_then(|c| {
+                midspan_contact(m, st, c).map(|values| ContactRecord {
+                    values,
+                    displacement: start.lambda_s - values.rho,
+                    initial_stretch: start.lambda_s,
+                    penalty: c.penalty,
+                })
+            });
+            let mut vals = vec![
+                ms.w,
+                ms.lambda_s,
+                ms.lambda_z,
+                ms.n_s,
+                ms.n_z,
+                ms.n_sz,
+                ms.volume,
+            ];
+            if let Some(c) = &contact {
+                let c = &c.values;
+                vals.extend([c.chi, c.force, c.contact_pressure, c.penetration]);
+            }
+            if vals.iter().any(|v| !v.is_finite()) {
+                return Err(Box::new(AppError::NonFinite {
+                    stage: i,
+                    step: info.step,
+                    values: vals,
+                }) as BoxError);
+            }
+            let closed_form = step_closed_form(
+                closed_form_law.as_ref(),
+                &ms,
+                contact.as_ref().map(|c| (&c.values, start.lambda_s)),
+            );
+            let record = StepRecord {
+                stage: i,
+                step: info.step,
+                load: info.value,
+                midspan: ms,
+                newton_iterations: info.newton.iterations,
+                negative_pivots: info.newton.inertia.negative_pivots,
+                residuals: info.newton.history.clone(),
+                contact,
+                closed_form,
+            };
+            let view = StepView {
+                model: m,
+                state: st,
+                load: info.load,
+                plan,
+                stages,
+                record: &record,
+                fraction: info.fraction,
+            };
+            for o in observers.iter_mut() {
+                o.step(&view)?;
+            }
+            steps.push(record);
+            Ok::<(), BoxError>(())
+        });
+        if let Err(e) = result {
+            let error = match e {
+                StageError::Solve(source) => AppError::Stage {
+                    stage: i,
+                    stages,
+                    source,
+                },
+                StageError::Observer { step, source, .. } => match source.downcast::<AppError>() {
+                    Ok(app) => *app,
+                    Err(source) => AppError::Observer {
+                        stage: i,
+                        step,
+                        source,
+                    },
+                },
+            };
+            let last_converged = steps.last().map(|s| s.midspan);
+            report.stages.push(StageReport {
+                plan: *plan,
+                steps,
+                outcome: StageOutcome::Failed(StageFailure {
+                    index: i,
+                    error: error.chain(),
+                    last_converged,
+                }),
+                profile: vec![],
+            });
+            return Err(error);
+        }
+        let (ms, contact, its, neg, local) = match steps.last() {
+            Some(l) => (
+                l.midspan,
+                l.contact,
+                l.newton_iterations,
+                l.negative_pivots,
+                l.closed_form.local.clone(),
+            ),
+            None => (
+                midspan(&model, &state).map_err(|source| AppError::Post { stage: i, source })?,
+                None,
+                0,
+                0,
+                None,
+            ),
+        };
+        let rings =
+            ring_profile(&model, &state).map_err(|source| AppError::Post { stage: i, source })?;
+        let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
+        let wrinkling = wrinkle_report(&model, &state, i)?;
+        let ([(gps, gps_err), (ps, ps_err)], local_section, local_err) = stage_closed_form(
+            closed_form_law.as_ref(),
+            &ms,
+            contact.as_ref(),
+            local.as_ref(),
+        )?;
+        let summary = StageSummary {
+            index: i,
+            kind: if contact.is_some() {
+                "squeeze"
+            } else {
+                "inflate"
+            },
+            target: plan.target,
+            final_state: StageFinal {
+                midspan: ms,
+                newton_iterations: its,
+                stage_steps: steps.len(),
+                stage_newton_iterations: steps.iter().map(|s| s.newton_iterations).sum(),
+                negative_pivots: neg,
+                contact: contact.map(|c| FinalContact {
+                    rho: c.values.rho,
+                    chi: c.values.chi,
+                    chi_geometric: c.values.chi_geometric,
+                    force: c.values.force,
+                    displacement: c.displacement,
+                    contact_pressure: c.values.contact_pressure,
+                    penetration: c.values.penetration,
+                    total_plate_force: c.values.total_force,
+                    penalty: c.penalty,
+                    initial_stretch: c.initial_stretch,
+                }),
+            },
+            cap_boundary_layer: layer,
+            wrinkling,
+            profile: format!("profiles/stage{i}_final.csv"),
+            gps,
+            ps,
+            relative_error_vs_gps: gps_err,
+            relative_error_vs_ps: ps_err,
+            gps_at_fe_pressure: local_section,
+            relative_error_vs_gps_at_fe_pressure: local_err,
+        };
+        report.stages.push(StageReport {
+            plan: *plan,
+            steps,
+            outcome: StageOutcome::Finished(Box::new(summary)),
+            profile: rings,
+        });
+        for o in observers.iter_mut() {
+            o.stage_finished(report)
+                .map_err(|source| AppError::Output {
+                    what: format!("the results of stage {i}"),
+                    source,
+                })?;
+        }
+    }
+    for o in observers.iter_mut() {
+        o.finished(report).map_err(|source| AppError::Output {
+            what: "the run's results".into(),
+            source,
+        })?;
+    }
+    Ok(())
+}

@@ -1,0 +1,132 @@
+//! The console observer of a run: a progress bar on a terminal (elapsed time, ETA, the step's
+//! Newton residual), or one line per converged step when the output is not a terminal; and the
+//! closing lines of each stage, printed from the typed report.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use tubemem_app::case::StagePlan;
+use tubemem_app::report::{rel, ClosedFormState, LocalSection, RunReport, StageOutcome};
+use tubemem_app::run::{BoxError, Observer, StepView};
+use tubemem_fem::model::{Model, State};
+
+/// Prints a run's progress and results.
+pub struct Console {
+    bar: Option<ProgressBar>,
+    terminal: bool,
+}
+
+impl Default for Console {
+    fn default() -> Self {
+        Self {
+            bar: None,
+            terminal: std::io::stderr().is_terminal(),
+        }
+    }
+}
+
+impl Observer for Console {
+    fn started(&mut self, report: &RunReport, _m: &Model, _s: &State) -> Result<(), BoxError> {
+        println!(
+            "tubemem run: {} — {} elements, {} equations ({} model), {}",
+            report.case,
+            report.mesh.elements,
+            report.mesh.equations,
+            report.mesh.symmetry,
+            report.material
+        );
+        Ok(())
+    }
+
+    fn stage_started(&mut self, plan: &StagePlan, stages: usize) {
+        let label = format!(
+            "stage {}/{} ({})",
+            plan.index,
+            stages,
+            plan.target.describe()
+        );
+        if self.terminal {
+            let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{prefix} [{bar:30}] {percent:>3}% {elapsed_precise} (ETA {eta}) {msg}",
+                )
+                .expect("a valid progress template")
+                .progress_chars("=> "),
+            );
+            bar.set_prefix(label);
+            self.bar = Some(bar);
+        } else {
+            println!("{label}");
+        }
+    }
+
+    fn step(&mut self, v: &StepView) -> Result<(), BoxError> {
+        let r = v.record;
+        let res = r.residuals.last().copied().unwrap_or(f64::NAN);
+        let msg = format!(
+            "step {}: ϖ = {:.5}, λs = {:.5}, {} Newton its, residual {res:.1e}",
+            r.step, r.midspan.w, r.midspan.lambda_s, r.newton_iterations
+        );
+        match &self.bar {
+            Some(bar) => {
+                bar.set_position((1000.0 * v.fraction.clamp(0.0, 1.0)) as u64);
+                bar.set_message(msg);
+            }
+            None => println!("  stage {} {msg} ({:.0} %)", r.stage, 100.0 * v.fraction),
+        }
+        Ok(())
+    }
+
+    fn stage_finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+        let Some(stage) = report.stages.last() else {
+            return Ok(());
+        };
+        let StageOutcome::Finished(s) = &stage.outcome else {
+            return Ok(());
+        };
+        let ms = &s.final_state.midspan;
+        let (w, ls, lz, chi, force) = values(&s.gps);
+        let (ps_w, _, _, ps_chi, ps_force) = values(&s.ps);
+        println!(
+            "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6} (GPS {:.6}), λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
+            s.index, ms.w, w, 100.0 * rel(ms.w, w), ps_w, ms.lambda_s, ls, ms.lambda_z, lz, ms.n_s, ms.n_z, ms.n_sz
+        );
+        if let Some(c) = &s.final_state.contact {
+            println!(
+                "         ρ = {:.4}: χ = {:.5} (GPS {:.5}, PS {:.5}), force ϖχ = {:.5} (GPS {:.5}, {:+.2}%; PS {:.5}), contact pressure {:.4}, penetration {:.1e}",
+                c.rho, c.chi, chi, ps_chi, c.force, force, 100.0 * rel(c.force, force), ps_force, c.contact_pressure, c.penetration
+            );
+            if let Some(LocalSection::Solved(l)) = &s.gps_at_fe_pressure {
+                println!(
+                    "         GPS section at the FE's pressure ϖ = {:.6} (eq. 76, no gas law): λs {:+.3}%, λz {:+.3}%, χ {:+.3}%, force {:+.3}%",
+                    ms.w,
+                    100.0 * rel(ms.lambda_s, l.lambda_s),
+                    100.0 * rel(ms.lambda_z, l.lambda_z),
+                    100.0 * rel(c.chi, l.chi),
+                    100.0 * rel(c.force, l.force)
+                );
+            }
+        }
+        if let Some(d) = s.cap_boundary_layer {
+            println!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)");
+        }
+        Ok(())
+    }
+
+    fn failed(&mut self, _report: &RunReport, _error: &tubemem_app::AppError) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// (ϖ, λs, λz, χ, force) of a closed-form state (χ and force NaN for an inflation).
+fn values(c: &ClosedFormState) -> (f64, f64, f64, f64, f64) {
+    match c {
+        ClosedFormState::Inflation(g) => (g.w, g.lambda_s, g.lambda_z, f64::NAN, f64::NAN),
+        ClosedFormState::Flattening(g) => (g.w, g.lambda_s, g.lambda_z, g.chi, g.force),
+    }
+}
