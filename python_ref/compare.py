@@ -64,7 +64,8 @@ def compare(run_dir, out_dir, plot=True):
             w, lz = closed_form.gps_inflation(ls, kuhn)
             for k, fe, sk, cf in [("w", fin["w"], ax["w"], w), ("lambda_z", fin["lambda_z"], ax["lambda_z"], lz)]:
                 rows.append((idx, "inflate", k, fe, sk, cf, rel(fe, sk), rel(fe, cf), rel(sk, cf)))
-            prof = read_profile(pathlib.Path(st["profile"]))
+            # summary.json names the profile relative to the run folder
+            prof = read_profile(pathlib.Path(run_dir) / st["profile"])
             z_ax, ls_ax, _, s_ax = tube.profile(q)
             cyl = s_ax >= np.pi / 2 - 1e-12
             z_ref_ax = length / 2 - (s_ax[cyl] - np.pi / 2)

@@ -2,7 +2,7 @@
 """Compare two tubemem run folders number by number: every numeric leaf of summary.json (matched
 by key path; a string leaf must be equal) and every steps.csv field (matched by column name).
 Prints the largest relative difference |a − b| / max(|a|, |b|) per file and exits 1 if it
-exceeds --rtol (default 1e-12, the refactoring criterion of issue #9). Values below 1e-14 in
+exceeds --rtol (default 1e-12: a refactoring must leave the numbers unchanged to this level). Values below 1e-14 in
 magnitude, N_sz and the penetration (differences of nearly equal numbers, of natural scale 1 in
 R = μH = 1) and the summary's relative errors (scale 1) are compared absolutely.
 

@@ -4,7 +4,8 @@ Sources: GPS free inflation (eq. 66) and the GPS limit point (closed_form.gps_li
 Measured (ABB N = 30, lambda_s* = 1.3, mid-span stretch control, P2, 8 elements per R along):
 the mid-span pressure differs from GPS by 1.03e-1, 7.0e-3, 1.32e-4, 5.35e-8 at L/R = 2, 5, 10, 20
 (lambda_z: 2.25e-2, 1.5e-3, 2.8e-5, 1.1e-8): the end-cap effect dies out exponentially with L/R.
-The issue asks for below 1e-4 at L/R = 20. The largest pressure along the mid-span-stretch path
+The test bounds the L/R = 20 error by 1e-4 (2,000x the measured 5.35e-8: it fails if the
+end effect stops decaying, not at round-off). The largest pressure along the mid-span-stretch path
 is above the uniform GPS limit by 1.12e-3 at L/R = 20 and 1.12e-4 at L/R = 40 (33 s, not in CI):
 a finite-length effect that vanishes as L grows; the test bounds it by 2e-3 at L/R = 20.
 """

@@ -2,7 +2,8 @@
 
 Tolerances: both sides converge their nonlinear solves to ~1e-14; the flattening system has a
 condition number of order 1e2 and hybrd stops at tol = 1e-14, so states agree to 1e-9 relative.
-Limit points are located to 1e-8 in lambda_s (the issue's requirement) by both sides.
+Limit points are located to 1e-8 in lambda_s by both sides (bisection on the slope to that
+width), so they are compared at 1e-8.
 """
 
 import pytest

@@ -2,8 +2,8 @@
 //! (`tubemem-gps`, the paper's equations) and against analytic solutions. One test binary; each
 //! module opens with the source of truth of its tests.
 //!
-//! The reference paper: S. Lopez-Pamies-style GPS analysis of pressurized membranes as cited in
-//! the README ("References"); equation numbers below are the paper's.
+//! The reference paper: *On the generalized plane strain assumption for pressurized membranes*
+//! (README, "References"); equation numbers below are the paper's.
 
 mod sphere;
 mod squeeze;

@@ -43,11 +43,27 @@ pub struct MainJob {
     pub figures: Vec<PathBuf>,
 }
 
+/// The closed-form part of the main job: limit points and Maxwell pressure of the paper's law.
+pub fn paper_limits() -> Result<Limits> {
+    let law = AnssariBenamBucchi::new(1.0, 30.0)?;
+    limit_points(&law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))
+}
+
+/// The closed-form header line.
+pub fn limits_text(l: &Limits) -> String {
+    match (l.max, l.min, l.maxwell) {
+        (Some(mx), Some(mn), Some(m)) => format!(
+            "Closed form, GPS inflation: pressure maximum ϖ = {:.6} at λs = {:.6}, minimum ϖ = {:.6} at λs = {:.6}, Maxwell ϖ = {:.6} (PS has no limit point)",
+            mx.w, mx.lambda_s, mn.w, mn.lambda_s, m.w
+        ),
+        _ => "Closed form, GPS inflation: no limit points found".into(),
+    }
+}
+
 /// Run the main job into `out`; `observers` see the FE run (e.g. a progress display).
 pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<MainJob> {
     let law = AnssariBenamBucchi::new(1.0, 30.0)?;
-    let limits =
-        limit_points(&law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))?;
+    let limits = paper_limits()?;
     let case = Case::parse(DEFAULT_CASE)?;
     let run_dir = out.join("squeeze");
     let mut writer = RunWriter::new(&run_dir);
@@ -94,18 +110,6 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
 }
 
 impl MainJob {
-    /// The closed-form header line.
-    pub fn limits_text(&self) -> String {
-        let l = &self.limits;
-        match (l.max, l.min, l.maxwell) {
-            (Some(mx), Some(mn), Some(m)) => format!(
-                "Closed form, GPS inflation: pressure maximum ϖ = {:.6} at λs = {:.6}, minimum ϖ = {:.6} at λs = {:.6}, Maxwell ϖ = {:.6} (PS has no limit point)",
-                mx.w, mx.lambda_s, mn.w, mn.lambda_s, m.w
-            ),
-            _ => "Closed form, GPS inflation: no limit points found".into(),
-        }
-    }
-
     /// The FE-versus-closed-form table of the squeeze.
     pub fn table(&self) -> String {
         let mut t = String::new();

@@ -62,12 +62,13 @@ fn app(e: tubemem_app::AppError) -> anyhow::Error {
 
 fn main_job() -> Result<()> {
     println!("tubemem — the paper's example (Anssari-Benam–Bucchi membrane, 𝒩 = 30; ϖ = pR/μH)\n");
+    let limits = tubemem_app::main_job::paper_limits().map_err(app)?;
+    println!("{}\n", tubemem_app::main_job::limits_text(&limits));
     let mut console = Console::default();
     let job =
         tubemem_app::main_job::run_main_job(&PathBuf::from("tubemem-out"), &mut [&mut console])
             .map_err(app)?;
-    println!("\n{}\n", job.limits_text());
-    println!("{}", job.table());
+    println!("\n{}", job.table());
     for p in &job.figures {
         println!("wrote {}", p.display());
     }

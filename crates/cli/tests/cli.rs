@@ -1,4 +1,4 @@
-//! End-to-end tests of the `tubemem` binary: the public flags and JSON keys of issue #2, the
+//! End-to-end tests of the `tubemem` binary: the public flags and JSON keys of the README's "Command line", the
 //! CSV curves, the figures, and bad input (non-zero exit, a clear message, never a panic).
 //! Reference values come from the paper's explicit formulas (eq. 68), not from the binary.
 

@@ -1,4 +1,4 @@
-//! Release-mode timing of the FE solver (issue #3 performance figures):
+//! Release-mode timing of the FE solver (the README's "FE performance" figures):
 //!
 //! ```text
 //! cargo run --release -p tubemem-fem --example newton_timing

@@ -1,0 +1,112 @@
+//! Tests of the application layer: the typed report is the one source of every output, the
+//! writer's files agree with it exactly, and failures (including precondition failures of a
+//! stage) are recorded in the report and in summary.json with their stage and cause.
+
+use std::path::PathBuf;
+use tubemem_app::case::Case;
+use tubemem_app::output::{step_row, RunWriter};
+use tubemem_app::report::StageOutcome;
+use tubemem_app::run::run;
+
+/// The small tube shared with the CLI and Python tests.
+const SMALL: &str = include_str!("../../../cases/small_abb30_ls1.2.toml");
+const SQUEEZE: &str = "\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.0\nsteps = 4\n";
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tubemem-app-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// steps.csv and summary.json are the report, field for field: every steps.csv value parses
+/// back to the report's (shortest round-trip formatting) and summary.json parses back to the
+/// serialized summary view (exact float round trip).
+#[test]
+fn the_files_are_the_report() {
+    let case = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
+    let out = tmp("files");
+    let mut writer = RunWriter::new(&out);
+    let report = run(&case, "small", &mut [&mut writer])
+        .into_result()
+        .unwrap();
+    assert_eq!(report.stages.len(), 2);
+    let text = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let mut lines = text.lines();
+    lines.next();
+    let mut n = 0;
+    for (line, rec) in lines.zip(report.steps()) {
+        let fields: Vec<&str> = line.split(',').collect();
+        let want = step_row(rec);
+        assert_eq!(fields.len(), want.len());
+        for (f, w) in fields.iter().zip(&want) {
+            match w {
+                Some(v) => assert_eq!(f.parse::<f64>().unwrap(), *v, "{line}"),
+                None => assert!(f.is_empty(), "{line}"),
+            }
+        }
+        n += 1;
+    }
+    assert_eq!(n, report.steps().count());
+    assert!(n >= 6);
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let in_memory = serde_json::to_value(report.summary()).unwrap();
+    assert_eq!(on_disk, in_memory);
+    // the profile path is relative to the run folder, and the file is there
+    let profile = on_disk["stages"][1]["profile"].as_str().unwrap();
+    assert_eq!(profile, "profiles/stage2_final.csv");
+    assert!(out.join(profile).exists());
+    // the target is plain data, not a debug string
+    assert_eq!(on_disk["stages"][0]["target"]["control"], "stretch");
+    assert_eq!(on_disk["stages"][0]["target"]["value"], 1.2);
+}
+
+/// A stage whose precondition fails (the plates would start above the tube) is recorded: the
+/// report and summary.json carry the failed stage with its message, and the error names the
+/// stage and the key.
+#[test]
+fn a_precondition_failure_is_recorded() {
+    let case = Case::parse(&format!("{SMALL}{}", SQUEEZE.replace("1.0", "5.0"))).unwrap();
+    let out = tmp("precondition");
+    let mut writer = RunWriter::new(&out);
+    let outcome = run(&case, "small", &mut [&mut writer]);
+    let err = outcome.error.expect("the squeeze cannot start");
+    let text = err.chain();
+    assert!(
+        text.contains("[[stage]] 2") && text.contains("target_rho"),
+        "{text}"
+    );
+    match &outcome.report.stages[1].outcome {
+        StageOutcome::Failed(f) => assert!(f.error.contains("target_rho"), "{}", f.error),
+        o => panic!("{o:?}"),
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(s["stages"][1]["error"]
+        .as_str()
+        .unwrap()
+        .contains("target_rho"));
+    assert_eq!(s["stages"][0]["kind"], "inflate");
+}
+
+/// The plan is resolved once by validation: targets and penalties as the run uses them.
+#[test]
+fn the_plan_is_resolved_by_validation() {
+    use tubemem_app::case::{PenaltySpec, Target, DEFAULT_PENETRATION_TOLERANCE};
+    let case = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
+    let plan = case.plan();
+    assert_eq!(plan.len(), 2);
+    assert_eq!(plan[0].target, Target::Stretch(1.2));
+    assert_eq!(plan[0].penalty, None);
+    assert_eq!(plan[1].target, Target::Rho(1.0));
+    assert_eq!(
+        plan[1].penalty,
+        Some(PenaltySpec::Tolerance(DEFAULT_PENETRATION_TOLERANCE))
+    );
+    let bad = Case::parse(&SMALL.replace("target_stretch = 1.2", "target_stretch = 0.5"));
+    let msg = tubemem_app::error_chain(&bad.unwrap_err());
+    assert!(
+        msg.contains("[[stage]] 1") && msg.contains("target_stretch"),
+        "{msg}"
+    );
+}
