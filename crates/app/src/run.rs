@@ -176,24 +176,32 @@ fn wrinkle_report(model: &Model, state: &State, stage: usize) -> Result<Wrinklin
 }
 
 /// The closed-form comparison of a stage's final state: GPS and PS, and for a squeeze the
-/// section at the FE's pressure (as solved for the last step).
+/// section at the FE's pressure. GPS and the section are the last step's (solved once, for its
+/// steps.csv row); only PS is solved here.
 #[allow(clippy::type_complexity)]
 fn stage_closed_form(
     law: &dyn MembraneLaw,
     ms: &tubemem_fem::post::MidSpan,
     contact: Option<&ContactRecord>,
-    local: Option<&std::result::Result<tubemem_gps::SectionState, String>>,
+    last: Option<&StepClosedForm>,
 ) -> Result<(
     [(ClosedFormState, RelativeErrors); 2],
     Option<LocalSection>,
     Option<RelativeErrors>,
 )> {
+    let local = last.and_then(|l| l.local.as_ref());
     let one = |hyp: Hypothesis| -> Result<(ClosedFormState, RelativeErrors)> {
         Ok(match contact {
             None => {
-                let s = inflate(law, hyp, ms.lambda_s).map_err(|e| {
-                    AppError::gps(format!("{} inflation at the FE's λs", hyp.label()), e)
-                })?;
+                let known = last
+                    .and_then(|l| l.gps_inflation)
+                    .filter(|_| hyp == Hypothesis::Gps);
+                let s = match known {
+                    Some(s) => s,
+                    None => inflate(law, hyp, ms.lambda_s).map_err(|e| {
+                        AppError::gps(format!("{} inflation at the FE's λs", hyp.label()), e)
+                    })?,
+                };
                 (
                     ClosedFormState::Inflation(s),
                     RelativeErrors {
@@ -206,9 +214,15 @@ fn stage_closed_form(
                 )
             }
             Some(c) => {
-                let s = flatten(law, hyp, c.initial_stretch, c.values.rho).map_err(|e| {
-                    AppError::gps(format!("{} flattening at the FE's ρ", hyp.label()), e)
-                })?;
+                let known = last
+                    .and_then(|l| l.gps_flattening)
+                    .filter(|_| hyp == Hypothesis::Gps);
+                let s = match known {
+                    Some(s) => s,
+                    None => flatten(law, hyp, c.initial_stretch, c.values.rho).map_err(|e| {
+                        AppError::gps(format!("{} flattening at the FE's ρ", hyp.label()), e)
+                    })?,
+                };
                 (
                     ClosedFormState::Flattening(s),
                     RelativeErrors {
@@ -498,13 +512,13 @@ fn run_inner(
             });
             return Err(error);
         }
-        let (ms, contact, its, neg, local) = match steps.last() {
+        let (ms, contact, its, neg, last_cf) = match steps.last() {
             Some(l) => (
                 l.midspan,
                 l.contact,
                 l.newton_iterations,
                 l.negative_pivots,
-                l.closed_form.local.clone(),
+                Some(l.closed_form.clone()),
             ),
             None => (
                 midspan(&model, &state).map_err(|source| AppError::Post { stage: i, source })?,
@@ -522,7 +536,7 @@ fn run_inner(
             closed_form_law.as_ref(),
             &ms,
             contact.as_ref(),
-            local.as_ref(),
+            last_cf.as_ref(),
         )?;
         let summary = StageSummary {
             index: i,

@@ -38,7 +38,11 @@ fn bench(c: &mut Criterion) {
     let mut g = Vector12::zeros();
     let mut h = Matrix12::zeros();
     c.bench_function("volume_kernel_with_hessian", |b| {
-        b.iter(|| volume_kernel(black_box(&x), Some(&mut g), Some(&mut h)))
+        b.iter(|| {
+            g = Vector12::zeros();
+            h = Matrix12::zeros();
+            volume_kernel(black_box(&x), Some(&mut g), Some(&mut h))
+        })
     });
     let contact = Contact {
         planes: vec![Plane {

@@ -96,8 +96,15 @@ impl RefElement {
     }
 
     /// The element's nodal positions taken from the global array `x`.
+    #[inline]
     pub fn gather(&self, x: &[[f64; 3]]) -> [Vec3; 4] {
-        self.nodes.map(|i| Vec3::from(x[i]))
+        let n = &self.nodes;
+        [
+            Vec3::from(x[n[0]]),
+            Vec3::from(x[n[1]]),
+            Vec3::from(x[n[2]]),
+            Vec3::from(x[n[3]]),
+        ]
     }
 
     /// x at Gauss point `g`.

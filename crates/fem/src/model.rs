@@ -135,13 +135,12 @@ impl Term for Contact {
     }
 }
 
+/// One element's energy, residual, volume and volume gradient.
 struct Local {
     energy: f64,
     r: Vector12,
-    k: Matrix12,
     v: f64,
     g: Vector12,
-    h: Matrix12,
 }
 
 /// Global quantities at a configuration.
@@ -270,40 +269,60 @@ impl Model {
         tangent: bool,
         terms: &[&dyn Term],
     ) -> Result<Assembled, FemError> {
-        let locals: Vec<Result<Local, FemError>> = self
-            .elements
-            .par_iter()
-            .enumerate()
-            .map(|(e, el)| {
-                let xe = el.gather(x);
-                let mut l = Local {
-                    energy: 0.0,
-                    r: Vector12::zeros(),
-                    k: Matrix12::zeros(),
-                    v: 0.0,
-                    g: Vector12::zeros(),
-                    h: Matrix12::zeros(),
-                };
-                for term in terms {
-                    l.energy += term.add(e, el, &xe, &mut l.r, tangent.then_some(&mut l.k))?;
-                }
-                l.v = volume_kernel(&xe, Some(&mut l.g), tangent.then_some(&mut l.h));
-                Ok(l)
-            })
-            .collect();
+        // Each element writes its 12 × 12 entries straight into its own contiguous range of
+        // the value arrays (the pattern lists entries element by element); the vectors and
+        // scalars come back per element and are summed in element order. No element matrix is
+        // stored, and the result does not depend on the number of threads.
+        let (mut k_int, mut k_vol) = if tangent {
+            (vec![0.0; self.pattern.len()], vec![0.0; self.pattern.len()])
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let mut slices: Vec<(&mut [f64], &mut [f64])> = Vec::with_capacity(self.elements.len());
+        if tangent {
+            let (mut ki, mut kv) = (k_int.as_mut_slice(), k_vol.as_mut_slice());
+            for e in 0..self.elements.len() {
+                let n = self.pattern.element_entries(e).len();
+                let (a, rest_i) = ki.split_at_mut(n);
+                let (b, rest_v) = kv.split_at_mut(n);
+                slices.push((a, b));
+                ki = rest_i;
+                kv = rest_v;
+            }
+        }
+        let locals: Vec<Result<Local, FemError>> = if tangent {
+            self.elements
+                .par_iter()
+                .zip(slices.par_iter_mut())
+                .enumerate()
+                .map(|(e, (el, (ki, kv)))| {
+                    let (mut k, mut h) = (Matrix12::zeros(), Matrix12::zeros());
+                    let l = self.element(e, el, x, terms, Some((&mut k, &mut h)))?;
+                    for (slot, &(i, j)) in self.pattern.element_entries(e).iter().enumerate() {
+                        let (i, j) = (i as usize, j as usize);
+                        ki[slot] = k[(i, j)];
+                        kv[slot] = h[(i, j)];
+                    }
+                    Ok(l)
+                })
+                .collect()
+        } else {
+            self.elements
+                .par_iter()
+                .enumerate()
+                .map(|(e, el)| self.element(e, el, x, terms, None))
+                .collect()
+        };
+        drop(slices);
         let n_eq = self.n_eq();
         let mut out = Assembled {
             energy: 0.0,
             f_int: vec![0.0; n_eq],
             volume: 0.0,
             g: vec![0.0; n_eq],
-            k_int: Vec::new(),
-            k_vol: Vec::new(),
+            k_int,
+            k_vol,
         };
-        if tangent {
-            out.k_int.reserve(self.pattern.len());
-            out.k_vol.reserve(self.pattern.len());
-        }
         for (e, l) in locals.into_iter().enumerate() {
             let l = l?;
             out.energy += l.energy;
@@ -313,13 +332,6 @@ impl Model {
                 if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {
                     out.f_int[a] += l.r[i];
                     out.g[a] += l.g[i];
-                }
-            }
-            if tangent {
-                for &(i, j) in self.pattern.element_entries(e) {
-                    let (i, j) = (i as usize, j as usize);
-                    out.k_int.push(l.k[(i, j)]);
-                    out.k_vol.push(l.h[(i, j)]);
                 }
             }
         }
@@ -334,6 +346,34 @@ impl Model {
             }
         }
         Ok(out)
+    }
+
+    /// One element: the terms' energy and residual (and stiffness into `mats.0`), the volume,
+    /// its gradient (and Hessian into `mats.1`). The matrices must come in zeroed.
+    fn element(
+        &self,
+        e: usize,
+        el: &RefElement,
+        x: &[[f64; 3]],
+        terms: &[&dyn Term],
+        mats: Option<(&mut Matrix12, &mut Matrix12)>,
+    ) -> Result<Local, FemError> {
+        let xe = el.gather(x);
+        let mut l = Local {
+            energy: 0.0,
+            r: Vector12::zeros(),
+            v: 0.0,
+            g: Vector12::zeros(),
+        };
+        let (mut k, h) = match mats {
+            Some((k, h)) => (Some(k), Some(h)),
+            None => (None, None),
+        };
+        for term in terms {
+            l.energy += term.add(e, el, &xe, &mut l.r, k.as_deref_mut())?;
+        }
+        l.v = volume_kernel(&xe, Some(&mut l.g), h);
+        Ok(l)
     }
 
     /// Factorize K = K_int − p H; if K is singular, retry with diagonal shifts of 1e-10 …

@@ -171,10 +171,7 @@ impl Mesh {
     pub fn membrane_volume_at(&self, x: &[[f64; 3]]) -> f64 {
         self.quads
             .iter()
-            .map(|q| {
-                let xe = q.map(|i| x[i]);
-                quad_volume(&xe)
-            })
+            .map(|q| quad_volume(&[x[q[0]], x[q[1]], x[q[2]], x[q[3]]]))
             .sum()
     }
 

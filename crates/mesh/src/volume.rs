@@ -24,6 +24,12 @@ pub type Matrix12 = SMatrix<f64, 12, 12>;
 /// Position and tangent vectors g1 = ∂x/∂ξ, g2 = ∂x/∂η of a bilinear quad at (ξ, η).
 pub fn tangents(x: &[Vector3<f64>; 4], xi: f64, eta: f64) -> [Vector3<f64>; 3] {
     let (n, d) = shape(xi, eta);
+    tangents_with(x, &n, &d)
+}
+
+/// [`tangents`] from shape-function values and derivatives already at hand.
+#[inline]
+fn tangents_with(x: &[Vector3<f64>; 4], n: &[f64; 4], d: &[[f64; 2]; 4]) -> [Vector3<f64>; 3] {
     let mut out = [Vector3::zeros(); 3];
     for a in 0..4 {
         out[0] += x[a] * n[a];
@@ -33,25 +39,18 @@ pub fn tangents(x: &[Vector3<f64>; 4], xi: f64, eta: f64) -> [Vector3<f64>; 3] {
     out
 }
 
-/// Volume contribution of one quad, (1/3) ∫ x·(g1 × g2) dξdη; fills its gradient and Hessian
-/// when asked (they are overwritten).
+/// Volume contribution of one quad, (1/3) ∫ x·(g1 × g2) dξdη; adds its gradient and Hessian
+/// into `grad` and `hess` when asked (the caller zeroes them).
 pub fn volume_kernel(
     x: &[Vector3<f64>; 4],
     mut grad: Option<&mut Vector12>,
     mut hess: Option<&mut Matrix12>,
 ) -> f64 {
-    // (assignment, not `fill`: nalgebra's `fill` walks the entries one by one, 20× slower)
-    if let Some(g) = grad.as_deref_mut() {
-        *g = Vector12::zeros();
-    }
-    if let Some(h) = hess.as_deref_mut() {
-        *h = Matrix12::zeros();
-    }
     let third = 1.0 / 3.0;
     let mut v = 0.0;
     for &(xi, eta) in &GAUSS2 {
         let (n, d) = shape(xi, eta);
-        let [p, g1, g2] = tangents(x, xi, eta);
+        let [p, g1, g2] = tangents_with(x, &n, &d);
         let g12 = g1.cross(&g2);
         v += third * p.dot(&g12);
         if let Some(grad) = grad.as_deref_mut() {
@@ -88,5 +87,11 @@ pub fn volume_kernel(
 
 /// The volume contribution of one quad given as plain coordinates.
 pub fn quad_volume(x: &[[f64; 3]; 4]) -> f64 {
-    volume_kernel(&x.map(Vector3::from), None, None)
+    let xv = [
+        Vector3::from(x[0]),
+        Vector3::from(x[1]),
+        Vector3::from(x[2]),
+        Vector3::from(x[3]),
+    ];
+    volume_kernel(&xv, None, None)
 }
