@@ -62,6 +62,9 @@ pub enum CaseError {
     Material(#[source] MaterialError),
 }
 
+/// The largest case file read: 1 MiB (a case is a few hundred bytes; a larger file is not one).
+pub const MAX_CASE_FILE_BYTES: u64 = 1 << 20;
+
 macro_rules! invalid {
     ($($arg:tt)*) => { return Err(CaseError::Invalid(format!($($arg)*))) };
 }
@@ -82,6 +85,9 @@ pub struct Case {
     /// the stages resolved by validation (filled by [`Case::parse`])
     #[serde(skip)]
     plan: Vec<StagePlan>,
+    /// the hash of the case text ([`crate::output::case_hash`])
+    #[serde(skip)]
+    hash: String,
 }
 
 /// `[solver]`: optional.
@@ -333,10 +339,13 @@ impl StageSpec {
 impl Case {
     /// Read and validate a case file; user mesh paths are relative to its folder.
     pub fn read(path: &Path) -> Result<Self, CaseError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            tubemem_mesh::io::read_text_limited(path, MAX_CASE_FILE_BYTES).map_err(|reason| {
+                CaseError::Read {
+                    path: path.to_path_buf(),
+                    source: std::io::Error::other(reason),
+                }
+            })?;
         let mut case = Self::parse(&text).map_err(|e| CaseError::In {
             path: path.to_path_buf(),
             source: Box::new(e),
@@ -349,7 +358,13 @@ impl Case {
     pub fn parse(text: &str) -> Result<Self, CaseError> {
         let mut case: Case = toml::from_str(text).map_err(|e| CaseError::Syntax(e.to_string()))?;
         case.plan = case.validate()?;
+        case.hash = crate::output::case_hash(text);
         Ok(case)
+    }
+
+    /// The hash of the case text the case was parsed from.
+    pub fn hash(&self) -> &str {
+        &self.hash
     }
 
     /// The resolved stages.

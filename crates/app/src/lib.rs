@@ -92,6 +92,10 @@ pub enum AppError {
     Figure { path: PathBuf, message: String },
     #[error("overlay {}: {message}", path.display())]
     Overlay { path: PathBuf, message: String },
+    #[error("interrupted at stage {stage} after {steps} converged steps of it")]
+    Interrupted { stage: usize, steps: usize },
+    #[error("output folder {}: {message}", path.display())]
+    Folder { path: PathBuf, message: String },
     #[error("an observer stopped the run at stage {stage}, step {step}")]
     Observer {
         stage: usize,

@@ -8,7 +8,7 @@
 //! 3. The figures (Figs. 5–7, λz) with the FE points overlaid.
 
 use crate::case::Case;
-use crate::output::RunWriter;
+use crate::output::{FolderMode, RunWriter};
 use crate::report::RunReport;
 use crate::run::{run, Observer};
 use crate::{figures, AppError, Result};
@@ -66,7 +66,8 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
     let limits = paper_limits()?;
     let case = Case::parse(DEFAULT_CASE)?;
     let run_dir = out.join("squeeze");
-    let mut writer = RunWriter::new(&run_dir);
+    // the main job's own folder: each run of it replaces the last
+    let mut writer = RunWriter::create(&run_dir, FolderMode::Overwrite, case.hash())?;
     let mut all: Vec<&mut dyn Observer> = vec![&mut writer];
     all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
     let report = run(

@@ -4,7 +4,15 @@
 //! * `vtu/step_NNNNN.vtu` + `tube.pvd`: a frame per step (frame 0 is the reference state);
 //! * `profiles/stageN_final.csv`: the profile along the tube at each stage end;
 //! * `summary.json`: [`RunReport::summary`], rewritten (atomically: write, then rename) after
-//!   every stage and on failure, so a run that fails midway loses nothing that had converged.
+//!   every stage and on failure, so a run that fails midway loses nothing that had converged;
+//! * `run.json`: the manifest — status `running`, `finished`, `failed` or `interrupted`, the
+//!   process, the case's hash, start and end times, the error — written atomically at the start,
+//!   after every stage and at the end.
+//!
+//! The folder is the run's alone: [`RunWriter::create`] takes an exclusive lock on
+//! `.tubemem.lock` (a second run into it is refused and told which process holds it; the lock
+//! dies with its process), and refuses a folder that already holds a run unless told to
+//! overwrite it, so frames of an earlier run can never mix with a new one.
 
 use crate::report::{RunReport, StepRecord};
 use crate::run::{BoxError, Observer, StepView};
@@ -81,22 +89,146 @@ fn format_row(r: &StepRecord) -> String {
     fields.join(",")
 }
 
+/// What to do with an output folder that already holds a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FolderMode {
+    /// refuse it
+    Fresh,
+    /// remove the earlier run's files (only tubemem's own) and start afresh
+    Overwrite,
+}
+
+/// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
+pub const RUN_ENTRIES: [&str; 8] = [
+    "steps.csv",
+    "summary.json",
+    "run.json",
+    "tube.pvd",
+    "vtu",
+    "profiles",
+    ".summary.json.tmp",
+    ".run.json.tmp",
+];
+
+const LOCK: &str = ".tubemem.lock";
+
+/// FNV-1a (64 bit) of the case text: the manifest's record of which case ran.
+pub fn case_hash(text: &str) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("fnv1a64:{h:016x}")
+}
+
+fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0)
+}
+
+/// The manifest `run.json`.
+#[derive(serde::Serialize)]
+struct Manifest<'a> {
+    status: &'a str,
+    tubemem: &'a str,
+    pid: u32,
+    case: &'a str,
+    case_hash: &'a str,
+    started_unix: f64,
+    finished_unix: Option<f64>,
+    stages_finished: usize,
+    steps_written: usize,
+    error: Option<String>,
+}
+
 /// Writes a run folder.
 pub struct RunWriter {
     dir: PathBuf,
     steps: Option<BufWriter<File>>,
     pvd: Vec<(f64, String)>,
     frames: usize,
+    rows: usize,
+    /// held for the writer's life: the folder's exclusive lock
+    _lock: File,
+    case_hash: String,
+    started: f64,
 }
 
 impl RunWriter {
-    pub fn new(dir: &Path) -> Self {
-        Self {
+    /// Take the folder `dir` for a run of the case whose text hashes to `case_hash`
+    /// ([`case_hash`]): create it, lock it, and refuse (`Fresh`) or clear (`Overwrite`) an
+    /// earlier run found in it.
+    pub fn create(dir: &Path, mode: FolderMode, case_hash: &str) -> Result<Self> {
+        let folder = |message: String| AppError::Folder {
+            path: dir.to_path_buf(),
+            message,
+        };
+        std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
+        let lock_path = dir.join(LOCK);
+        let mut lock = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&lock_path)
+            .map_err(|e| AppError::io(&lock_path, e))?;
+        match lock.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let holder = std::fs::read_to_string(&lock_path).unwrap_or_default();
+                return Err(folder(format!(
+                    "another tubemem run is writing into it ({}); wait for it or choose another --out",
+                    if holder.trim().is_empty() { "process unknown".to_string() } else { holder.trim().to_string() }
+                )));
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(AppError::io(&lock_path, e)),
+        }
+        let present: Vec<&str> = RUN_ENTRIES
+            .iter()
+            .copied()
+            .filter(|e| dir.join(e).exists())
+            .collect();
+        if !present.is_empty() {
+            match mode {
+                FolderMode::Fresh => {
+                    return Err(folder(format!(
+                        "it already holds a run ({}); use --overwrite to replace it, or choose another --out",
+                        present.join(", ")
+                    )))
+                }
+                FolderMode::Overwrite => {
+                    for e in present {
+                        let p = dir.join(e);
+                        let r = if p.is_dir() {
+                            std::fs::remove_dir_all(&p)
+                        } else {
+                            std::fs::remove_file(&p)
+                        };
+                        r.map_err(|err| AppError::io(&p, err))?;
+                    }
+                }
+            }
+        }
+        {
+            use std::io::Seek;
+            lock.set_len(0).map_err(|e| AppError::io(&lock_path, e))?;
+            lock.seek(std::io::SeekFrom::Start(0))
+                .map_err(|e| AppError::io(&lock_path, e))?;
+            write!(lock, "pid {}", std::process::id()).map_err(|e| AppError::io(&lock_path, e))?;
+        }
+        Ok(Self {
             dir: dir.to_path_buf(),
             steps: None,
             pvd: vec![],
             frames: 0,
-        }
+            rows: 0,
+            _lock: lock,
+            case_hash: case_hash.to_string(),
+            started: unix_now(),
+        })
     }
 
     /// The number of VTU frames written.
@@ -162,6 +294,40 @@ impl RunWriter {
         Ok(())
     }
 
+    fn write_manifest(
+        &self,
+        report: &RunReport,
+        status: &str,
+        error: Option<String>,
+    ) -> Result<()> {
+        let finished = report
+            .stages
+            .iter()
+            .filter(|s| matches!(s.outcome, crate::report::StageOutcome::Finished(_)))
+            .count();
+        let m = Manifest {
+            status,
+            tubemem: env!("CARGO_PKG_VERSION"),
+            pid: std::process::id(),
+            case: &report.case,
+            case_hash: &self.case_hash,
+            started_unix: self.started,
+            finished_unix: (status != "running").then(unix_now),
+            stages_finished: finished,
+            steps_written: self.rows,
+            error,
+        };
+        let text = serde_json::to_string_pretty(&m).map_err(|e| AppError::Output {
+            what: "run.json".into(),
+            source: Box::new(e),
+        })?;
+        atomic_write(
+            &self.dir.join("run.json"),
+            &self.dir.join(".run.json.tmp"),
+            &text,
+        )
+    }
+
     fn write_summary(&self, report: &RunReport) -> Result<()> {
         let path = self.dir.join("summary.json");
         let tmp = self.dir.join(".summary.json.tmp");
@@ -170,9 +336,15 @@ impl RunWriter {
                 what: path.display().to_string(),
                 source: Box::new(e),
             })?;
-        std::fs::write(&tmp, text).map_err(|e| AppError::io(&tmp, e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| AppError::io(&path, e))
+        atomic_write(&path, &tmp, &text)
     }
+}
+
+/// Write `text` to `tmp`, then rename it over `path`: a reader sees the old file or the new one,
+/// never a partial one.
+fn atomic_write(path: &Path, tmp: &Path, text: &str) -> Result<()> {
+    std::fs::write(tmp, text).map_err(|e| AppError::io(tmp, e))?;
+    std::fs::rename(tmp, path).map_err(|e| AppError::io(path, e))
 }
 
 /// Write a profile (one row per ring) as CSV.
@@ -211,6 +383,7 @@ impl Observer for RunWriter {
         if let Some(steps) = &mut self.steps {
             writeln!(steps, "{}", format_row(view.record))?;
             steps.flush()?;
+            self.rows += 1;
         }
         self.frame(view.model, view.state, view.load.contact.as_ref())
     }
@@ -224,14 +397,26 @@ impl Observer for RunWriter {
             write_profile(&path, &stage.profile)?;
         }
         self.write_summary(report)?;
+        self.write_manifest(report, "running", None)?;
         Ok(())
     }
 
-    fn failed(&mut self, report: &RunReport, _error: &AppError) {
+    fn finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
+        self.write_manifest(report, "finished", None)?;
+        Ok(())
+    }
+
+    fn failed(&mut self, report: &RunReport, error: &AppError) {
         // Best effort: the run's error is what the user must see; a summary that cannot be
         // written here would have failed at the last stage end as well.
         if self.dir.is_dir() {
             let _ = self.write_summary(report);
+            let status = if matches!(error, AppError::Interrupted { .. }) {
+                "interrupted"
+            } else {
+                "failed"
+            };
+            let _ = self.write_manifest(report, status, Some(error.chain()));
         }
     }
 }

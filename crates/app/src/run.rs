@@ -256,12 +256,30 @@ fn stage_closed_form(
     Ok((both, section, errors))
 }
 
+/// How a run is driven from outside.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// once set (by a signal handler, or Python's Ctrl-C), the run stops at the next Newton
+    /// iteration with [`AppError::Interrupted`], keeping every converged step
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+}
+
 /// Run a validated case; `label` names it in the report. Observers see every converged step as
 /// it comes. The outcome always carries the report (every converged step) and, if the run
 /// failed, the error, which every observer has also been told of.
 pub fn run(case: &Case, label: &str, observers: &mut [&mut dyn Observer]) -> RunOutcome {
+    run_with(case, label, &RunOptions::default(), observers)
+}
+
+/// [`run`] with options.
+pub fn run_with(
+    case: &Case,
+    label: &str,
+    options: &RunOptions,
+    observers: &mut [&mut dyn Observer],
+) -> RunOutcome {
     let mut report = None;
-    let error = run_inner(case, label, observers, &mut report).err();
+    let error = run_inner(case, label, options, observers, &mut report).err();
     let report = report.unwrap_or_else(|| RunReport {
         case: label.to_string(),
         mesh: MeshInfo {
@@ -292,6 +310,7 @@ pub fn run(case: &Case, label: &str, observers: &mut [&mut dyn Observer]) -> Run
 fn run_inner(
     case: &Case,
     label: &str,
+    options: &RunOptions,
     observers: &mut [&mut dyn Observer],
     slot: &mut Option<RunReport>,
 ) -> Result<()> {
@@ -302,6 +321,7 @@ fn run_inner(
     let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;
     let mut model = Model::new(mesh, law).map_err(AppError::Model)?;
+    model.set_interrupt(options.interrupt.clone());
     model.set_settings(NewtonSettings {
         rtol: case.solver.rtol,
         max_iterations: case.solver.max_iterations,
@@ -343,6 +363,84 @@ fn run_inner(
         for o in observers.iter_mut() {
             o.stage_started(plan, stages);
         }
+        // A stage from the stress-free state first takes a small pressure step (the pre-stress,
+        // ϖ = 0.01, `StepSettings::prestress`): a stress-free membrane has no stiffness against
+        // its inextensional modes. When the target's own pressure (GPS, eq. 66) is not well
+        // above that, the pre-stress is half of it, so that the stage runs from the
+        // pre-stressed state up to the target; a pressure target below it is approached from
+        // above, and a first step that would undo the pre-stress starts from it instead.
+        let settings = StepSettings {
+            initial_steps: plan.steps,
+            ..StepSettings::default()
+        };
+        let mut prestressed_from: Option<f64> = None;
+        // the controlled value before any pre-stress: where the stage's steps are measured from
+        let from_before = match plan.target {
+            Target::Stretch(_) => Some(state.x[node][0]),
+            Target::VolumeRatio(_) => Some(model.total_volume(&state.x)),
+            _ => None,
+        };
+        if state.p == 0.0 && !matches!(plan.target, Target::Rho(_)) {
+            let estimate = match plan.target {
+                Target::Pressure(p) => Some(p),
+                Target::Stretch(s) => inflate(closed_form_law.as_ref(), Hypothesis::Gps, s)
+                    .ok()
+                    .map(|g| g.w),
+                Target::VolumeRatio(r) => {
+                    inflate(closed_form_law.as_ref(), Hypothesis::Gps, r.cbrt())
+                        .ok()
+                        .map(|g| g.w)
+                }
+                Target::Rho(_) => None,
+            };
+            let mut pre = settings;
+            let target_pressure = matches!(plan.target, Target::Pressure(_));
+            if let Some(w) = estimate.filter(|w| *w > 0.0 && 0.5 * w < settings.prestress) {
+                if !target_pressure {
+                    pre.prestress = 0.5 * w;
+                    pre.min_prestress = pre.min_prestress.min(0.5 * pre.prestress);
+                }
+            } else if target_pressure {
+                pre.prestress = 0.0; // a pressure stage from zero needs none
+            }
+            if pre.prestress > 0.0 && estimate.is_some_and(|w| w > 0.0) {
+                let stage = Stage {
+                    index: i,
+                    from: 0.0,
+                    to: 1.0,
+                    settings: pre,
+                };
+                tubemem_fem::stepping::prestress::<BoxError>(&mut model, &mut state, &stage)
+                    .map_err(|e| match e {
+                        StageError::Solve(tubemem_fem::FemError::Interrupted) => {
+                            AppError::Interrupted { stage: i, steps: 0 }
+                        }
+                        StageError::Solve(source) => AppError::Stage {
+                            stage: i,
+                            stages,
+                            source,
+                        },
+                        StageError::Observer { step, source, .. } => AppError::Observer {
+                            stage: i,
+                            step,
+                            source,
+                        },
+                    })?;
+                let now = match plan.target {
+                    Target::Stretch(_) => state.x[node][0],
+                    Target::VolumeRatio(_) => model.total_volume(&state.x),
+                    _ => state.p,
+                };
+                let first = match (plan.target, from_before) {
+                    (Target::Stretch(s), Some(f0)) => f0 + (s - f0) / plan.steps as f64,
+                    (Target::VolumeRatio(r), Some(f0)) => f0 + (r * v0 - f0) / plan.steps as f64,
+                    _ => f64::INFINITY,
+                };
+                if target_pressure || now >= first {
+                    prestressed_from = Some(now);
+                }
+            }
+        }
         // for a squeeze: the inflated mid-span stretch λs* and the gas constant at its start
         let start =
             midspan(&model, &state).map_err(|source| AppError::Post { stage: i, source })?;
@@ -360,7 +458,7 @@ fn run_inner(
             });
             AppError::StageInput { stage: i, message }
         };
-        let (from, to, load): (f64, f64, Box<dyn Fn(f64) -> Load>) = match plan.target {
+        let (mut from, to, load): (f64, f64, Box<dyn Fn(f64) -> Load>) = match plan.target {
             Target::Pressure(p) => (state.p, p, Box::new(Load::pressure)),
             Target::Stretch(s) => (
                 state.x[node][0],
@@ -412,14 +510,15 @@ fn run_inner(
                 )
             }
         };
+        match (prestressed_from, from_before) {
+            (Some(f), _) | (None, Some(f)) => from = f,
+            _ => {}
+        }
         let stage = Stage {
             index: i,
             from,
             to,
-            settings: StepSettings {
-                initial_steps: plan.steps,
-                ..StepSettings::default()
-            },
+            settings,
         };
         let mut steps: Vec<StepRecord> = vec![];
         let result = run_stage(&mut model, &mut state, &stage, &load, |m, st, info| {
@@ -485,6 +584,10 @@ fn run_inner(
         });
         if let Err(e) = result {
             let error = match e {
+                StageError::Solve(tubemem_fem::FemError::Interrupted) => AppError::Interrupted {
+                    stage: i,
+                    steps: steps.len(),
+                },
                 StageError::Solve(source) => AppError::Stage {
                     stage: i,
                     stages,

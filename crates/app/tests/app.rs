@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 use tubemem_app::case::Case;
-use tubemem_app::output::{step_row, RunWriter};
+use tubemem_app::output::{step_row, FolderMode, RunWriter};
 use tubemem_app::report::StageOutcome;
 use tubemem_app::run::run;
 
@@ -25,7 +25,7 @@ fn tmp(name: &str) -> PathBuf {
 fn the_files_are_the_report() {
     let case = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
     let out = tmp("files");
-    let mut writer = RunWriter::new(&out);
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
     let report = run(&case, "small", &mut [&mut writer])
         .into_result()
         .unwrap();
@@ -68,7 +68,7 @@ fn the_files_are_the_report() {
 fn a_precondition_failure_is_recorded() {
     let case = Case::parse(&format!("{SMALL}{}", SQUEEZE.replace("1.0", "5.0"))).unwrap();
     let out = tmp("precondition");
-    let mut writer = RunWriter::new(&out);
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
     let outcome = run(&case, "small", &mut [&mut writer]);
     let err = outcome.error.expect("the squeeze cannot start");
     let text = err.chain();

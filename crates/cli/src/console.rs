@@ -2,6 +2,7 @@
 //! Newton residual), or one line per converged step when the output is not a terminal; and the
 //! closing lines of each stage, printed from the typed report.
 
+use crate::say;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use tubemem_app::case::StagePlan;
@@ -13,6 +14,8 @@ use tubemem_fem::model::{Model, State};
 pub struct Console {
     bar: Option<ProgressBar>,
     terminal: bool,
+    /// a write error of a method that cannot return one, reported at the next that can
+    pending: Option<std::io::Error>,
 }
 
 impl Default for Console {
@@ -20,20 +23,21 @@ impl Default for Console {
         Self {
             bar: None,
             terminal: std::io::stderr().is_terminal(),
+            pending: None,
         }
     }
 }
 
 impl Observer for Console {
     fn started(&mut self, report: &RunReport, _m: &Model, _s: &State) -> Result<(), BoxError> {
-        println!(
+        say!(
             "tubemem run: {} — {} elements, {} equations ({} model), {}",
             report.case,
             report.mesh.elements,
             report.mesh.equations,
             report.mesh.symmetry,
             report.material
-        );
+        )?;
         Ok(())
     }
 
@@ -55,12 +59,15 @@ impl Observer for Console {
             );
             bar.set_prefix(label);
             self.bar = Some(bar);
-        } else {
-            println!("{label}");
+        } else if let Err(e) = say!("{label}") {
+            self.pending = Some(e);
         }
     }
 
     fn step(&mut self, v: &StepView) -> Result<(), BoxError> {
+        if let Some(e) = self.pending.take() {
+            return Err(Box::new(e));
+        }
         let r = v.record;
         let res = r.residuals.last().copied().unwrap_or(f64::NAN);
         let msg = format!(
@@ -72,7 +79,7 @@ impl Observer for Console {
                 bar.set_position((1000.0 * v.fraction.clamp(0.0, 1.0)) as u64);
                 bar.set_message(msg);
             }
-            None => println!("  stage {} {msg} ({:.0} %)", r.stage, 100.0 * v.fraction),
+            None => say!("  stage {} {msg} ({:.0} %)", r.stage, 100.0 * v.fraction)?,
         }
         Ok(())
     }
@@ -90,28 +97,28 @@ impl Observer for Console {
         let ms = &s.final_state.midspan;
         let (w, ls, lz, chi, force) = values(&s.gps);
         let (ps_w, _, _, ps_chi, ps_force) = values(&s.ps);
-        println!(
+        say!(
             "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6} (GPS {:.6}), λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
             s.index, ms.w, w, 100.0 * rel(ms.w, w), ps_w, ms.lambda_s, ls, ms.lambda_z, lz, ms.n_s, ms.n_z, ms.n_sz
-        );
+        )?;
         if let Some(c) = &s.final_state.contact {
-            println!(
+            say!(
                 "         ρ = {:.4}: χ = {:.5} (GPS {:.5}, PS {:.5}), force ϖχ = {:.5} (GPS {:.5}, {:+.2}%; PS {:.5}), contact pressure {:.4}, penetration {:.1e}",
                 c.rho, c.chi, chi, ps_chi, c.force, force, 100.0 * rel(c.force, force), ps_force, c.contact_pressure, c.penetration
-            );
+            )?;
             if let Some(LocalSection::Solved(l)) = &s.gps_at_fe_pressure {
-                println!(
+                say!(
                     "         GPS section at the FE's pressure ϖ = {:.6} (eq. 76, no gas law): λs {:+.3}%, λz {:+.3}%, χ {:+.3}%, force {:+.3}%",
                     ms.w,
                     100.0 * rel(ms.lambda_s, l.lambda_s),
                     100.0 * rel(ms.lambda_z, l.lambda_z),
                     100.0 * rel(c.chi, l.chi),
                     100.0 * rel(c.force, l.force)
-                );
+                )?;
             }
         }
         if let Some(d) = s.cap_boundary_layer {
-            println!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)");
+            say!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)")?;
         }
         Ok(())
     }

@@ -121,10 +121,10 @@ fn ensure_finite(values: &[f64]) -> Result<()> {
 fn print_state<T: Serialize>(state: &T, json: bool) -> Result<()> {
     let v = serde_json::to_value(state)?;
     if json {
-        println!("{v}");
+        crate::say!("{v}")?;
     } else if let Some(map) = v.as_object() {
         for (k, x) in map {
-            println!("{k:>13} = {x}");
+            crate::say!("{k:>13} = {x}")?;
         }
     }
     Ok(())
@@ -145,7 +145,7 @@ pub fn run(cmd: GpsCommand) -> Result<()> {
                     let from = a.from.unwrap_or(1.0);
                     let c = inflation_curve(law.as_ref(), hyp, from, to, points)?;
                     write_csv(csv, INFLATION_HEADER, c.iter().map(inflation_values))?;
-                    println!("wrote {} {} inflation states (λs {from} → {to}) to {}", c.len(), hyp.label(), csv.display());
+                    crate::say!("wrote {} {} inflation states (λs {from} → {to}) to {}", c.len(), hyp.label(), csv.display())?;
                     Ok(())
                 }
                 _ => bail!("give either --stretch λs (one state) or --to, --points and --csv (a curve, with optional --from)"),
@@ -163,13 +163,13 @@ pub fn run(cmd: GpsCommand) -> Result<()> {
                 (None, Some(to), Some(points), Some(csv)) => {
                     let c = flattening_curve(law.as_ref(), hyp, a.initial_stretch, to, points)?;
                     write_csv(csv, FLATTENING_HEADER, c.iter().map(flattening_values))?;
-                    println!(
+                    crate::say!(
                         "wrote {} {} flattening states (ρ {} → {to}) to {}",
                         c.len(),
                         hyp.label(),
                         a.initial_stretch,
                         csv.display()
-                    );
+                    )?;
                     Ok(())
                 }
                 _ => bail!("give either --rho ρ (one state) or --to, --points and --csv (a curve)"),
@@ -194,28 +194,32 @@ fn print_limits(l: &Limits, json: bool) -> Result<()> {
     ensure_finite(&nums)?;
     if json {
         let v = serde_json::json!({ "max": l.max, "min": l.min, "maxwell": l.maxwell });
-        println!("{v}");
+        crate::say!("{v}")?;
         return Ok(());
     }
     let point = |name: &str, p: Option<tubemem_gps::limits::LimitPoint>| match p {
-        Some(p) => println!(
+        Some(p) => crate::say!(
             "{name:>8}: ϖ = {:.10}  at λs = {:.10}, λz = {:.10}",
-            p.w, p.lambda_s, p.lambda_z
+            p.w,
+            p.lambda_s,
+            p.lambda_z
         ),
-        None => println!("{name:>8}: none"),
+        None => crate::say!("{name:>8}: none"),
     };
-    point("maximum", l.max);
-    point("minimum", l.min);
+    point("maximum", l.max)?;
+    point("minimum", l.min)?;
     match l.maxwell {
-        Some(m) => println!(
+        Some(m) => crate::say!(
             " Maxwell: ϖ = {:.10}  coexisting λs = {:.10} and {:.10}",
-            m.w, m.lambda_s_lower, m.lambda_s_upper
-        ),
-        None => println!(" Maxwell: none"),
+            m.w,
+            m.lambda_s_lower,
+            m.lambda_s_upper
+        )?,
+        None => crate::say!(" Maxwell: none")?,
     }
-    println!(
+    crate::say!(
         "(inflation curve scanned for λs from 1 to {:.3})",
         l.scanned_to
-    );
+    )?;
     Ok(())
 }

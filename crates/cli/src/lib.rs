@@ -5,3 +5,19 @@
 pub mod console;
 pub mod gps_cmd;
 pub mod material_args;
+
+/// Write one line to standard output. A closed or full standard output (`> /dev/full`, a pipe
+/// whose reader has gone) is an error that the caller reports, never a panic.
+pub fn say(line: impl std::fmt::Display) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut o = std::io::stdout().lock();
+    writeln!(o, "{line}")
+        .and_then(|()| o.flush())
+        .map_err(|e| std::io::Error::new(e.kind(), format!("cannot write to standard output: {e}")))
+}
+
+/// `say!(…)`: `println!` that returns the write error instead of panicking.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => { $crate::say(format_args!($($arg)*)) };
+}

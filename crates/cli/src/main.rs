@@ -6,11 +6,14 @@
 use anyhow::Context;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use tubemem_app::case::Case;
-use tubemem_app::output::RunWriter;
-use tubemem_app::run::Observer;
+use tubemem_app::output::{FolderMode, RunWriter};
+use tubemem_app::run::{Observer, RunOptions};
 use tubemem_cli::console::Console;
 use tubemem_cli::gps_cmd;
 
@@ -37,9 +40,12 @@ enum Command {
     Run {
         /// The case file (TOML).
         case: PathBuf,
-        /// Output folder (created if missing).
+        /// Output folder (created if missing). A folder that already holds a run is refused.
         #[arg(long, default_value = "tubemem-out/run")]
         out: PathBuf,
+        /// Replace the run already in the output folder (only tubemem's own files are removed).
+        #[arg(long)]
+        overwrite: bool,
     },
     /// Write PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure.
     Figures {
@@ -61,36 +67,58 @@ fn app(e: tubemem_app::AppError) -> anyhow::Error {
 }
 
 fn main_job() -> Result<()> {
-    println!("tubemem — the paper's example (Anssari-Benam–Bucchi membrane, 𝒩 = 30; ϖ = pR/μH)\n");
+    tubemem_cli::say!(
+        "tubemem — the paper's example (Anssari-Benam–Bucchi membrane, 𝒩 = 30; ϖ = pR/μH)\n"
+    )?;
     let limits = tubemem_app::main_job::paper_limits().map_err(app)?;
-    println!("{}\n", tubemem_app::main_job::limits_text(&limits));
+    tubemem_cli::say!("{}\n", tubemem_app::main_job::limits_text(&limits))?;
     let mut console = Console::default();
     let job =
         tubemem_app::main_job::run_main_job(&PathBuf::from("tubemem-out"), &mut [&mut console])
             .map_err(app)?;
-    println!("\n{}", job.table());
+    tubemem_cli::say!("\n{}", job.table())?;
     for p in &job.figures {
-        println!("wrote {}", p.display());
+        tubemem_cli::say!("wrote {}", p.display())?;
     }
     Ok(())
 }
 
-fn run_case(case_path: &std::path::Path, out: &std::path::Path) -> Result<()> {
+/// Set by SIGINT or SIGTERM: the run stops at its next Newton iteration and records that it
+/// was interrupted.
+fn interrupt_flag() -> Option<Arc<AtomicBool>> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let f = flag.clone();
+    // if a handler cannot be installed the run simply cannot be interrupted cleanly
+    ctrlc::set_handler(move || f.store(true, Ordering::Relaxed))
+        .ok()
+        .map(|()| flag)
+}
+
+fn run_case(case_path: &std::path::Path, out: &std::path::Path, overwrite: bool) -> Result<()> {
     let case = Case::read(case_path).map_err(|e| app(e.into()))?;
-    let mut writer = RunWriter::new(out);
+    let mode = if overwrite {
+        FolderMode::Overwrite
+    } else {
+        FolderMode::Fresh
+    };
+    let mut writer = RunWriter::create(out, mode, case.hash()).map_err(app)?;
     let mut console = Console::default();
-    let outcome = tubemem_app::run::run(
+    let options = RunOptions {
+        interrupt: interrupt_flag(),
+    };
+    let outcome = tubemem_app::run::run_with(
         &case,
         &case_path.display().to_string(),
+        &options,
         &mut [&mut writer as &mut dyn Observer, &mut console],
     );
     match outcome.error {
         None => {
-            println!(
+            tubemem_cli::say!(
                 "wrote {}/steps.csv, summary.json, profiles/, tube.pvd ({} VTU frames)",
                 out.display(),
                 writer.frames()
-            );
+            )?;
             Ok(())
         }
         Some(e) => Err(app(e)).with_context(|| {
@@ -106,11 +134,15 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => main_job(),
         Some(Command::Gps { command }) => gps_cmd::run(command),
-        Some(Command::Run { case, out }) => run_case(&case, &out),
+        Some(Command::Run {
+            case,
+            out,
+            overwrite,
+        }) => run_case(&case, &out, overwrite),
         Some(Command::Figures { out, kuhn, overlay }) => {
             let written = tubemem_app::figures::write_all(&out, kuhn, &overlay).map_err(app)?;
             for p in written {
-                println!("wrote {}", p.display());
+                tubemem_cli::say!("wrote {}", p.display())?;
             }
             Ok(())
         }
@@ -121,8 +153,20 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e)
+            if e.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<tubemem_app::AppError>(),
+                    Some(tubemem_app::AppError::Interrupted { .. })
+                )
+            }) =>
+        {
+            let _ = writeln!(std::io::stderr(), "error: {e:#}");
+            ExitCode::from(130)
+        }
         Err(e) => {
-            eprintln!("error: {e:#}");
+            // a closed standard error cannot be reported anywhere: the exit code says it
+            let _ = writeln!(std::io::stderr(), "error: {e:#}");
             ExitCode::FAILURE
         }
     }

@@ -67,9 +67,13 @@ pub enum FemError {
     ZeroPivot { index: usize, value: f64 },
     #[error("tangent matrix entry {entry} is not finite")]
     NonFiniteEntry { entry: usize },
+    /// The run was asked to stop (SIGINT, SIGTERM, Ctrl-C in Python) between two Newton
+    /// iterations.
+    #[error("interrupted")]
+    Interrupted,
     #[error("sparse factorization failed: {reason}")]
     Factorization { reason: String },
-    #[error("invalid parameter `{name}` = {value}: {requirement}")]
+    #[error("invalid parameter `{name}` = {}: {requirement}", tubemem_material::Num(*value))]
     InvalidParameter {
         name: &'static str,
         value: f64,

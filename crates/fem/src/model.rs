@@ -159,6 +159,8 @@ pub struct Assembled {
 
 /// The finite element model of one mesh and one law.
 pub struct Model {
+    /// set from outside (a signal handler) to stop the solve at the next Newton iteration
+    interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     mesh: Mesh,
     law: Box<dyn MembraneLaw>,
     elements: Vec<RefElement>,
@@ -189,6 +191,7 @@ impl Model {
         }
         let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
         Ok(Self {
+            interrupt: None,
             mesh,
             law,
             elements,
@@ -201,6 +204,17 @@ impl Model {
 
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
+    }
+    /// A flag that, once set, makes the next Newton iteration fail with
+    /// [`FemError::Interrupted`] (the stepping then stops at once, keeping every converged step).
+    pub fn set_interrupt(&mut self, flag: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.interrupt = flag;
+    }
+    /// Whether the interrupt flag is set.
+    pub fn interrupted(&self) -> bool {
+        self.interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
     }
     pub fn law(&self) -> &dyn MembraneLaw {
         self.law.as_ref()
@@ -481,6 +495,21 @@ impl Model {
     }
 }
 
+/// The pressure below which forces count as zero in the convergence test: ϖ = 1e-6 (six
+/// orders below the pressures of the paper's examples). Near the stress-free state the internal
+/// force vanishes, and a residual measured against it alone would never converge.
+pub const PRESSURE_FLOOR: f64 = 1e-6;
+
+/// The force scale the residual is measured against: the internal force, the pressure load, or
+/// the load of [`PRESSURE_FLOOR`], whichever is largest.
+fn force_scale(a: &Assembled, p: f64) -> f64 {
+    let g = norm(&a.g);
+    norm(&a.f_int)
+        .max(p.abs() * g)
+        .max(1e-12)
+        .max(PRESSURE_FLOOR * g)
+}
+
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|a| a * a).sum::<f64>().sqrt()
 }
@@ -520,6 +549,9 @@ impl newton::Problem for MembraneProblem<'_> {
     type Error = FemError;
 
     fn linearize(&mut self, state: &mut State) -> Result<Linearization<Self::Step>, FemError> {
+        if self.model.interrupted() {
+            return Err(FemError::Interrupted);
+        }
         let m = self.model.multiplicity();
         let a = self
             .model
@@ -545,7 +577,7 @@ impl newton::Problem for MembraneProblem<'_> {
             }
             _ => (0.0, None),
         };
-        let reference = norm(&a.f_int).max(p.abs() * norm(&a.g)).max(1e-12);
+        let reference = force_scale(&a, p);
         let res = norm(&r) / reference;
         let cscale = match self.load.loading {
             Loading::Volume(v) => v.abs().max(1e-300),
@@ -613,7 +645,7 @@ impl newton::Problem for MembraneProblem<'_> {
             .zip(&trial.g)
             .map(|(f, g)| f - pt * g)
             .collect();
-        let reft = norm(&trial.f_int).max(pt.abs() * norm(&trial.g)).max(1e-12);
+        let reft = force_scale(&trial, pt);
         Ok(Evaluation {
             residual: norm(&rt) / reft,
             potential: potential(self.load.loading, trial.energy, trial.volume, pt),

@@ -80,31 +80,12 @@ pub fn run_stage<E>(
 ) -> Result<(), StageError<E>> {
     let (from, to) = (stage.from, stage.to);
     let set = &stage.settings;
+    // nothing to do: the stage ends where it starts (a target equal to the current state)
+    if (to - from).abs() <= 1e-14 * from.abs().max(to.abs()).max(1.0) {
+        return Ok(());
+    }
     if state.p == 0.0 && !matches!(load(from).loading, Loading::Pressure(_)) {
-        let mut p0 = set.prestress;
-        loop {
-            let mut trial = state.clone();
-            match model.solve(&mut trial, &Load::pressure(p0)) {
-                Ok(_) => {
-                    *state = trial;
-                    break;
-                }
-                Err(e) => {
-                    p0 *= 0.5;
-                    if p0 < set.min_prestress {
-                        return Err(StageError::Solve(FemError::Stage {
-                            stage: stage.index,
-                            step: 0,
-                            value: p0,
-                            cuts: 0,
-                            material: None,
-                            near_locking: None,
-                            source: Box::new(e),
-                        }));
-                    }
-                }
-            }
-        }
+        prestress(model, state, stage)?;
     }
     let mut lambda = 0.0;
     let mut dl = 1.0 / set.initial_steps.max(1) as f64;
@@ -145,6 +126,9 @@ pub fn run_stage<E>(
                 }
             }
             Err(e) => {
+                if matches!(e.cause(), Some(FemError::Interrupted)) {
+                    return Err(StageError::Solve(FemError::Interrupted));
+                }
                 if let Some(m) = e.cause().filter(|c| c.material_cause().is_some()) {
                     material = Some(m.clone());
                 }
@@ -169,6 +153,44 @@ pub fn run_stage<E>(
         }
     }
     Ok(())
+}
+
+/// Take the stress-free `state` to the small pressure [`StepSettings::prestress`] (halved on
+/// failure down to [`StepSettings::min_prestress`]), which converges from the reference and
+/// gives the membrane its geometric stiffness.
+pub fn prestress<E>(
+    model: &mut Model,
+    state: &mut State,
+    stage: &Stage,
+) -> Result<(), StageError<E>> {
+    let set = &stage.settings;
+    let mut p0 = set.prestress;
+    loop {
+        let mut trial = state.clone();
+        match model.solve(&mut trial, &Load::pressure(p0)) {
+            Ok(_) => {
+                *state = trial;
+                return Ok(());
+            }
+            Err(e) if matches!(e.cause(), Some(FemError::Interrupted)) => {
+                return Err(StageError::Solve(FemError::Interrupted));
+            }
+            Err(e) => {
+                p0 *= 0.5;
+                if p0 < set.min_prestress {
+                    return Err(StageError::Solve(FemError::Stage {
+                        stage: stage.index,
+                        step: 0,
+                        value: p0,
+                        cuts: 0,
+                        material: None,
+                        near_locking: None,
+                        source: Box::new(e),
+                    }));
+                }
+            }
+        }
+    }
 }
 
 /// Why a stage stopped.

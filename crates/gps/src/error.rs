@@ -5,14 +5,15 @@ use tubemem_material::MaterialError;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum GpsError {
     /// An input outside its admissible range (λs < 1, ρ ≥ λs*, a point count < 2, …).
-    #[error("invalid input `{name}` = {value}: {requirement}")]
+    #[error("invalid input `{name}` = {}: {requirement}", tubemem_material::Num(*value))]
     InvalidInput {
         name: &'static str,
         value: f64,
         requirement: &'static str,
     },
-    /// The material law rejected a state on the way (typically the locking limit).
-    #[error("{stage} at {at}: {source}")]
+    /// The material law rejected a state on the way (typically the locking limit). The cause
+    /// is `source()`, not repeated in this message: print the chain.
+    #[error("{stage} at {at}")]
     Material {
         stage: &'static str,
         at: String,

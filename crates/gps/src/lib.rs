@@ -111,7 +111,7 @@ pub struct SectionState {
 const MAX_CUTS: usize = 30;
 
 fn at_ls(ls: f64) -> String {
-    format!("λs = {ls}")
+    format!("λs = {}", tubemem_material::Num(ls))
 }
 
 /// Neo-Hookean/GPS axial stretch of eq. (68), used only as an initial guess for other laws.
@@ -161,14 +161,18 @@ fn inflation_solve(
     })
 }
 
+/// The largest stretch the closed form takes: beyond 1e6 the invariants (λ² and 1/(λs λz)²)
+/// approach overflow and underflow long before any law means anything there.
+pub const MAX_STRETCH: f64 = 1e6;
+
 fn check_stretch(ls: f64) -> Result<(), GpsError> {
-    if ls.is_finite() && ls >= 1.0 {
+    if ls.is_finite() && (1.0..=MAX_STRETCH).contains(&ls) {
         Ok(())
     } else {
         Err(invalid(
             "lambda_s",
             ls,
-            "the hoop stretch of an inflated membrane must be finite and ≥ 1",
+            "the hoop stretch of an inflated membrane must be ≥ 1 and at most 1e6",
         ))
     }
 }
@@ -183,6 +187,29 @@ pub fn inflate(
     inflation_solve(law, hyp, lambda_s, eq68_lambda_z(lambda_s))
 }
 
+/// The most points a curve may have: 10 million (0.4 GB of inflation states, 0.7 GB of
+/// flattening states, about 1 GB of CSV; a 10,000-point curve takes 2.5 ms, so this one about
+/// 2.5 s). A request for more is refused before anything is allocated.
+pub const MAX_CURVE_POINTS: usize = 10_000_000;
+
+fn check_points(points: usize) -> Result<(), GpsError> {
+    if points < 2 {
+        return Err(invalid(
+            "points",
+            points as f64,
+            "a curve needs at least 2 points",
+        ));
+    }
+    if points > MAX_CURVE_POINTS {
+        return Err(invalid(
+            "points",
+            points as f64,
+            "a curve may have at most 10,000,000 points (about 1 GB of results)",
+        ));
+    }
+    Ok(())
+}
+
 /// `points` states equally spaced in λs from `from` to `to` (both ≥ 1), each solved from the
 /// previous one (Sec. 4.3).
 pub fn inflation_curve(
@@ -194,13 +221,7 @@ pub fn inflation_curve(
 ) -> Result<Vec<InflationState>, GpsError> {
     check_stretch(from)?;
     check_stretch(to)?;
-    if points < 2 {
-        return Err(invalid(
-            "points",
-            points as f64,
-            "a curve needs at least 2 points",
-        ));
-    }
+    check_points(points)?;
     let mut out: Vec<InflationState> = Vec::with_capacity(points);
     for i in 0..points {
         let ls = from + (to - from) * i as f64 / (points - 1) as f64;
@@ -435,14 +456,9 @@ pub fn flattening_curve(
 ) -> Result<Vec<FlatteningState>, GpsError> {
     let fl = Flattening::new(law, hyp, initial_stretch)?;
     check_rho(rho_to, initial_stretch)?;
-    if points < 2 {
-        return Err(invalid(
-            "points",
-            points as f64,
-            "a curve needs at least 2 points",
-        ));
-    }
-    let mut out = vec![fl.start()];
+    check_points(points)?;
+    let mut out = Vec::with_capacity(points);
+    out.push(fl.start());
     for i in 1..points {
         let rho = initial_stretch + (rho_to - initial_stretch) * i as f64 / (points - 1) as f64;
         let n = out.len();

@@ -93,7 +93,7 @@ impl<'a> InflationPath<'a> {
         let r = resultants::resultants(self.law, ls, s.lambda_z).map_err(|source| {
             GpsError::Material {
                 stage: "inflation path slope",
-                at: format!("λs = {ls}"),
+                at: format!("λs = {}", tubemem_material::Num(ls)),
                 source,
             }
         })?;
@@ -261,7 +261,7 @@ fn maxwell(
     }
     Err(GpsError::NoConvergence {
         stage: "Maxwell equal-area pressure",
-        at: format!("ϖ = {p}"),
+        at: format!("ϖ = {}", tubemem_material::Num(p)),
         residual: hi - lo,
         iterations: 100,
     })

@@ -29,13 +29,35 @@ pub struct MeshFile {
     pub plugs: Vec<Vec<usize>>,
 }
 
+/// The largest mesh file read: 256 MiB, about 3 million nodes with their quads in this JSON
+/// form (some 80 bytes a node): already beyond what the memory guard admits for a full model.
+pub const MAX_MESH_FILE_BYTES: u64 = 256 << 20;
+
+/// Read at most `limit` bytes of a text file; a longer file (or a device such as /dev/zero)
+/// is refused with its limit named.
+pub fn read_text_limited(path: &Path, limit: u64) -> Result<String, String> {
+    use std::io::Read;
+    let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut buf = Vec::new();
+    f.take(limit + 1)
+        .read_to_end(&mut buf)
+        .map_err(|e| e.to_string())?;
+    if buf.len() as u64 > limit {
+        return Err(format!(
+            "larger than the {} MiB this file may have",
+            limit as f64 / (1u64 << 20) as f64
+        ));
+    }
+    String::from_utf8(buf).map_err(|e| format!("not UTF-8 text ({e})"))
+}
+
 /// Read and check a JSON mesh; coordinates are divided by `radius` (to units of R).
 pub fn read_json(path: &Path, radius: f64) -> Result<Mesh, MeshError> {
     let err = |reason: String| MeshError::Io {
         path: path.display().to_string(),
         reason,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    let text = read_text_limited(path, MAX_MESH_FILE_BYTES).map_err(err)?;
     let f: MeshFile =
         serde_json::from_str(&text).map_err(|e| err(format!("not a tubemem mesh file: {e}")))?;
     if f.nodes.is_empty() || f.quads.is_empty() {
@@ -49,16 +71,22 @@ pub fn read_json(path: &Path, radius: f64) -> Result<Mesh, MeshError> {
     {
         return Err(err(format!("node {i} has a non-finite coordinate {p:?}")));
     }
-    for (k, ring) in f.plugs.iter().enumerate() {
-        if let Some(&i) = ring.iter().find(|&&i| i >= f.nodes.len()) {
-            return Err(err(format!(
-                "plug {k} refers to node {i}, but the mesh has {} nodes",
-                f.nodes.len()
-            )));
-        }
+    if !(radius.is_finite() && radius > 0.0) {
+        return Err(err(format!("radius {radius} must be finite and > 0")));
+    }
+    let nodes: Vec<[f64; 3]> = f.nodes.iter().map(|p| p.map(|v| v / radius)).collect();
+    if let Some((i, p)) = nodes
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.iter().any(|v| !v.is_finite()))
+    {
+        return Err(err(format!(
+            "node {i} at {:?} divided by the radius {radius} is {p:?}: not a finite position",
+            f.nodes[i]
+        )));
     }
     let mesh = Mesh {
-        nodes: f.nodes.iter().map(|p| p.map(|v| v / radius)).collect(),
+        nodes,
         quads: f.quads,
         symmetry: f.symmetry,
         plugs: f.plugs,

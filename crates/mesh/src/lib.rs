@@ -34,10 +34,25 @@ use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use thiserror::Error;
 
+/// A number as a message shows it (scientific notation where plain would be long).
+#[derive(Clone, Copy, Debug)]
+pub struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = self.0;
+        if v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs()) {
+            write!(f, "{v:e}")
+        } else {
+            write!(f, "{v}")
+        }
+    }
+}
+
 /// A mesh error, naming the element, edge or parameter concerned.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum MeshError {
-    #[error("invalid mesh parameter `{name}` = {value}: {requirement}")]
+    #[error("invalid mesh parameter `{name}` = {}: {requirement}", Num(*value))]
     InvalidParameter {
         name: &'static str,
         value: f64,
@@ -73,6 +88,8 @@ pub enum MeshError {
         "the enclosed volume is {volume} ≤ 0: the element normals point inward (inverted mesh)"
     )]
     InwardNormals { volume: f64 },
+    #[error("plug {plug}: {reason}")]
+    InvalidPlug { plug: usize, reason: String },
     #[error("{path}: {reason}")]
     Io { path: String, reason: String },
 }
@@ -179,6 +196,37 @@ impl Mesh {
     /// its symmetry planes.
     pub fn check(&self) -> Result<(), MeshError> {
         let n = self.nodes.len();
+        if n == 0 || self.quads.is_empty() {
+            return Err(MeshError::InvalidParameter {
+                name: "mesh",
+                value: n as f64,
+                requirement: "a mesh needs nodes and quads",
+            });
+        }
+        let mut in_plug = vec![usize::MAX; n];
+        for (k, ring) in self.plugs.iter().enumerate() {
+            let bad = |reason: String| MeshError::InvalidPlug { plug: k, reason };
+            if ring.len() < 2 {
+                return Err(bad(format!(
+                    "a plug ring needs at least 2 nodes, it has {}",
+                    ring.len()
+                )));
+            }
+            for &i in ring {
+                if i >= n {
+                    return Err(bad(format!(
+                        "node {i} is out of range (the mesh has {n} nodes)"
+                    )));
+                }
+                if in_plug[i] != usize::MAX {
+                    return Err(bad(format!(
+                        "node {i} appears twice (also in plug {})",
+                        in_plug[i]
+                    )));
+                }
+                in_plug[i] = k;
+            }
+        }
         for (e, q) in self.quads.iter().enumerate() {
             for &i in q {
                 if i >= n {

@@ -34,13 +34,14 @@ const DEFAULT_MATERIAL: MaterialSpec = MaterialSpec::Abb {
 };
 
 fn gps_err(e: GpsError) -> PyErr {
+    let msg = tubemem_app::error_chain(&e);
     match e {
-        GpsError::InvalidInput { .. } => PyValueError::new_err(e.to_string()),
+        GpsError::InvalidInput { .. } => PyValueError::new_err(msg),
         GpsError::Material {
             source: MaterialError::InvalidParameter { .. },
             ..
-        } => PyValueError::new_err(e.to_string()),
-        _ => TubememError::new_err(e.to_string()),
+        } => PyValueError::new_err(msg),
+        _ => TubememError::new_err(msg),
     }
 }
 
@@ -235,33 +236,47 @@ fn run_parsed<'py>(
     case: &tubemem_app::case::Case,
     label: &str,
     out: &std::path::Path,
+    overwrite: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let outcome = py.detach(|| {
-        let mut writer = tubemem_app::output::RunWriter::new(out);
-        tubemem_app::run::run(case, label, &mut [&mut writer])
-    });
+    use tubemem_app::output::{FolderMode, RunWriter};
+    let mode = if overwrite {
+        FolderMode::Overwrite
+    } else {
+        FolderMode::Fresh
+    };
+    let mut writer =
+        RunWriter::create(out, mode, case.hash()).map_err(|e| PyValueError::new_err(e.chain()))?;
+    let outcome = py.detach(|| tubemem_app::run::run(case, label, &mut [&mut writer]));
     run_outcome(py, outcome, out)
 }
 
 /// Run a case file (TOML, as for `tubemem run`), writing steps.csv, summary.json, profiles/ and
 /// the VTU series to `out`; returns the summary as a dict. On failure the converged steps are
-/// already in `out` and `TubememError` says which stage, step and residual, and why.
+/// already in `out` and `TubememError` says which stage, step and residual, and why. A folder
+/// that already holds a run is refused (`ValueError`) unless `overwrite=True`.
 #[pyfunction]
-fn run_case<'py>(py: Python<'py>, case: PathBuf, out: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+#[pyo3(signature = (case, out, overwrite=false))]
+fn run_case<'py>(
+    py: Python<'py>,
+    case: PathBuf,
+    out: PathBuf,
+    overwrite: bool,
+) -> PyResult<Bound<'py, PyAny>> {
     let parsed = tubemem_app::case::Case::read(&case)
         .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
-    run_parsed(py, &parsed, &case.display().to_string(), &out)
+    run_parsed(py, &parsed, &case.display().to_string(), &out, overwrite)
 }
 
 /// Run a case given as TOML text (user mesh files are looked up relative to `base_dir`); as
 /// `run_case` otherwise.
 #[pyfunction]
-#[pyo3(signature = (text, out, base_dir=None))]
+#[pyo3(signature = (text, out, base_dir=None, overwrite=false))]
 fn run_case_text<'py>(
     py: Python<'py>,
     text: &str,
     out: PathBuf,
     base_dir: Option<PathBuf>,
+    overwrite: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut case = tubemem_app::case::Case::parse(text).map_err(|e| {
         PyValueError::new_err(format!(
@@ -270,7 +285,7 @@ fn run_case_text<'py>(
         ))
     })?;
     case.base_dir = base_dir.unwrap_or_default();
-    run_parsed(py, &case, "case text from Python", &out)
+    run_parsed(py, &case, "case text from Python", &out, overwrite)
 }
 
 /// The embedded default case (`cases/squeeze_abb30_ls1.3.toml`, the main job's) as TOML text.
