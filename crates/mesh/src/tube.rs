@@ -202,14 +202,14 @@ pub fn capped_tube_with_cap_rows(
     }
     check_positive("radius", radius)?;
     check_positive("length", length)?;
-    if around < 8 || around % 8 != 0 {
+    if around < 8 || !around.is_multiple_of(8) {
         return Err(MeshError::InvalidParameter {
             name: "around",
             value: around as f64,
             requirement: "elements around must be a multiple of 8 (≥ 8), so that the caps are half cube-spheres and x = 0, y = 0 are mesh lines",
         });
     }
-    if along < 2 || along % 2 != 0 {
+    if along < 2 || !along.is_multiple_of(2) {
         return Err(MeshError::InvalidParameter {
             name: "along",
             value: along as f64,
@@ -352,7 +352,7 @@ fn renumber(mesh: Mesh) -> Mesh {
 /// `m` × `m` elements per cube face (m even, ≥ 2), 6m² elements in all.
 pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshError> {
     check_positive("radius", radius)?;
-    if m < 2 || m % 2 != 0 {
+    if m < 2 || !m.is_multiple_of(2) {
         return Err(MeshError::InvalidParameter {
             name: "m",
             value: m as f64,
