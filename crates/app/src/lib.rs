@@ -92,6 +92,14 @@ pub enum AppError {
     Figure { path: PathBuf, message: String },
     #[error("overlay {}: {message}", path.display())]
     Overlay { path: PathBuf, message: String },
+    #[error("stage {stage}, step {step}: the plates penetrate the membrane by {penetration:.3e} R, {:.1} % of the plate half-gap ρ = {rho:.4} (more than {:.0} %): the penalty κ = {penalty:.3e} cannot hold them; raise `penalty` or lower `penetration_tolerance`", 100.0 * penetration / rho, 100.0 * crate::run::MAX_PENETRATION_FRACTION)]
+    ContactUnresolved {
+        stage: usize,
+        step: usize,
+        penetration: f64,
+        rho: f64,
+        penalty: f64,
+    },
     #[error("interrupted at stage {stage} after {steps} converged steps of it")]
     Interrupted { stage: usize, steps: usize },
     #[error("output folder {}: {message}", path.display())]

@@ -801,3 +801,282 @@ fn main_job_runs_the_embedded_squeeze() {
         .join("tubemem-out/figures/fig6_force_displacement_ls1.3.png")
         .exists());
 }
+
+/// Reliability: write errors on standard output (`> /dev/full`) are a clear error with exit 1,
+/// not a panic (exit 101); curves are capped before anything is allocated; the value shown is
+/// the user's, in scientific notation where plain would be a 309-digit integer.
+#[test]
+fn output_errors_and_resource_caps_are_clear_errors() {
+    for args in [
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--stretch",
+            "1.3",
+            "--json",
+        ][..],
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--stretch",
+            "1.3",
+        ][..],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+            .args(args)
+            .stdout(std::fs::File::create("/dev/full").unwrap())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("cannot write to standard output"), "{err}");
+    }
+    let d = tmp("caps");
+    let csv = d.join("x.csv");
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--from",
+            "1",
+            "--to",
+            "2",
+            "--points",
+            "18446744073709551615",
+            "--csv",
+            csv.to_str().unwrap(),
+        ],
+        "at most 10,000,000 points",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "inflate",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--stretch",
+            "1e308",
+        ],
+        "`lambda_s` = 1e308",
+    );
+}
+
+fn run_in(case: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    tubemem(&args)
+}
+
+/// Malformed user meshes are refused with the plug or node at fault: an empty plug ring
+/// (`"plugs": [[]]`) and a node that no quad uses.
+#[test]
+fn malformed_user_meshes_name_the_plug_or_node() {
+    let d = tmp("bad-mesh");
+    // a unit cube of 6 quads, outward normals
+    let cube = r#"{"nodes": [[-1,-1,-1],[1,-1,-1],[1,1,-1],[-1,1,-1],[-1,-1,1],[1,-1,1],[1,1,1],[-1,1,1]EXTRA],
+ "quads": [[0,3,2,1],[4,5,6,7],[0,1,5,4],[1,2,6,5],[2,3,7,6],[3,0,4,7]]PLUGS}"#;
+    let case = SMALL_CASE
+        .replace("around = 16\n", "file = \"mesh.json\"\n")
+        .replace("along = 24\n", "")
+        .replace("symmetry = \"eighth\"\n", "")
+        .replace("target_stretch = 1.2", "target_volume_ratio = 1.1");
+    let p = d.join("case.toml");
+    std::fs::write(&p, &case).unwrap();
+    for (extra, plugs, needle) in [
+        ("", r#", "plugs": [[]]"#, "plug 0"),
+        (",[5,5,5]", "", "node 8"),
+    ] {
+        std::fs::write(
+            d.join("mesh.json"),
+            cube.replace("EXTRA", extra).replace("PLUGS", plugs),
+        )
+        .unwrap();
+        let out = d.join(needle.replace(' ', "-"));
+        let o = run_in(&p, &out, &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && !err.contains("panicked"), "{err}");
+        assert!(err.contains(needle), "`{needle}` missing from: {err}");
+    }
+}
+
+/// One folder, one run: a run into a folder whose lock another process holds is refused and told
+/// which process holds it (here the test itself holds the lock, as a running tubemem would); a
+/// folder that holds an earlier run is refused unless `--overwrite`, which replaces it (no stale
+/// VTU frames remain); the manifest says `finished`.
+#[test]
+fn output_folders_cannot_be_mixed() {
+    let d = tmp("folders");
+    let out = d.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let long = d.join("long.toml");
+    std::fs::write(&long, SMALL_CASE.replace("steps = 4", "steps = 12")).unwrap();
+    let short = d.join("short.toml");
+    std::fs::write(&short, SMALL_CASE).unwrap();
+    {
+        use std::io::Write;
+        let mut lock = std::fs::File::create(out.join(".tubemem.lock")).unwrap();
+        lock.try_lock().unwrap();
+        write!(lock, "pid {}", std::process::id()).unwrap();
+        let o = run_in(&long, &out, &["--overwrite"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "a locked folder must be refused");
+        assert!(
+            err.contains("another tubemem run")
+                && err.contains(&format!("pid {}", std::process::id())),
+            "{err}"
+        );
+    }
+    let o = run_in(&long, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let long_rows = Steps::read(&out.join("steps.csv")).rows.len();
+    // the folder now holds a finished run: refused without --overwrite
+    let o = run_in(&short, &out, &[]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--overwrite"));
+    let o = run_in(&short, &out, &["--overwrite"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let steps = Steps::read(&out.join("steps.csv"));
+    assert!(
+        steps.rows.len() < long_rows,
+        "the shorter run replaced the longer one"
+    );
+    let frames = std::fs::read_dir(out.join("vtu")).unwrap().count();
+    assert_eq!(frames, steps.rows.len() + 1, "no stale frames");
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(manifest["status"], "finished");
+    assert_eq!(manifest["steps_written"], steps.rows.len());
+}
+
+/// SIGINT stops a run at its next Newton iteration: exit 130, every converged step kept, the
+/// summary and the manifest say "interrupted".
+#[test]
+fn an_interrupted_run_says_so_and_keeps_its_steps() {
+    let d = tmp("sigint");
+    let case = d.join("case.toml");
+    std::fs::write(&case, SMALL_CASE.replace("steps = 4", "steps = 2000")).unwrap();
+    let out = d.join("out");
+    let child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while t0.elapsed().as_secs() < 30 {
+        let rows = std::fs::read_to_string(out.join("steps.csv"))
+            .map(|t| t.lines().count())
+            .unwrap_or(0);
+        if rows >= 4 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(manifest["status"], "interrupted");
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(s["stages"][0]["error"]
+        .as_str()
+        .unwrap()
+        .contains("interrupted"));
+    let steps = Steps::read(&out.join("steps.csv"));
+    assert!(steps.rows.len() >= 3);
+    assert_eq!(manifest["steps_written"], steps.rows.len());
+}
+
+/// Accepted input that used to give nonsense is refused: a penalty too small to hold the plates,
+/// or a squeeze down to ρ = 1e-9, stop with the penetration against the plate gap; targets at or
+/// next to the stress-free state work (the 16-gon's pressure factor 1/cos(π/16) − 1 = 1.96 %).
+#[test]
+fn nonsense_is_refused_and_small_targets_work() {
+    let d = tmp("nonsense");
+    for (extra, rho) in [("penalty = 1e-300\n", "1.0"), ("", "1e-9")] {
+        let case = d.join(format!("sq{rho}.toml"));
+        std::fs::write(
+            &case,
+            format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = {rho}\n{extra}"),
+        )
+        .unwrap();
+        let o = run_in(&case, &d.join(format!("o{rho}")), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{err}");
+        assert!(
+            err.contains("penetrate") && err.contains("plate half-gap"),
+            "{err}"
+        );
+    }
+    for (k, (from, to)) in [
+        ("target_stretch = 1.2", "target_stretch = 1.00001"),
+        ("target_stretch = 1.2", "target_volume_ratio = 1"),
+        (
+            "control = \"volume\"\ntarget_stretch = 1.2",
+            "control = \"pressure\"\ntarget_pressure = 1e-5",
+        ),
+        (
+            "control = \"volume\"\ntarget_stretch = 1.2",
+            "control = \"pressure\"\ntarget_pressure = 0",
+        ),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let case = d.join(format!("small{k}.toml"));
+        std::fs::write(&case, SMALL_CASE.replace(from, to)).unwrap();
+        let out = d.join(format!("small{k}"));
+        let o = run_in(&case, &out, &[]);
+        assert!(
+            o.status.success(),
+            "{to}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let s: Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let (w, gw) = (
+            num(&s["stages"][0]["final"], "w"),
+            num(&s["stages"][0]["gps"], "w"),
+        );
+        if gw > 0.0 {
+            let factor = 1.0 / (std::f64::consts::PI / 16.0).cos();
+            assert!(
+                (w / gw / factor - 1.0).abs() < 1e-3,
+                "{to}: ϖ {w} vs GPS {gw}"
+            );
+        } else {
+            assert_eq!(w, 0.0);
+        }
+    }
+}
