@@ -552,7 +552,7 @@ fn run_inner(
             }
             if let Some(c) = &contact {
                 let (pen, rho) = (c.values.penetration, c.values.rho);
-                if !(pen <= MAX_PENETRATION_FRACTION * rho) {
+                if pen.is_nan() || pen > MAX_PENETRATION_FRACTION * rho {
                     return Err(Box::new(AppError::ContactUnresolved {
                         stage: i,
                         step: info.step,
