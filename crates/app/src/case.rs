@@ -62,6 +62,10 @@ pub enum CaseError {
     Material(#[source] MaterialError),
 }
 
+/// The longest tube, in radii: 10,000 (the README's studies go to L/R = 80; at 10,000 even one
+/// element per radius along is 10,000 rings).
+pub const MAX_LENGTH_RATIO: f64 = 1e4;
+
 /// The largest case file read: 1 MiB (a case is a few hundred bytes; a larger file is not one).
 pub const MAX_CASE_FILE_BYTES: u64 = 1 << 20;
 
@@ -198,7 +202,7 @@ fn default_steps() -> usize {
 }
 
 /// What a stage drives, once validated.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "control", content = "value", rename_all = "kebab-case")]
 pub enum Target {
     /// reduced pressure ϖ, pressure control
@@ -224,7 +228,7 @@ impl Target {
 }
 
 /// How the contact penalty of a squeeze is set.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PenaltySpec {
     /// κ given
@@ -234,7 +238,7 @@ pub enum PenaltySpec {
 }
 
 /// A stage resolved once by validation: what the run executes.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StagePlan {
     /// 1-based
     pub index: usize,
@@ -380,8 +384,21 @@ impl Case {
             ("thickness", g.thickness),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                invalid!("[geometry] `{k}` = {v}: must be finite and > 0");
+                invalid!(
+                    "[geometry] `{k}` = {}: must be finite and > 0",
+                    tubemem_material::Num(v)
+                );
             }
+        }
+        let ratio = g.length / g.radius;
+        if !(ratio.is_finite() && ratio > 0.0 && ratio <= MAX_LENGTH_RATIO) {
+            invalid!(
+                "[geometry] `length` / `radius` = {} / {} = {}: L/R must be in (0, {}] (results are per R; a longer tube cannot be meshed)",
+                tubemem_material::Num(g.length),
+                tubemem_material::Num(g.radius),
+                tubemem_material::Num(ratio),
+                MAX_LENGTH_RATIO
+            );
         }
         let m = &self.mesh;
         match (&m.file, m.around, m.along) {

@@ -100,6 +100,12 @@ pub enum AppError {
         rho: f64,
         penalty: f64,
     },
+    #[error("the model is too large for this machine: about {equations} equations need an estimated {:.1} GiB, and {:.1} GiB are available (estimate: 8 MiB + 240 B·n·log2 n, fitted to peak memory at 4.5k–104k equations; use --force to try anyway)", *estimate_bytes as f64 / (1u64 << 30) as f64, *available_bytes as f64 / (1u64 << 30) as f64)]
+    TooLarge {
+        equations: usize,
+        estimate_bytes: u64,
+        available_bytes: u64,
+    },
     #[error("interrupted at stage {stage} after {steps} converged steps of it")]
     Interrupted { stage: usize, steps: usize },
     #[error("output folder {}: {message}", path.display())]

@@ -15,7 +15,7 @@
 //! overwrite it, so frames of an earlier run can never mix with a new one.
 
 use crate::report::{RunReport, StepRecord};
-use crate::run::{BoxError, Observer, StepView};
+use crate::run::{BoxError, Checkpoint, Observer, StepView};
 use crate::{AppError, Result};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -99,7 +99,8 @@ pub enum FolderMode {
 }
 
 /// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
-pub const RUN_ENTRIES: [&str; 8] = [
+pub const RUN_ENTRIES: [&str; 9] = [
+    "checkpoints",
     "steps.csv",
     "summary.json",
     "run.json",
@@ -155,6 +156,55 @@ pub struct RunWriter {
     _lock: File,
     case_hash: String,
     started: f64,
+    /// continuing a run: the files are there already
+    resumed: bool,
+}
+
+const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT1";
+
+/// Write a checkpoint: magic, header length (u64 LE), the header as JSON (exact floats), the
+/// node count (u64 LE), the positions and the pressure as f64 LE.
+fn write_checkpoint(path: &Path, tmp: &Path, ck: &Checkpoint) -> Result<()> {
+    let header = serde_json::to_vec(ck).map_err(|e| AppError::Output {
+        what: path.display().to_string(),
+        source: Box::new(e),
+    })?;
+    let mut buf = Vec::with_capacity(40 + header.len() + 24 * ck.x.len());
+    buf.extend_from_slice(CHECKPOINT_MAGIC);
+    buf.extend_from_slice(&(header.len() as u64).to_le_bytes());
+    buf.extend_from_slice(&header);
+    buf.extend_from_slice(&(ck.x.len() as u64).to_le_bytes());
+    for p in &ck.x {
+        for v in p {
+            buf.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    buf.extend_from_slice(&ck.p.to_le_bytes());
+    std::fs::write(tmp, &buf).map_err(|e| AppError::io(tmp, e))?;
+    std::fs::rename(tmp, path).map_err(|e| AppError::io(path, e))
+}
+
+/// Read a checkpoint written by [`write_checkpoint`]; `None` if it is not a whole one.
+fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
+    let buf = std::fs::read(path).ok()?;
+    let rest = buf.strip_prefix(CHECKPOINT_MAGIC)?;
+    let u64_at =
+        |b: &[u8]| -> Option<u64> { Some(u64::from_le_bytes(b.get(..8)?.try_into().ok()?)) };
+    let hl = usize::try_from(u64_at(rest)?).ok()?;
+    let header = rest.get(8..8usize.checked_add(hl)?)?;
+    let mut ck: Checkpoint = serde_json::from_slice(header).ok()?;
+    let rest = rest.get(8 + hl..)?;
+    let n = usize::try_from(u64_at(rest)?).ok()?;
+    let data = rest.get(8..)?;
+    if data.len() != n.checked_mul(24)?.checked_add(8)? {
+        return None;
+    }
+    let f = |k: usize| f64::from_le_bytes(data[8 * k..8 * k + 8].try_into().expect("8 bytes"));
+    ck.x = (0..n)
+        .map(|i| [f(3 * i), f(3 * i + 1), f(3 * i + 2)])
+        .collect();
+    ck.p = f(3 * n);
+    Some(ck)
 }
 
 impl RunWriter {
@@ -167,25 +217,7 @@ impl RunWriter {
             message,
         };
         std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
-        let lock_path = dir.join(LOCK);
-        let mut lock = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&lock_path)
-            .map_err(|e| AppError::io(&lock_path, e))?;
-        match lock.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                let holder = std::fs::read_to_string(&lock_path).unwrap_or_default();
-                return Err(folder(format!(
-                    "another tubemem run is writing into it ({}); wait for it or choose another --out",
-                    if holder.trim().is_empty() { "process unknown".to_string() } else { holder.trim().to_string() }
-                )));
-            }
-            Err(std::fs::TryLockError::Error(e)) => return Err(AppError::io(&lock_path, e)),
-        }
+        let writer = Self::create_locked(dir, case_hash)?;
         let present: Vec<&str> = RUN_ENTRIES
             .iter()
             .copied()
@@ -194,10 +226,19 @@ impl RunWriter {
         if !present.is_empty() {
             match mode {
                 FolderMode::Fresh => {
-                    return Err(folder(format!(
-                        "it already holds a run ({}); use --overwrite to replace it, or choose another --out",
-                        present.join(", ")
-                    )))
+                    // we hold the lock, so a manifest still saying "running" is a killed run
+                    let killed = std::fs::read_to_string(dir.join("run.json"))
+                        .ok()
+                        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+                        .is_some_and(|m| m["status"] == "running");
+                    return Err(folder(if killed {
+                        "it holds a run that was killed (its manifest says running, but no process holds the folder); use --resume to continue it from its last checkpoint, --overwrite to replace it, or choose another --out".to_string()
+                    } else {
+                        format!(
+                            "it already holds a run ({}); use --overwrite to replace it, or choose another --out",
+                            present.join(", ")
+                        )
+                    }));
                 }
                 FolderMode::Overwrite => {
                     for e in present {
@@ -211,6 +252,91 @@ impl RunWriter {
                     }
                 }
             }
+        }
+        Ok(writer)
+    }
+
+    /// Take the folder `dir` back to continue its run: lock it, read the newest checkpoint
+    /// (`checkpoints/`, the last two are kept), check that the case is the one that ran, and cut
+    /// steps.csv and the VTU series back to that checkpoint (a kill may have come between a
+    /// step's files and its checkpoint). Returns the writer and the checkpoint to give to
+    /// [`crate::run::RunOptions::resume`].
+    pub fn resume(dir: &Path, case_hash: &str) -> Result<(Self, Checkpoint)> {
+        let folder = |message: String| AppError::Folder {
+            path: dir.to_path_buf(),
+            message,
+        };
+        if !dir.join("checkpoints").is_dir() {
+            return Err(folder("it holds no checkpoint to resume from".into()));
+        }
+        let mut w = Self::create_locked(dir, case_hash)?;
+        let ck = ["a", "b"]
+            .iter()
+            .filter_map(|k| read_checkpoint(&dir.join("checkpoints").join(format!("ckpt-{k}.bin"))))
+            .max_by_key(|c| c.rows)
+            .ok_or_else(|| folder("no whole checkpoint in checkpoints/".into()))?;
+        if ck.case_hash != case_hash {
+            return Err(folder(format!(
+                "the case has changed since the run started (hash {} then, {case_hash} now): resume with the same case file, or start afresh with --overwrite",
+                ck.case_hash
+            )));
+        }
+        // steps.csv: the header and the checkpoint's rows
+        let path = dir.join("steps.csv");
+        let text = std::fs::read_to_string(&path).map_err(|e| AppError::io(&path, e))?;
+        let kept: Vec<&str> = text.lines().take(1 + ck.rows).collect();
+        if kept.len() != 1 + ck.rows {
+            return Err(folder(format!(
+                "steps.csv has {} rows but the checkpoint {}",
+                kept.len().saturating_sub(1),
+                ck.rows
+            )));
+        }
+        std::fs::write(&path, format!("{}\n", kept.join("\n")))
+            .map_err(|e| AppError::io(&path, e))?;
+        // frames past the checkpoint
+        for k in ck.frames.. {
+            let f = dir.join("vtu").join(format!("step_{k:05}.vtu"));
+            if !f.exists() {
+                break;
+            }
+            std::fs::remove_file(&f).map_err(|e| AppError::io(&f, e))?;
+        }
+        write_pvd(&dir.join("tube.pvd"), &ck.pvd).map_err(AppError::Mesh)?;
+        let steps = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .map_err(|e| AppError::io(&path, e))?;
+        w.steps = Some(BufWriter::new(steps));
+        w.pvd = ck.pvd.clone();
+        w.frames = ck.frames;
+        w.rows = ck.rows;
+        w.resumed = true;
+        Ok((w, ck))
+    }
+
+    fn create_locked(dir: &Path, case_hash: &str) -> Result<Self> {
+        let lock_path = dir.join(LOCK);
+        let mut lock = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&lock_path)
+            .map_err(|e| AppError::io(&lock_path, e))?;
+        match lock.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let holder = std::fs::read_to_string(&lock_path).unwrap_or_default();
+                return Err(AppError::Folder {
+                    path: dir.to_path_buf(),
+                    message: format!(
+                        "another tubemem run is writing into it ({}); wait for it or choose another --out",
+                        if holder.trim().is_empty() { "process unknown" } else { holder.trim() }
+                    ),
+                });
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(AppError::io(&lock_path, e)),
         }
         {
             use std::io::Seek;
@@ -228,6 +354,7 @@ impl RunWriter {
             _lock: lock,
             case_hash: case_hash.to_string(),
             started: unix_now(),
+            resumed: false,
         })
     }
 
@@ -363,10 +490,14 @@ pub fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
 impl Observer for RunWriter {
     fn started(
         &mut self,
-        _report: &RunReport,
+        report: &RunReport,
         model: &Model,
         state: &State,
     ) -> Result<(), BoxError> {
+        self.write_manifest(report, "running", None)?;
+        if self.resumed {
+            return Ok(());
+        }
         for sub in ["vtu", "profiles"] {
             let d = self.dir.join(sub);
             std::fs::create_dir_all(&d).map_err(|e| AppError::io(&d, e))?;
@@ -385,7 +516,29 @@ impl Observer for RunWriter {
             steps.flush()?;
             self.rows += 1;
         }
-        self.frame(view.model, view.state, view.load.contact.as_ref())
+        self.frame(view.model, view.state, view.load.contact.as_ref())?;
+        // the checkpoint of this step, alternating between two files (the last two are kept)
+        let dir = self.dir.join("checkpoints");
+        std::fs::create_dir_all(&dir).map_err(|e| AppError::io(&dir, e))?;
+        let ck = Checkpoint {
+            case_hash: self.case_hash.clone(),
+            context: *view.context,
+            progress: view.progress,
+            report: view.report.clone(),
+            steps: view.stage_steps.to_vec(),
+            rows: self.rows,
+            frames: self.frames,
+            pvd: self.pvd.clone(),
+            x: view.state.x.clone(),
+            p: view.state.p,
+        };
+        let name = if self.rows.is_multiple_of(2) {
+            "ckpt-a.bin"
+        } else {
+            "ckpt-b.bin"
+        };
+        write_checkpoint(&dir.join(name), &dir.join(".ckpt.tmp"), &ck)?;
+        Ok(())
     }
 
     fn stage_finished(&mut self, report: &RunReport) -> Result<(), BoxError> {

@@ -3,13 +3,13 @@
 //! returns it as arrays and dicts.
 
 use crate::case::{StagePlan, Target};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use tubemem_fem::post::{ContactValues, MidSpan, RingValues};
 use tubemem_gps::{FlatteningState, InflationState, SectionState};
 use tubemem_material::MaterialSpec;
 
 /// What the mesh and model are.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MeshInfo {
     pub nodes: usize,
     pub elements: usize,
@@ -17,7 +17,7 @@ pub struct MeshInfo {
     pub symmetry: String,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct GeometryInfo {
     pub radius: f64,
     pub length: f64,
@@ -30,7 +30,7 @@ pub struct GeometryInfo {
 /// mid-span pressure (eq. 76 without the gas law: the local mechanics, free of the end effect
 /// that acts through the shared gas). A closed form without a solution is `None` (the run goes
 /// on; the stage summary says why).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StepClosedForm {
     pub gps_inflation: Option<InflationState>,
     pub gps_flattening: Option<FlatteningState>,
@@ -39,7 +39,7 @@ pub struct StepClosedForm {
 }
 
 /// Contact values of a squeeze step (mid-span, [`ContactValues`]) with the displacement λs* − ρ.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct ContactRecord {
     #[serde(flatten)]
     pub values: ContactValues,
@@ -51,7 +51,7 @@ pub struct ContactRecord {
 }
 
 /// One converged step.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StepRecord {
     pub stage: usize,
     pub step: usize,
@@ -68,7 +68,7 @@ pub struct StepRecord {
 }
 
 /// The final state of a stage (the `final` entry of summary.json).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StageFinal {
     #[serde(flatten)]
     pub midspan: MidSpan,
@@ -80,7 +80,7 @@ pub struct StageFinal {
     pub contact: Option<FinalContact>,
 }
 
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct FinalContact {
     pub rho: f64,
     pub chi: f64,
@@ -95,7 +95,8 @@ pub struct FinalContact {
 }
 
 /// Relative errors FE − closed form (inflation: w, λz, N_s, N_z; squeeze: w, λs, λz, χ, force).
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct RelativeErrors {
     pub w: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -113,15 +114,16 @@ pub struct RelativeErrors {
 }
 
 /// A closed-form state of either kind.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum ClosedFormState {
-    Inflation(InflationState),
+    // (untagged: deserialization tries the variants in order, so the larger one comes first)
     Flattening(FlatteningState),
+    Inflation(InflationState),
 }
 
 /// The section at the FE's pressure, or why it has no solution.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum LocalSection {
     Solved(SectionState),
@@ -129,7 +131,7 @@ pub enum LocalSection {
 }
 
 /// Elements in one regime at a stage end, with the range of reference height they occupy.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RegimeExtent {
     pub elements: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -138,17 +140,17 @@ pub struct RegimeExtent {
     pub z_ref_max: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Wrinkling {
     pub wrinkled: RegimeExtent,
     pub slack: RegimeExtent,
 }
 
 /// The summary of a finished stage (one entry of summary.json's `stages`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StageSummary {
     pub index: usize,
-    pub kind: &'static str,
+    pub kind: String,
     pub target: Target,
     #[serde(rename = "final")]
     pub final_state: StageFinal,
@@ -168,7 +170,7 @@ pub struct StageSummary {
 }
 
 /// A stage that failed: its error and the last converged mid-span state.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StageFailure {
     pub index: usize,
     pub error: String,
@@ -176,7 +178,7 @@ pub struct StageFailure {
 }
 
 /// One stage of the report: its plan, its steps and how it ended.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StageReport {
     pub plan: StagePlan,
     pub steps: Vec<StepRecord>,
@@ -185,7 +187,7 @@ pub struct StageReport {
     pub profile: Vec<RingValues>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum StageOutcome {
     Finished(Box<StageSummary>),
@@ -193,7 +195,7 @@ pub enum StageOutcome {
 }
 
 /// A whole run.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RunReport {
     pub case: String,
     pub mesh: MeshInfo,
@@ -201,7 +203,7 @@ pub struct RunReport {
     pub material: String,
     pub material_spec: MaterialSpec,
     pub geometry: GeometryInfo,
-    pub units: &'static str,
+    pub units: String,
     pub stages: Vec<StageReport>,
 }
 
@@ -228,7 +230,7 @@ impl RunReport {
             material: &self.material,
             material_spec: &self.material_spec,
             geometry: &self.geometry,
-            units: self.units,
+            units: &self.units,
             stages: self.stages.iter().map(|s| &s.outcome).collect(),
         }
     }

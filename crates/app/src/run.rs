@@ -7,7 +7,7 @@ use crate::{AppError, Result};
 use tubemem_fem::contact::{penalty_for, Contact};
 use tubemem_fem::model::{nearest_node, Load, Loading, Model, State};
 use tubemem_fem::post::{cell_values, midspan, midspan_contact, ring_profile, Regime};
-use tubemem_fem::stepping::{run_stage, Stage, StageError, StepSettings};
+use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepSettings};
 use tubemem_fem::NewtonSettings;
 use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
@@ -25,6 +25,13 @@ pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
 /// What an observer sees at a converged step.
 pub struct StepView<'a> {
+    /// the run so far: the finished stages
+    pub report: &'a RunReport,
+    /// the current stage's steps so far, this one last
+    pub stage_steps: &'a [StepRecord],
+    /// how the current stage was set up, and where its stepping stands (for checkpoints)
+    pub context: &'a StageContext,
+    pub progress: tubemem_fem::stepping::StepState,
     pub model: &'a Model,
     pub state: &'a State,
     pub load: &'a Load,
@@ -262,12 +269,259 @@ fn stage_closed_form(
     Ok((both, section, errors))
 }
 
+/// The estimated peak memory of a model with `equations` equations: 8 MiB + 240 B·n·log2 n.
+/// Fitted to the measured peak RSS of pressure-controlled runs (release, this 2-core machine):
+/// 19.7, 56.9, 167 and 414 MiB at 4,520, 16,280, 47,904 and 104,448 equations (the fit is
+/// within 10 % there); at 978,432 equations it gives 4.7 GiB against the 3.6 GiB measured, so
+/// it errs on the safe side as the factor's fill grows more slowly than n log n.
+pub fn memory_estimate(equations: usize) -> u64 {
+    let n = equations.max(2) as f64;
+    (8.0 * (1u64 << 20) as f64 + 240.0 * n * n.log2()) as u64
+}
+
+/// The equations of the case's generated tube, counted before it is built: the full tube has
+/// about around·along cylinder nodes plus 0.375·around² in the two cube-sphere caps (exact for
+/// the default cap rows), three unknowns each, divided by the symmetry multiplicity.
+pub fn equations_estimate(case: &Case) -> Option<usize> {
+    let (around, along) = (case.mesh.around? as f64, case.mesh.along? as f64);
+    let nodes = around * along + 0.375 * around * around;
+    Some((3.0 * nodes / case.mesh.symmetry.multiplicity()) as usize)
+}
+
+/// The memory this machine has available (`MemAvailable` of /proc/meminfo), if it says.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+fn check_memory(equations: usize, force: bool) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    let estimate = memory_estimate(equations);
+    match available_memory() {
+        Some(available) if estimate > available => Err(AppError::TooLarge {
+            equations,
+            estimate_bytes: estimate,
+            available_bytes: available,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// What a stage is set up with at its start. A checkpoint stores it, so that a restart
+/// continues the stage exactly as the interrupted run would have.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StageContext {
+    pub stage: usize,
+    /// the load parameter at the start and the end of the stage
+    pub from: f64,
+    pub to: f64,
+    /// Boyle's constant of a squeeze (0 otherwise)
+    pub pv: f64,
+    /// the contact penalty of a squeeze (0 otherwise)
+    pub penalty: f64,
+    /// the mid-span λs at the stage start (λs* of a squeeze)
+    pub start_lambda_s: f64,
+}
+
+/// A run's state after a converged step, to restart from ([`crate::output::RunWriter`] writes
+/// them, [`crate::output::RunWriter::resume`] reads the newest back).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Checkpoint {
+    pub case_hash: String,
+    pub context: StageContext,
+    pub progress: tubemem_fem::stepping::StepState,
+    /// the finished stages
+    pub report: RunReport,
+    /// the current stage's steps so far
+    pub steps: Vec<StepRecord>,
+    /// steps.csv rows and VTU frames written up to this step, and the PVD entries
+    pub rows: usize,
+    pub frames: usize,
+    pub pvd: Vec<(f64, String)>,
+    /// the state (stored in binary beside the header)
+    #[serde(skip)]
+    pub x: Vec<[f64; 3]>,
+    #[serde(skip)]
+    pub p: f64,
+}
+
 /// How a run is driven from outside.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
+    /// continue from this checkpoint (its case hash must be the case's)
+    pub resume: Option<Checkpoint>,
+    /// skip the memory guard (a model estimated larger than the available memory is tried)
+    pub force: bool,
     /// once set (by a signal handler, or Python's Ctrl-C), the run stops at the next Newton
     /// iteration with [`AppError::Interrupted`], keeping every converged step
     pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+}
+
+/// Set up a stage at its start: the pre-stress from a stress-free state, the load parameter's
+/// range, and for a squeeze the gas constant and the penalty. A precondition that fails is
+/// recorded in the report.
+#[allow(clippy::too_many_arguments)]
+fn setup_stage(
+    _case: &Case,
+    plan: &StagePlan,
+    stages: usize,
+    model: &mut Model,
+    state: &mut State,
+    report: &mut RunReport,
+    closed_form_law: &dyn MembraneLaw,
+    node: usize,
+    v0: f64,
+) -> Result<StageContext> {
+    let i = plan.index;
+    // A stage from the stress-free state first takes a small pressure step (the pre-stress,
+    // ϖ = 0.01, `StepSettings::prestress`): a stress-free membrane has no stiffness against
+    // its inextensional modes. When the target's own pressure (GPS, eq. 66) is not well
+    // above that, the pre-stress is half of it, so that the stage runs from the
+    // pre-stressed state up to the target; a pressure target below it is approached from
+    // above, and a first step that would undo the pre-stress starts from it instead.
+    let settings = StepSettings {
+        initial_steps: plan.steps,
+        ..StepSettings::default()
+    };
+    let mut prestressed_from: Option<f64> = None;
+    // the controlled value before any pre-stress: where the stage's steps are measured from
+    let from_before = match plan.target {
+        Target::Stretch(_) => Some(state.x[node][0]),
+        Target::VolumeRatio(_) => Some(model.total_volume(&state.x)),
+        _ => None,
+    };
+    if state.p == 0.0 && !matches!(plan.target, Target::Rho(_)) {
+        let estimate = match plan.target {
+            Target::Pressure(p) => Some(p),
+            Target::Stretch(s) => inflate(closed_form_law, Hypothesis::Gps, s)
+                .ok()
+                .map(|g| g.w),
+            Target::VolumeRatio(r) => inflate(closed_form_law, Hypothesis::Gps, r.cbrt())
+                .ok()
+                .map(|g| g.w),
+            Target::Rho(_) => None,
+        };
+        let mut pre = settings;
+        let target_pressure = matches!(plan.target, Target::Pressure(_));
+        if let Some(w) = estimate.filter(|w| *w > 0.0 && 0.5 * w < settings.prestress) {
+            if !target_pressure {
+                pre.prestress = 0.5 * w;
+                pre.min_prestress = pre.min_prestress.min(0.5 * pre.prestress);
+            }
+        } else if target_pressure {
+            pre.prestress = 0.0; // a pressure stage from zero needs none
+        }
+        if pre.prestress > 0.0 && estimate.is_some_and(|w| w > 0.0) {
+            let stage = Stage {
+                index: i,
+                from: 0.0,
+                to: 1.0,
+                settings: pre,
+            };
+            tubemem_fem::stepping::prestress::<BoxError>(model, state, &stage).map_err(
+                |e| match e {
+                    StageError::Solve(tubemem_fem::FemError::Interrupted) => {
+                        AppError::Interrupted { stage: i, steps: 0 }
+                    }
+                    StageError::Solve(source) => AppError::Stage {
+                        stage: i,
+                        stages,
+                        source,
+                    },
+                    StageError::Observer { step, source, .. } => AppError::Observer {
+                        stage: i,
+                        step,
+                        source,
+                    },
+                },
+            )?;
+            let now = match plan.target {
+                Target::Stretch(_) => state.x[node][0],
+                Target::VolumeRatio(_) => model.total_volume(&state.x),
+                _ => state.p,
+            };
+            let first = match (plan.target, from_before) {
+                (Target::Stretch(s), Some(f0)) => f0 + (s - f0) / plan.steps as f64,
+                (Target::VolumeRatio(r), Some(f0)) => f0 + (r * v0 - f0) / plan.steps as f64,
+                _ => f64::INFINITY,
+            };
+            if target_pressure || now >= first {
+                prestressed_from = Some(now);
+            }
+        }
+    }
+    // for a squeeze: the inflated mid-span stretch λs* and the gas constant at its start
+    let start = midspan(model, state).map_err(|source| AppError::Post { stage: i, source })?;
+    let pv = state.p * model.multiplicity() * model.mesh().volume_at(&state.x);
+    let fail_input = |report: &mut RunReport, message: String| {
+        report.stages.push(StageReport {
+            plan: *plan,
+            steps: vec![],
+            outcome: StageOutcome::Failed(StageFailure {
+                index: i,
+                error: format!("[[stage]] {i}: {message}"),
+                last_converged: None,
+            }),
+            profile: vec![],
+        });
+        AppError::StageInput { stage: i, message }
+    };
+    let (mut from, to, penalty): (f64, f64, f64) = match plan.target {
+        Target::Pressure(p) => (state.p, p, 0.0),
+        Target::Stretch(s) => (state.x[node][0], s, 0.0),
+        Target::VolumeRatio(r) => (
+            model.multiplicity() * model.mesh().volume_at(&state.x),
+            r * v0,
+            0.0,
+        ),
+        Target::Rho(rho) => {
+            if state.p.is_nan() || state.p <= 0.0 {
+                return Err(fail_input(
+                    report,
+                    format!(
+                        "the tube holds no gas pressure to squeeze (ϖ = {})",
+                        state.p
+                    ),
+                ));
+            }
+            let h0 = state.x.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+            if rho >= h0 {
+                return Err(fail_input(report, format!("`target_rho` = {rho} must be below the current half-height {h0:.6} of the tube")));
+            }
+            let penalty = match plan.penalty {
+                Some(PenaltySpec::Value(k)) => k,
+                Some(PenaltySpec::Tolerance(t)) => {
+                    penalty_for(state.p, start.lambda_s * start.lambda_z, t)
+                }
+                None => penalty_for(
+                    state.p,
+                    start.lambda_s * start.lambda_z,
+                    crate::case::DEFAULT_PENETRATION_TOLERANCE,
+                ),
+            };
+            (h0, rho, penalty)
+        }
+    };
+    match (prestressed_from, from_before) {
+        (Some(f), _) | (None, Some(f)) => from = f,
+        _ => {}
+    }
+    Ok(StageContext {
+        stage: i,
+        from,
+        to,
+        pv: if matches!(plan.target, Target::Rho(_)) {
+            pv
+        } else {
+            0.0
+        },
+        penalty,
+        start_lambda_s: start.lambda_s,
+    })
 }
 
 /// Run a validated case; `label` names it in the report. Observers see every converged step as
@@ -302,7 +556,7 @@ pub fn run_with(
             thickness: case.geometry.thickness,
             caps: String::new(),
         },
-        units: UNITS,
+        units: UNITS.into(),
         stages: vec![],
     });
     if let Some(e) = &error {
@@ -322,7 +576,14 @@ fn run_inner(
 ) -> Result<()> {
     let g = &case.geometry;
     let half = 0.5 * g.length / g.radius;
+    // the memory guard, before anything large is built
+    if let Some(n) = equations_estimate(case) {
+        check_memory(n, options.force)?;
+    }
     let mesh = build_mesh(case)?;
+    if case.mesh.file.is_some() {
+        check_memory(3 * mesh.nodes.len(), options.force)?;
+    }
     let symmetry = mesh.symmetry;
     let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;
@@ -352,9 +613,30 @@ fn run_inner(
             thickness: g.thickness,
             caps: format!("{:?}", g.caps).to_lowercase(),
         },
-        units: UNITS,
+        units: UNITS.into(),
         stages: vec![],
     });
+    if let Some(ck) = &options.resume {
+        if ck.case_hash != case.hash() {
+            return Err(AppError::Folder {
+                path: std::path::PathBuf::from(label),
+                message: format!(
+                    "the case has changed since the run started (hash {} then, {} now): resume with the same case file, or start afresh with --overwrite",
+                    ck.case_hash,
+                    case.hash()
+                ),
+            });
+        }
+        if ck.x.len() != state.x.len() {
+            return Err(AppError::Folder {
+                path: std::path::PathBuf::from(label),
+                message: "the checkpoint's state does not fit the case's mesh".into(),
+            });
+        }
+        *report = ck.report.clone();
+        state.x.clone_from(&ck.x);
+        state.p = ck.p;
+    }
     for o in observers.iter_mut() {
         o.started(report, &model, &state)
             .map_err(|source| AppError::Observer {
@@ -366,240 +648,143 @@ fn run_inner(
     let stages = case.plan().len();
     for plan in case.plan() {
         let i = plan.index;
+        let resume_here = options.resume.as_ref().filter(|c| c.context.stage == i);
+        if options.resume.as_ref().is_some_and(|c| i < c.context.stage) {
+            continue; // finished before the restart: in the restored report
+        }
         for o in observers.iter_mut() {
             o.stage_started(plan, stages);
         }
-        // A stage from the stress-free state first takes a small pressure step (the pre-stress,
-        // ϖ = 0.01, `StepSettings::prestress`): a stress-free membrane has no stiffness against
-        // its inextensional modes. When the target's own pressure (GPS, eq. 66) is not well
-        // above that, the pre-stress is half of it, so that the stage runs from the
-        // pre-stressed state up to the target; a pressure target below it is approached from
-        // above, and a first step that would undo the pre-stress starts from it instead.
+        let (context, progress, restored) = match resume_here {
+            Some(ck) => (ck.context, Some(ck.progress), ck.steps.clone()),
+            None => {
+                let ctx = setup_stage(
+                    case,
+                    plan,
+                    stages,
+                    &mut model,
+                    &mut state,
+                    report,
+                    closed_form_law.as_ref(),
+                    node,
+                    v0,
+                )?;
+                (ctx, None, vec![])
+            }
+        };
         let settings = StepSettings {
             initial_steps: plan.steps,
             ..StepSettings::default()
         };
-        let mut prestressed_from: Option<f64> = None;
-        // the controlled value before any pre-stress: where the stage's steps are measured from
-        let from_before = match plan.target {
-            Target::Stretch(_) => Some(state.x[node][0]),
-            Target::VolumeRatio(_) => Some(model.total_volume(&state.x)),
-            _ => None,
+        let start_lambda_s = context.start_lambda_s;
+        let (pv, penalty) = (context.pv, context.penalty);
+        let load: Box<dyn Fn(f64) -> Load> = match plan.target {
+            Target::Pressure(_) => Box::new(Load::pressure),
+            Target::Stretch(_) => Box::new(move |v| {
+                Load::new(Loading::Node {
+                    node,
+                    component: 0,
+                    target: v,
+                })
+            }),
+            Target::VolumeRatio(_) => Box::new(|v| Load::new(Loading::Volume(v))),
+            Target::Rho(_) => Box::new(move |h| {
+                Load::with_contact(Loading::Gas { pv }, Contact::plates(h, penalty))
+            }),
         };
-        if state.p == 0.0 && !matches!(plan.target, Target::Rho(_)) {
-            let estimate = match plan.target {
-                Target::Pressure(p) => Some(p),
-                Target::Stretch(s) => inflate(closed_form_law.as_ref(), Hypothesis::Gps, s)
-                    .ok()
-                    .map(|g| g.w),
-                Target::VolumeRatio(r) => {
-                    inflate(closed_form_law.as_ref(), Hypothesis::Gps, r.cbrt())
-                        .ok()
-                        .map(|g| g.w)
-                }
-                Target::Rho(_) => None,
-            };
-            let mut pre = settings;
-            let target_pressure = matches!(plan.target, Target::Pressure(_));
-            if let Some(w) = estimate.filter(|w| *w > 0.0 && 0.5 * w < settings.prestress) {
-                if !target_pressure {
-                    pre.prestress = 0.5 * w;
-                    pre.min_prestress = pre.min_prestress.min(0.5 * pre.prestress);
-                }
-            } else if target_pressure {
-                pre.prestress = 0.0; // a pressure stage from zero needs none
-            }
-            if pre.prestress > 0.0 && estimate.is_some_and(|w| w > 0.0) {
-                let stage = Stage {
-                    index: i,
-                    from: 0.0,
-                    to: 1.0,
-                    settings: pre,
-                };
-                tubemem_fem::stepping::prestress::<BoxError>(&mut model, &mut state, &stage)
-                    .map_err(|e| match e {
-                        StageError::Solve(tubemem_fem::FemError::Interrupted) => {
-                            AppError::Interrupted { stage: i, steps: 0 }
-                        }
-                        StageError::Solve(source) => AppError::Stage {
-                            stage: i,
-                            stages,
-                            source,
-                        },
-                        StageError::Observer { step, source, .. } => AppError::Observer {
-                            stage: i,
-                            step,
-                            source,
-                        },
-                    })?;
-                let now = match plan.target {
-                    Target::Stretch(_) => state.x[node][0],
-                    Target::VolumeRatio(_) => model.total_volume(&state.x),
-                    _ => state.p,
-                };
-                let first = match (plan.target, from_before) {
-                    (Target::Stretch(s), Some(f0)) => f0 + (s - f0) / plan.steps as f64,
-                    (Target::VolumeRatio(r), Some(f0)) => f0 + (r * v0 - f0) / plan.steps as f64,
-                    _ => f64::INFINITY,
-                };
-                if target_pressure || now >= first {
-                    prestressed_from = Some(now);
-                }
-            }
-        }
-        // for a squeeze: the inflated mid-span stretch λs* and the gas constant at its start
-        let start =
-            midspan(&model, &state).map_err(|source| AppError::Post { stage: i, source })?;
-        let pv = state.p * model.multiplicity() * model.mesh().volume_at(&state.x);
-        let fail_input = |report: &mut RunReport, message: String| {
-            report.stages.push(StageReport {
-                plan: *plan,
-                steps: vec![],
-                outcome: StageOutcome::Failed(StageFailure {
-                    index: i,
-                    error: format!("[[stage]] {i}: {message}"),
-                    last_converged: None,
-                }),
-                profile: vec![],
-            });
-            AppError::StageInput { stage: i, message }
-        };
-        let (mut from, to, load): (f64, f64, Box<dyn Fn(f64) -> Load>) = match plan.target {
-            Target::Pressure(p) => (state.p, p, Box::new(Load::pressure)),
-            Target::Stretch(s) => (
-                state.x[node][0],
-                s,
-                Box::new(move |v| {
-                    Load::new(Loading::Node {
-                        node,
-                        component: 0,
-                        target: v,
-                    })
-                }),
-            ),
-            Target::VolumeRatio(r) => (
-                model.multiplicity() * model.mesh().volume_at(&state.x),
-                r * v0,
-                Box::new(|v| Load::new(Loading::Volume(v))),
-            ),
-            Target::Rho(rho) => {
-                if state.p.is_nan() || state.p <= 0.0 {
-                    return Err(fail_input(
-                        report,
-                        format!(
-                            "the tube holds no gas pressure to squeeze (ϖ = {})",
-                            state.p
-                        ),
-                    ));
-                }
-                let h0 = state.x.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
-                if rho >= h0 {
-                    return Err(fail_input(report, format!("`target_rho` = {rho} must be below the current half-height {h0:.6} of the tube")));
-                }
-                let penalty = match plan.penalty {
-                    Some(PenaltySpec::Value(k)) => k,
-                    Some(PenaltySpec::Tolerance(t)) => {
-                        penalty_for(state.p, start.lambda_s * start.lambda_z, t)
-                    }
-                    None => penalty_for(
-                        state.p,
-                        start.lambda_s * start.lambda_z,
-                        crate::case::DEFAULT_PENETRATION_TOLERANCE,
-                    ),
-                };
-                (
-                    h0,
-                    rho,
-                    Box::new(move |h| {
-                        Load::with_contact(Loading::Gas { pv }, Contact::plates(h, penalty))
-                    }),
-                )
-            }
-        };
-        match (prestressed_from, from_before) {
-            (Some(f), _) | (None, Some(f)) => from = f,
-            _ => {}
-        }
         let stage = Stage {
             index: i,
-            from,
-            to,
+            from: context.from,
+            to: context.to,
             settings,
         };
-        let mut steps: Vec<StepRecord> = vec![];
-        let result = run_stage(&mut model, &mut state, &stage, &load, |m, st, info| {
-            let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
-            let contact = info.load.contact.as_ref().and_then(|c| {
-                midspan_contact(m, st, c).map(|values| ContactRecord {
-                    values,
-                    displacement: start.lambda_s - values.rho,
-                    initial_stretch: start.lambda_s,
-                    penalty: c.penalty,
-                })
-            });
-            let mut vals = vec![
-                ms.w,
-                ms.lambda_s,
-                ms.lambda_z,
-                ms.n_s,
-                ms.n_z,
-                ms.n_sz,
-                ms.volume,
-            ];
-            if let Some(c) = &contact {
-                let c = &c.values;
-                vals.extend([c.chi, c.force, c.contact_pressure, c.penetration]);
-            }
-            if let Some(c) = &contact {
-                let (pen, rho) = (c.values.penetration, c.values.rho);
-                if pen.is_nan() || pen > MAX_PENETRATION_FRACTION * rho {
-                    return Err(Box::new(AppError::ContactUnresolved {
+        let mut steps: Vec<StepRecord> = restored;
+        let finished: &RunReport = report;
+        let result = run_stage_from(
+            &mut model,
+            &mut state,
+            &stage,
+            progress,
+            &load,
+            |m, st, info| {
+                let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
+                let contact = info.load.contact.as_ref().and_then(|c| {
+                    midspan_contact(m, st, c).map(|values| ContactRecord {
+                        values,
+                        displacement: start_lambda_s - values.rho,
+                        initial_stretch: start_lambda_s,
+                        penalty: c.penalty,
+                    })
+                });
+
+                let mut vals = vec![
+                    ms.w,
+                    ms.lambda_s,
+                    ms.lambda_z,
+                    ms.n_s,
+                    ms.n_z,
+                    ms.n_sz,
+                    ms.volume,
+                ];
+                if let Some(c) = &contact {
+                    let c = &c.values;
+                    vals.extend([c.chi, c.force, c.contact_pressure, c.penetration]);
+                }
+                if let Some(c) = &contact {
+                    let (pen, rho) = (c.values.penetration, c.values.rho);
+                    if pen.is_nan() || pen > MAX_PENETRATION_FRACTION * rho {
+                        return Err(Box::new(AppError::ContactUnresolved {
+                            stage: i,
+                            step: info.step,
+                            penetration: pen,
+                            rho,
+                            penalty: c.penalty,
+                        }) as BoxError);
+                    }
+                }
+                if vals.iter().any(|v| !v.is_finite()) {
+                    return Err(Box::new(AppError::NonFinite {
                         stage: i,
                         step: info.step,
-                        penetration: pen,
-                        rho,
-                        penalty: c.penalty,
+                        values: vals,
                     }) as BoxError);
                 }
-            }
-            if vals.iter().any(|v| !v.is_finite()) {
-                return Err(Box::new(AppError::NonFinite {
+                let closed_form = step_closed_form(
+                    closed_form_law.as_ref(),
+                    &ms,
+                    contact.as_ref().map(|c| (&c.values, start_lambda_s)),
+                );
+                let record = StepRecord {
                     stage: i,
                     step: info.step,
-                    values: vals,
-                }) as BoxError);
-            }
-            let closed_form = step_closed_form(
-                closed_form_law.as_ref(),
-                &ms,
-                contact.as_ref().map(|c| (&c.values, start.lambda_s)),
-            );
-            let record = StepRecord {
-                stage: i,
-                step: info.step,
-                load: info.value,
-                midspan: ms,
-                newton_iterations: info.newton.iterations,
-                negative_pivots: info.newton.inertia.negative_pivots,
-                residuals: info.newton.history.clone(),
-                contact,
-                closed_form,
-            };
-            let view = StepView {
-                model: m,
-                state: st,
-                load: info.load,
-                plan,
-                stages,
-                record: &record,
-                fraction: info.fraction,
-            };
-            for o in observers.iter_mut() {
-                o.step(&view)?;
-            }
-            steps.push(record);
-            Ok::<(), BoxError>(())
-        });
+                    load: info.value,
+                    midspan: ms,
+                    newton_iterations: info.newton.iterations,
+                    negative_pivots: info.newton.inertia.negative_pivots,
+                    residuals: info.newton.history.clone(),
+                    contact,
+                    closed_form,
+                };
+                steps.push(record);
+                let view = StepView {
+                    report: finished,
+                    stage_steps: &steps,
+                    context: &context,
+                    progress: info.progress,
+                    model: m,
+                    state: st,
+                    load: info.load,
+                    plan,
+                    stages,
+                    record: steps.last().expect("just pushed"),
+                    fraction: info.fraction,
+                };
+                for o in observers.iter_mut() {
+                    o.step(&view)?;
+                }
+                Ok::<(), BoxError>(())
+            },
+        );
         if let Err(e) = result {
             let error = match e {
                 StageError::Solve(tubemem_fem::FemError::Interrupted) => AppError::Interrupted {
@@ -662,9 +847,9 @@ fn run_inner(
         let summary = StageSummary {
             index: i,
             kind: if contact.is_some() {
-                "squeeze"
+                "squeeze".into()
             } else {
-                "inflate"
+                "inflate".into()
             },
             target: plan.target,
             final_state: StageFinal {

@@ -46,6 +46,13 @@ enum Command {
         /// Replace the run already in the output folder (only tubemem's own files are removed).
         #[arg(long)]
         overwrite: bool,
+        /// Run even a model whose estimated memory exceeds what the machine has available.
+        #[arg(long)]
+        force: bool,
+        /// Continue the run in the output folder from its last checkpoint (the case file must
+        /// be the one it started with).
+        #[arg(long, conflicts_with = "overwrite")]
+        resume: bool,
     },
     /// Write PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure.
     Figures {
@@ -94,16 +101,39 @@ fn interrupt_flag() -> Option<Arc<AtomicBool>> {
         .map(|()| flag)
 }
 
-fn run_case(case_path: &std::path::Path, out: &std::path::Path, overwrite: bool) -> Result<()> {
+fn run_case(
+    case_path: &std::path::Path,
+    out: &std::path::Path,
+    overwrite: bool,
+    force: bool,
+    resume: bool,
+) -> Result<()> {
     let case = Case::read(case_path).map_err(|e| app(e.into()))?;
-    let mode = if overwrite {
-        FolderMode::Overwrite
+    let (mut writer, checkpoint) = if resume {
+        let (w, ck) = RunWriter::resume(out, case.hash()).map_err(app)?;
+        tubemem_cli::say!(
+            "resuming {} from stage {}, step {} ({} steps already in steps.csv)",
+            out.display(),
+            ck.context.stage,
+            ck.progress.step,
+            ck.rows
+        )?;
+        (w, Some(ck))
     } else {
-        FolderMode::Fresh
+        let mode = if overwrite {
+            FolderMode::Overwrite
+        } else {
+            FolderMode::Fresh
+        };
+        (
+            RunWriter::create(out, mode, case.hash()).map_err(app)?,
+            None,
+        )
     };
-    let mut writer = RunWriter::create(out, mode, case.hash()).map_err(app)?;
     let mut console = Console::default();
     let options = RunOptions {
+        resume: checkpoint,
+        force,
         interrupt: interrupt_flag(),
     };
     let outcome = tubemem_app::run::run_with(
@@ -121,12 +151,19 @@ fn run_case(case_path: &std::path::Path, out: &std::path::Path, overwrite: bool)
             )?;
             Ok(())
         }
-        Some(e) => Err(app(e)).with_context(|| {
-            format!(
-                "the run stopped; its converged steps are in {}",
-                out.display()
-            )
-        }),
+        Some(e) => {
+            let steps = outcome.report.steps().count();
+            Err(app(e)).with_context(|| {
+                if steps == 0 {
+                    format!("the run stopped before its first step ({})", out.display())
+                } else {
+                    format!(
+                        "the run stopped; its {steps} converged steps are in {}",
+                        out.display()
+                    )
+                }
+            })
+        }
     }
 }
 
@@ -138,7 +175,9 @@ fn run(cli: Cli) -> Result<()> {
             case,
             out,
             overwrite,
-        }) => run_case(&case, &out, overwrite),
+            force,
+            resume,
+        }) => run_case(&case, &out, overwrite, force, resume),
         Some(Command::Figures { out, kuhn, overlay }) => {
             let written = tubemem_app::figures::write_all(&out, kuhn, &overlay).map_err(app)?;
             for p in written {

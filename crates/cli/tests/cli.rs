@@ -1080,3 +1080,73 @@ fn nonsense_is_refused_and_small_targets_work() {
         }
     }
 }
+
+/// Restart: a run killed (SIGKILL) in the middle of its squeeze and resumed with `--resume`
+/// ends bit-identical to an uninterrupted run (steps.csv, summary.json, the PVD index and every
+/// VTU frame); before it is resumed, the folder is refused as "killed"; a changed case file is
+/// refused on resume.
+#[test]
+fn a_killed_run_resumes_bit_identical() {
+    let d = tmp("resume");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        include_str!("../../../cases/squeeze_abb30_ls1.3.toml"),
+    )
+    .unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    assert!(run_in(&case, &reference, &[]).status.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            killed.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // kill it after its second squeeze step
+    let t0 = std::time::Instant::now();
+    loop {
+        let squeeze_rows = std::fs::read_to_string(killed.join("steps.csv"))
+            .map(|t| t.lines().filter(|l| l.starts_with("2,")).count())
+            .unwrap_or(0);
+        if squeeze_rows >= 2 || t0.elapsed().as_secs() > 60 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let o = run_in(&case, &killed, &[]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("was killed"));
+    let changed = d.join("changed.toml");
+    std::fs::write(
+        &changed,
+        std::fs::read_to_string(&case)
+            .unwrap()
+            .replace("target_rho = 0.8", "target_rho = 0.9"),
+    )
+    .unwrap();
+    let o = run_in(&changed, &killed, &["--resume"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("the case has changed"));
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["steps.csv", "summary.json", "tube.pvd"] {
+        assert!(
+            std::fs::read(reference.join(f)).unwrap() == std::fs::read(killed.join(f)).unwrap(),
+            "{f} differs after the restart"
+        );
+    }
+    let frames: Vec<_> = std::fs::read_dir(reference.join("vtu")).unwrap().collect();
+    for f in frames {
+        let name = f.unwrap().file_name();
+        assert!(
+            std::fs::read(reference.join("vtu").join(&name)).unwrap()
+                == std::fs::read(killed.join("vtu").join(&name)).unwrap(),
+            "{name:?} differs"
+        );
+    }
+}

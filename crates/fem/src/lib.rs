@@ -67,6 +67,13 @@ pub enum FemError {
     ZeroPivot { index: usize, value: f64 },
     #[error("tangent matrix entry {entry} is not finite")]
     NonFiniteEntry { entry: usize },
+    /// A stage took more steps than allowed without reaching its end.
+    #[error("stage {stage} took {steps} steps and is only {:.1} % done: the step limit (`StepSettings::max_steps`) stops it (a path that needs this many steps is stalling, and each step writes a frame)", 100.0 * fraction)]
+    StepLimit {
+        stage: usize,
+        steps: usize,
+        fraction: f64,
+    },
     /// The run was asked to stop (SIGINT, SIGTERM, Ctrl-C in Python) between two Newton
     /// iterations.
     #[error("interrupted")]

@@ -16,11 +16,11 @@ use crate::element::point_state;
 use crate::geometry::Vec3;
 use crate::model::{Model, State};
 use crate::FemError;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 pub use tubemem_material::relaxed::Regime;
 
 /// Mid-span values, dimensionless (resultants per μH).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MidSpan {
     pub w: f64,
     pub lambda_s: f64,
@@ -226,7 +226,7 @@ pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemE
 }
 
 /// One ring of the cylinder at reference height Z: the [`ring_state`] values there.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RingValues {
     /// reference height Z (in R)
     pub z_ref: f64,
@@ -276,7 +276,7 @@ pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, Fem
 }
 
 /// Mid-span contact values of a squeeze, dimensionless.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactValues {
     /// ρ = h/R
     pub rho: f64,

@@ -23,6 +23,9 @@ pub struct StepSettings {
     pub easy_iterations: usize,
     /// the largest step as a fraction of the stage
     pub max_fraction: f64,
+    /// converged steps allowed in one stage (each writes a row and a VTU frame): 2,000, forty
+    /// times what the shipped cases need (at most 50)
+    pub max_steps: usize,
     /// the pre-stress pressure ϖ taken out of a stress-free state before a bordered or
     /// gas-controlled stage (a hoop strain of about 0.25 % at ϖ = 0.01), halved on failure…
     pub prestress: f64,
@@ -38,6 +41,7 @@ impl Default for StepSettings {
             growth: 1.5,
             easy_iterations: 5,
             max_fraction: 0.25,
+            max_steps: 2000,
             prestress: 0.01,
             min_prestress: 1e-6,
         }
@@ -52,8 +56,24 @@ pub struct Stage {
     pub settings: StepSettings,
 }
 
+/// Where the stepping of a stage stands: enough to continue it exactly (a restart from a
+/// checkpoint continues bit for bit).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StepState {
+    /// the fraction of the stage done
+    pub lambda: f64,
+    /// the next step's fraction
+    pub dl: f64,
+    /// converged steps so far
+    pub step: usize,
+    /// cut-backs so far
+    pub cuts: usize,
+}
+
 /// A converged step as the stepping reports it to its caller.
 pub struct StepInfo<'a> {
+    /// the stepping state after this step (what a restart continues from)
+    pub progress: StepState,
     pub step: usize,
     /// the load parameter
     pub value: f64,
@@ -76,24 +96,53 @@ pub fn run_stage<E>(
     state: &mut State,
     stage: &Stage,
     load: impl Fn(f64) -> Load,
+    on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
+) -> Result<(), StageError<E>> {
+    run_stage_from(model, state, stage, None, load, on_step)
+}
+
+/// [`run_stage`], continued from `resume` (a [`StepInfo::progress`] of an earlier run, with
+/// `state` the state of that step) when given.
+pub fn run_stage_from<E>(
+    model: &mut Model,
+    state: &mut State,
+    stage: &Stage,
+    resume: Option<StepState>,
+    load: impl Fn(f64) -> Load,
     mut on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
 ) -> Result<(), StageError<E>> {
     let (from, to) = (stage.from, stage.to);
     let set = &stage.settings;
-    // nothing to do: the stage ends where it starts (a target equal to the current state)
-    if (to - from).abs() <= 1e-14 * from.abs().max(to.abs()).max(1.0) {
-        return Ok(());
+    if resume.is_none() {
+        // nothing to do: the stage ends where it starts (a target equal to the current state)
+        if (to - from).abs() <= 1e-14 * from.abs().max(to.abs()).max(1.0) {
+            return Ok(());
+        }
+        if state.p == 0.0 && !matches!(load(from).loading, Loading::Pressure(_)) {
+            prestress(model, state, stage)?;
+        }
     }
-    if state.p == 0.0 && !matches!(load(from).loading, Loading::Pressure(_)) {
-        prestress(model, state, stage)?;
-    }
-    let mut lambda = 0.0;
-    let mut dl = 1.0 / set.initial_steps.max(1) as f64;
-    let mut step = 0;
-    let mut cuts = 0;
+    let StepState {
+        mut lambda,
+        mut dl,
+        mut step,
+        mut cuts,
+    } = resume.unwrap_or(StepState {
+        lambda: 0.0,
+        dl: 1.0 / set.initial_steps.max(1) as f64,
+        step: 0,
+        cuts: 0,
+    });
     // the last material error that rejected an attempt at the current step
     let mut material: Option<FemError> = None;
     while lambda < 1.0 {
+        if step >= set.max_steps {
+            return Err(StageError::Solve(FemError::StepLimit {
+                stage: stage.index,
+                steps: step,
+                fraction: lambda,
+            }));
+        }
         // snap to the end when within rounding of it (no zero-length last step)
         let next = if lambda + dl >= 1.0 - 1e-9 {
             1.0
@@ -109,7 +158,16 @@ pub fn run_stage<E>(
                 step += 1;
                 lambda = next;
                 *state = trial;
+                if report.iterations <= set.easy_iterations {
+                    dl = (dl * set.growth).min(set.max_fraction);
+                }
                 let info = StepInfo {
+                    progress: StepState {
+                        lambda,
+                        dl,
+                        step,
+                        cuts,
+                    },
                     step,
                     value,
                     fraction: next,
@@ -121,9 +179,6 @@ pub fn run_stage<E>(
                     step,
                     source,
                 })?;
-                if report.iterations <= set.easy_iterations {
-                    dl = (dl * set.growth).min(set.max_fraction);
-                }
             }
             Err(e) => {
                 if matches!(e.cause(), Some(FemError::Interrupted)) {
