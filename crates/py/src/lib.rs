@@ -58,7 +58,18 @@ fn material_err(e: MaterialError) -> PyErr {
 /// A Python object to a serde value, through `json.dumps`.
 fn from_py<T: serde::de::DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<T> {
     let json = obj.py().import("json")?;
-    let text: String = json.call_method1("dumps", (obj,))?.extract()?;
+    let kwargs = pyo3::types::PyDict::new(obj.py());
+    kwargs.set_item("allow_nan", false)?;
+    // NaN and infinity are not values a material may have; say so rather than let the JSON
+    // reader point at a column the user never wrote
+    let text: String = json
+        .call_method("dumps", (obj,), Some(&kwargs))
+        .map_err(|_| {
+            PyValueError::new_err(format!(
+                "{what}: a value is not a finite number (NaN or infinity) or not a plain number, string or dict: {obj}"
+            ))
+        })?
+        .extract()?;
     serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
 }
 

@@ -104,6 +104,12 @@ def test_resultants_are_eq_58_and_take_any_material():
         (lambda: tubemem.gps_inflate(1.3, material={"model": "rubber"}), "rubber"),
         (lambda: tubemem.resultants(9.0, 9.0), "locking"),  # I1 = 162 > 3N = 90
         (lambda: tubemem.gps_flattening_curve(1.3, 0.8, points=1), "points"),
+        # resource caps, checked before anything is allocated (no PanicException, no abort)
+        (lambda: tubemem.gps_inflation_curve(2.0, points=2**62), "at most 10,000,000 points"),
+        (lambda: tubemem.gps_inflation_curve(2.0, points=10**9), "at most 10,000,000 points"),
+        (lambda: tubemem.gps_flattening_curve(1.3, 0.8, points=10**9), "at most 10,000,000 points"),
+        # a NaN in a material dict is named as such, not as a JSON column
+        (lambda: tubemem.gps_inflate(1.3, material={"model": "abb", "shear_modulus": 1.0, "kuhn": math.nan}), "not a finite number"),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(call, needle):
