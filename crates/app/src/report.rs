@@ -205,11 +205,17 @@ pub struct RunReport {
     pub geometry: GeometryInfo,
     pub units: String,
     pub stages: Vec<StageReport>,
+    /// what the run noticed that a user should know (a target outside the closed form's
+    /// validity, …), in order
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 /// summary.json: the report without the steps and profiles.
 #[derive(Serialize)]
 pub struct Summary<'a> {
+    #[serde(skip_serializing_if = "<[String]>::is_empty")]
+    pub warnings: &'a [String],
     pub case: &'a str,
     pub mesh: &'a MeshInfo,
     pub material: &'a str,
@@ -232,6 +238,7 @@ impl RunReport {
             geometry: &self.geometry,
             units: &self.units,
             stages: self.stages.iter().map(|s| &s.outcome).collect(),
+            warnings: &self.warnings,
         }
     }
 

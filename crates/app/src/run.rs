@@ -377,6 +377,31 @@ fn setup_stage(
     v0: f64,
 ) -> Result<StageContext> {
     let i = plan.index;
+    // a target the closed form has no state for: say so before the run meets it
+    let beyond = match plan.target {
+        Target::Stretch(s) => inflate(closed_form_law, Hypothesis::Gps, s).err(),
+        Target::Pressure(p) if p > 0.0 => tubemem_gps::limits::limit_points(
+            closed_form_law,
+            Hypothesis::Gps,
+        )
+        .ok()
+        .and_then(|l| l.max)
+        .filter(|mx| p > mx.w)
+        .map(|_| {
+            tubemem_gps::GpsError::InvalidInput {
+                name: "target_pressure",
+                value: p,
+                requirement: "above the pressure maximum of the GPS inflation curve: under pressure control there is no uniform equilibrium there (use volume control)",
+            }
+        }),
+        _ => None,
+    };
+    if let Some(e) = beyond {
+        report.warnings.push(format!(
+            "stage {i}: the target lies outside the closed form's validity ({}); the run will stop where the law allows no further equilibrium",
+            crate::error_chain(&e)
+        ));
+    }
     // A stage from the stress-free state first takes a small pressure step (the pre-stress,
     // ϖ = 0.01, `StepSettings::prestress`): a stress-free membrane has no stiffness against
     // its inextensional modes. When the target's own pressure (GPS, eq. 66) is not well
@@ -558,6 +583,7 @@ pub fn run_with(
         },
         units: UNITS.into(),
         stages: vec![],
+        warnings: vec![],
     });
     if let Some(e) = &error {
         for o in observers.iter_mut() {
@@ -615,6 +641,7 @@ fn run_inner(
         },
         units: UNITS.into(),
         stages: vec![],
+        warnings: vec![],
     });
     if let Some(ck) = &options.resume {
         if ck.case_hash != case.hash() {

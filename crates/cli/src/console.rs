@@ -12,6 +12,8 @@ use tubemem_fem::model::{Model, State};
 
 /// Prints a run's progress and results.
 pub struct Console {
+    /// warnings of the report already printed
+    warned: usize,
     bar: Option<ProgressBar>,
     terminal: bool,
     /// a write error of a method that cannot return one, reported at the next that can
@@ -21,6 +23,7 @@ pub struct Console {
 impl Default for Console {
     fn default() -> Self {
         Self {
+            warned: 0,
             bar: None,
             terminal: std::io::stderr().is_terminal(),
             pending: None,
@@ -68,6 +71,7 @@ impl Observer for Console {
         if let Some(e) = self.pending.take() {
             return Err(Box::new(e));
         }
+        self.warn(v.report)?;
         let r = v.record;
         let res = r.residuals.last().copied().unwrap_or(f64::NAN);
         let msg = format!(
@@ -123,10 +127,23 @@ impl Observer for Console {
         Ok(())
     }
 
-    fn failed(&mut self, _report: &RunReport, _error: &tubemem_app::AppError) {
+    fn failed(&mut self, report: &RunReport, _error: &tubemem_app::AppError) {
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
+        let _ = self.warn(report);
+    }
+}
+
+impl Console {
+    /// Print the report's warnings not printed yet (to standard error).
+    fn warn(&mut self, report: &RunReport) -> std::io::Result<()> {
+        use std::io::Write;
+        for w in &report.warnings[self.warned.min(report.warnings.len())..] {
+            writeln!(std::io::stderr(), "warning: {w}")?;
+        }
+        self.warned = report.warnings.len();
+        Ok(())
     }
 }
 

@@ -635,7 +635,12 @@ fn a_failing_run_keeps_every_converged_step() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(!err.contains("panicked"), "{err}");
-    // the cause is named: the law's locking limit, with the element
+    // warned beforehand (the closed form has no state at λs = 3 for 𝒩 = 3), and the cause is
+    // named: the law's locking limit, with the element
+    assert!(
+        err.contains("warning: stage 1: the target lies outside the closed form's validity"),
+        "{err}"
+    );
     for needle in [
         "stage 1",
         "step",
@@ -659,6 +664,7 @@ fn a_failing_run_keeps_every_converged_step() {
         .as_str()
         .unwrap()
         .contains("locking"));
+    assert!(s["warnings"][0].as_str().unwrap().contains("locking limit"));
     assert!(
         s["stages"][0]["last_converged"]["lambda_s"]
             .as_f64()

@@ -362,7 +362,11 @@ fn bad_inputs_are_rejected_with_typed_errors() {
     let stiff = AnssariBenamBucchi::new(1.0, 3.0).unwrap();
     let e = inflate(&stiff, Hypothesis::Gps, 3.0).unwrap_err();
     assert!(matches!(e, GpsError::Material { .. }), "{e}");
-    assert!(e.to_string().contains("locking"), "{e}");
+    // the cause is the source (printed by the chain, not repeated in this message)
+    let cause = std::error::Error::source(&e)
+        .map(|c| c.to_string())
+        .unwrap_or_default();
+    assert!(cause.contains("locking"), "{e}: {cause}");
 }
 
 /// At the pressure the gas law gives, the section-at-pressure solve must land on the same state as
