@@ -24,6 +24,7 @@
 //! wrinkling = "relaxed" # tension-field relaxation (default) | "none"
 //! rtol = 1e-9           # Newton tolerance on ‖R‖/‖f‖
 //! max_iterations = 30
+//! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
 //!
 //! [[stage]]
 //! kind = "inflate"
@@ -106,6 +107,14 @@ pub struct SolverSpec {
     pub rtol: f64,
     #[serde(default = "default_max_iterations")]
     pub max_iterations: usize,
+    /// write a restart checkpoint every this many converged steps (0: none); the last two are
+    /// kept, and `tubemem run --resume` continues from the newest
+    #[serde(default = "default_checkpoint_every")]
+    pub checkpoint_every: usize,
+}
+
+fn default_checkpoint_every() -> usize {
+    1
 }
 
 impl Default for SolverSpec {
@@ -114,6 +123,7 @@ impl Default for SolverSpec {
             wrinkling: Wrinkling::default(),
             rtol: default_rtol(),
             max_iterations: default_max_iterations(),
+            checkpoint_every: default_checkpoint_every(),
         }
     }
 }

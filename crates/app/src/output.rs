@@ -158,6 +158,8 @@ pub struct RunWriter {
     started: f64,
     /// continuing a run: the files are there already
     resumed: bool,
+    /// a checkpoint every this many steps (0: none)
+    checkpoint_every: usize,
 }
 
 const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT1";
@@ -355,7 +357,14 @@ impl RunWriter {
             case_hash: case_hash.to_string(),
             started: unix_now(),
             resumed: false,
+            checkpoint_every: 1,
         })
+    }
+
+    /// Write a restart checkpoint every `n` converged steps (0: none; default 1).
+    pub fn checkpoint_every(mut self, n: usize) -> Self {
+        self.checkpoint_every = n;
+        self
     }
 
     /// The number of VTU frames written.
@@ -518,6 +527,9 @@ impl Observer for RunWriter {
         }
         self.frame(view.model, view.state, view.load.contact.as_ref())?;
         // the checkpoint of this step, alternating between two files (the last two are kept)
+        if self.checkpoint_every == 0 || !self.rows.is_multiple_of(self.checkpoint_every) {
+            return Ok(());
+        }
         let dir = self.dir.join("checkpoints");
         std::fs::create_dir_all(&dir).map_err(|e| AppError::io(&dir, e))?;
         let ck = Checkpoint {
@@ -532,7 +544,7 @@ impl Observer for RunWriter {
             x: view.state.x.clone(),
             p: view.state.p,
         };
-        let name = if self.rows.is_multiple_of(2) {
+        let name = if (self.rows / self.checkpoint_every).is_multiple_of(2) {
             "ckpt-a.bin"
         } else {
             "ckpt-b.bin"

@@ -130,6 +130,7 @@ fn run_case(
             None,
         )
     };
+    writer = writer.checkpoint_every(case.solver.checkpoint_every);
     let mut console = Console::default();
     let options = RunOptions {
         resume: checkpoint,
