@@ -403,10 +403,14 @@ impl Case {
         let ratio = g.length / g.radius;
         if !(ratio.is_finite() && ratio > 0.0 && ratio <= MAX_LENGTH_RATIO) {
             invalid!(
-                "[geometry] `length` / `radius` = {} / {} = {}: L/R must be in (0, {}] (results are per R; a longer tube cannot be meshed)",
+                "[geometry] `length` / `radius` = {} / {}{}: L/R must be in (0, {}] (results are per R; a longer tube cannot be meshed)",
                 tubemem_material::Num(g.length),
                 tubemem_material::Num(g.radius),
-                tubemem_material::Num(ratio),
+                if ratio.is_finite() {
+                    format!(" = {}", tubemem_material::Num(ratio))
+                } else {
+                    " overflows".to_string()
+                },
                 MAX_LENGTH_RATIO
             );
         }

@@ -113,6 +113,10 @@ pub const RUN_ENTRIES: [&str; 9] = [
 
 const LOCK: &str = ".tubemem.lock";
 
+/// The most VTU output a run may write: 8 GiB (the L/R = 80 case writes 30 MB; a run that
+/// would pass this is asked to write fewer or smaller frames rather than fill the disk).
+pub const MAX_VTU_BYTES: u64 = 8 << 30;
+
 /// FNV-1a (64 bit) of the case text: the manifest's record of which case ran.
 pub fn case_hash(text: &str) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -160,6 +164,8 @@ pub struct RunWriter {
     resumed: bool,
     /// a checkpoint every this many steps (0: none)
     checkpoint_every: usize,
+    /// bytes of VTU written so far
+    vtu_bytes: u64,
 }
 
 const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT1";
@@ -358,6 +364,7 @@ impl RunWriter {
             started: unix_now(),
             resumed: false,
             checkpoint_every: 1,
+            vtu_bytes: 0,
         })
     }
 
@@ -401,6 +408,20 @@ impl RunWriter {
         let wrinkled = pick(|c| regime_code(c.regime()));
         let pc = cell_contact_pressure(model, state, contact);
         let name = format!("step_{:05}.vtu", self.frames);
+        // a frame is about as large as the last one: refuse before the series passes the cap
+        let last = self.vtu_bytes / (self.frames.max(1) as u64);
+        if self.vtu_bytes + last > MAX_VTU_BYTES {
+            return Err(Box::new(AppError::Output {
+                what: format!("VTU frame {name}"),
+                source: format!(
+                    "the VTU series would pass {} GiB ({} frames of about {} MiB so far)",
+                    MAX_VTU_BYTES >> 30,
+                    self.frames,
+                    last >> 20
+                )
+                .into(),
+            }));
+        }
         let cell = |name, values| Field {
             name,
             components: 1,
@@ -424,6 +445,9 @@ impl RunWriter {
                 cell("contact_pressure", &pc),
             ],
         )?;
+        self.vtu_bytes += std::fs::metadata(self.dir.join("vtu").join(&name))
+            .map(|m| m.len())
+            .unwrap_or(0);
         self.pvd.push((self.frames as f64, format!("vtu/{name}")));
         self.frames += 1;
         write_pvd(&self.dir.join("tube.pvd"), &self.pvd)?;

@@ -377,6 +377,11 @@ fn setup_stage(
     v0: f64,
 ) -> Result<StageContext> {
     let i = plan.index;
+    // the squeeze this stage continues, if the previous stage was one
+    let previous_squeeze: Option<FinalContact> = match report.stages.last().map(|s| &s.outcome) {
+        Some(StageOutcome::Finished(s)) => s.final_state.contact,
+        _ => None,
+    };
     // a target the closed form has no state for: say so before the run meets it
     let beyond = match plan.target {
         Target::Stretch(s) => inflate(closed_form_law, Hypothesis::Gps, s).err(),
@@ -517,12 +522,14 @@ fn setup_stage(
             if rho >= h0 {
                 return Err(fail_input(report, format!("`target_rho` = {rho} must be below the current half-height {h0:.6} of the tube")));
             }
-            let penalty = match plan.penalty {
-                Some(PenaltySpec::Value(k)) => k,
-                Some(PenaltySpec::Tolerance(t)) => {
+            let penalty = match (plan.penalty, previous_squeeze) {
+                (Some(PenaltySpec::Value(k)), _) => k,
+                // a squeeze that continues a squeeze keeps its plates' penalty
+                (_, Some(prev)) => prev.penalty,
+                (Some(PenaltySpec::Tolerance(t)), None) => {
                     penalty_for(state.p, start.lambda_s * start.lambda_z, t)
                 }
-                None => penalty_for(
+                (None, None) => penalty_for(
                     state.p,
                     start.lambda_s * start.lambda_z,
                     crate::case::DEFAULT_PENETRATION_TOLERANCE,
@@ -545,7 +552,8 @@ fn setup_stage(
             0.0
         },
         penalty,
-        start_lambda_s: start.lambda_s,
+        // a squeeze that continues a squeeze compares with the flattening from the same λs*
+        start_lambda_s: previous_squeeze.map_or(start.lambda_s, |c| c.initial_stretch),
     })
 }
 

@@ -110,3 +110,44 @@ fn the_plan_is_resolved_by_validation() {
         "{msg}"
     );
 }
+
+/// A squeeze that continues a squeeze (ρ = 1.0, then 0.9) ends where one squeeze to ρ = 0.9
+/// ends: the closed gas and the penalty make the problem conservative, so its equilibrium does
+/// not depend on the path. It keeps the plates' penalty and compares with the flattening from
+/// the same λs*. Agreement: 1e-6 relative (Newton's 1e-9 residual times the tangent's condition,
+/// measured 1e-8 level here).
+#[test]
+fn a_squeeze_after_a_squeeze_ends_where_one_squeeze_ends() {
+    let two =
+        format!("{SMALL}{SQUEEZE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 0.9\nsteps = 4\n");
+    let one = format!("{SMALL}{}", SQUEEZE.replace("1.0", "0.9"));
+    let finish = |text: &str| {
+        let case = Case::parse(text).unwrap();
+        let report = run(&case, "squeeze", &mut []).into_result().unwrap();
+        match &report.stages.last().unwrap().outcome {
+            StageOutcome::Finished(s) => s.clone(),
+            o => panic!("{o:?}"),
+        }
+    };
+    let (a, b) = (finish(&two), finish(&one));
+    let (ca, cb) = (
+        a.final_state.contact.unwrap(),
+        b.final_state.contact.unwrap(),
+    );
+    let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+    assert!(rel(a.final_state.midspan.w, b.final_state.midspan.w) < 1e-6);
+    assert!(
+        rel(ca.force, cb.force) < 1e-6,
+        "{} vs {}",
+        ca.force,
+        cb.force
+    );
+    assert_eq!(ca.initial_stretch, cb.initial_stretch);
+    assert_eq!(ca.penalty, cb.penalty);
+    assert!(
+        rel(
+            a.relative_error_vs_gps.force.unwrap() + 1.0,
+            b.relative_error_vs_gps.force.unwrap() + 1.0
+        ) < 1e-6
+    );
+}

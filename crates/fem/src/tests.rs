@@ -523,3 +523,35 @@ fn bad_models_are_refused() {
         }
     ));
 }
+
+/// The step limit: a stage that would need more than `max_steps` converged steps stops with a
+/// typed error that says how far it got.
+#[test]
+fn the_step_limit_stops_a_stage() {
+    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let mut model = Model::new(sphere(1.0, 2, Symmetry::Eighth).unwrap(), Box::new(law)).unwrap();
+    let mut st = model.reference_state();
+    let stage = Stage {
+        index: 1,
+        from: 0.0,
+        to: 0.5,
+        settings: StepSettings {
+            initial_steps: 100,
+            max_steps: 3,
+            ..Default::default()
+        },
+    };
+    let err = run_stage(&mut model, &mut st, &stage, Load::pressure, |_, _, _| {
+        Ok::<(), std::convert::Infallible>(())
+    })
+    .unwrap_err();
+    match err {
+        crate::stepping::StageError::Solve(FemError::StepLimit {
+            steps, fraction, ..
+        }) => {
+            assert_eq!(steps, 3);
+            assert!(fraction > 0.0 && fraction < 1.0);
+        }
+        e => panic!("{e:?}"),
+    }
+}
