@@ -65,6 +65,10 @@ pub enum FemError {
     FixedControlDof { node: usize, component: usize },
     #[error("zero pivot {index} ({value:e}) in the LDLᵀ factorization: the tangent is singular")]
     ZeroPivot { index: usize, value: f64 },
+    #[error("the enclosed volume of the modelled part is {} (not positive): the gas has been squeezed out, the plates are closer than the membrane allows", tubemem_material::Num(*volume))]
+    GasVolume { volume: f64 },
+    #[error("the residual is not finite at this state (an overflow in the {what})")]
+    NonFiniteResidual { what: &'static str },
     #[error("tangent matrix entry {entry} is not finite")]
     NonFiniteEntry { entry: usize },
     /// A stage took more steps than allowed without reaching its end.

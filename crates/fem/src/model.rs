@@ -541,6 +541,25 @@ impl MembraneProblem<'_> {
             None => state_p,
         }
     }
+
+    /// Refuse states the loading cannot have: closed gas needs a positive volume, and the
+    /// residual must be finite (so that no NaN reaches the convergence test or a message).
+    fn admissible(&self, a: &Assembled, p: f64, res: f64) -> Result<(), FemError> {
+        if self.load.gas().is_some() && !(a.volume > 0.0) {
+            return Err(FemError::GasVolume { volume: a.volume });
+        }
+        if !p.is_finite() {
+            return Err(FemError::NonFiniteResidual {
+                what: "gas pressure",
+            });
+        }
+        if !res.is_finite() {
+            return Err(FemError::NonFiniteResidual {
+                what: "internal or contact forces",
+            });
+        }
+        Ok(())
+    }
 }
 
 impl newton::Problem for MembraneProblem<'_> {
@@ -579,6 +598,7 @@ impl newton::Problem for MembraneProblem<'_> {
         };
         let reference = force_scale(&a, p);
         let res = norm(&r) / reference;
+        self.admissible(&a, p, res)?;
         let cscale = match self.load.loading {
             Loading::Volume(v) => v.abs().max(1e-300),
             _ => 1.0,
@@ -646,8 +666,10 @@ impl newton::Problem for MembraneProblem<'_> {
             .map(|(f, g)| f - pt * g)
             .collect();
         let reft = force_scale(&trial, pt);
+        let residual = norm(&rt) / reft;
+        self.admissible(&trial, pt, residual)?;
         Ok(Evaluation {
-            residual: norm(&rt) / reft,
+            residual,
             potential: potential(self.load.loading, trial.energy, trial.volume, pt),
         })
     }
