@@ -8,6 +8,30 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
 
+/// The n-gon prism's exact equilibrium against GPS (see the first test): λz, N_s, N_z and
+/// ϖ·cos(π/n) within 1e-6; returns the GPS state.
+fn assert_prism_matches_gps(
+    ms: &tubemem_fem::post::MidSpan,
+    around: usize,
+) -> tubemem_gps::InflationState {
+    let g = inflate(&abb30(), Hypothesis::Gps, ms.lambda_s).unwrap();
+    assert!(
+        rel(ms.lambda_z, g.lambda_z) < 1e-6,
+        "λz {} vs {}",
+        ms.lambda_z,
+        g.lambda_z
+    );
+    assert!(rel(ms.n_s, g.n_s) < 1e-6 && rel(ms.n_z, g.n_z) < 1e-6);
+    let apothem = (std::f64::consts::PI / around as f64).cos();
+    assert!(
+        rel(ms.w * apothem, g.w) < 1e-6,
+        "ϖ cos(π/n) {} vs {}",
+        ms.w * apothem,
+        g.w
+    );
+    g
+}
+
 /// Capped tube, ABB 𝒩 = 30, L/R = 20, inflated to λs* = 1.3 (eighth model).
 ///
 /// Source: the GPS closed form, eq. (66). Far from the caps the discrete tube is a uniform prism
@@ -26,23 +50,9 @@ fn capped_tube_midspan_matches_gps_at_ls_1_3() {
     let mut errs = vec![];
     for (around, along) in [(32, 80), (64, 160)] {
         let ms = inflate_capped_tube(20.0, around, along, Symmetry::Eighth, 1.3).midspan;
-        let g = inflate(&law, Hypothesis::Gps, ms.lambda_s).unwrap();
         assert!((ms.lambda_s - 1.3).abs() < 1e-9);
-        assert!(
-            rel(ms.lambda_z, g.lambda_z) < 1e-6,
-            "λz {} vs {}",
-            ms.lambda_z,
-            g.lambda_z
-        );
-        assert!(rel(ms.n_s, g.n_s) < 1e-6 && rel(ms.n_z, g.n_z) < 1e-6);
         assert!(ms.n_sz.abs() < 1e-10);
-        let apothem = (std::f64::consts::PI / around as f64).cos();
-        assert!(
-            rel(ms.w * apothem, g.w) < 1e-6,
-            "ϖ cos(π/n) {} vs {}",
-            ms.w * apothem,
-            g.w
-        );
+        let g = assert_prism_matches_gps(&ms, around);
         errs.push(rel(ms.w, g.w));
         // plane strain misses λz entirely: 5.4 % here
         let p = inflate(&law, Hypothesis::Ps, ms.lambda_s).unwrap();
@@ -80,7 +90,6 @@ fn full_tube_agrees_with_eighth_model() {
 /// `capped_tube_midspan_matches_gps_at_ls_1_3`). The ring at the plug keeps radius R.
 #[test]
 fn plugged_tube_midspan_matches_gps() {
-    let law = abb30();
     let n = 32;
     let t = inflate_mesh(
         plugged_tube(1.0, 20.0, n, 80, Symmetry::Eighth).unwrap(),
@@ -88,21 +97,7 @@ fn plugged_tube_midspan_matches_gps() {
     );
     let ms = t.midspan;
     assert_eq!(t.model.mesh().plugs.len(), 1);
-    let g = inflate(&law, Hypothesis::Gps, ms.lambda_s).unwrap();
-    assert!(
-        rel(ms.lambda_z, g.lambda_z) < 1e-6,
-        "λz {} vs {}",
-        ms.lambda_z,
-        g.lambda_z
-    );
-    assert!(rel(ms.n_s, g.n_s) < 1e-6 && rel(ms.n_z, g.n_z) < 1e-6);
-    let apothem = (std::f64::consts::PI / n as f64).cos();
-    assert!(
-        rel(ms.w * apothem, g.w) < 1e-6,
-        "ϖ cos(π/n) {} vs {}",
-        ms.w * apothem,
-        g.w
-    );
+    assert_prism_matches_gps(&ms, n);
     // the ring at the plug stays at radius R
     let ring = &t.model.mesh().plugs[0];
     assert!(ring

@@ -34,20 +34,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use thiserror::Error;
 
-/// A number as a message shows it (scientific notation where plain would be long).
-#[derive(Clone, Copy, Debug)]
-pub struct Num(pub f64);
-
-impl std::fmt::Display for Num {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let v = self.0;
-        if v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs()) {
-            write!(f, "{v:e}")
-        } else {
-            write!(f, "{v}")
-        }
-    }
-}
+pub use tubemem_material::Num;
 
 /// A mesh error, naming the element, edge or parameter concerned.
 #[derive(Debug, Clone, PartialEq, Error)]
