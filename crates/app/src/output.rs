@@ -1,7 +1,8 @@
 //! The run writer: an [`Observer`] that turns the report into files as the run goes.
 //!
 //! * `steps.csv`: one row per converged step, flushed at once ([`STEPS_HEADER`]);
-//! * `vtu/step_NNNNN.vtu` + `tube.pvd`: a frame per step (frame 0 is the reference state);
+//! * `vtu/step_NNNNN.vtu` + `tube.pvd`: a frame per step (frame 0 is the reference state); the
+//!   PVD timestep is the load path: stage − 1 + the fraction of the stage done;
 //! * `profiles/stageN_final.csv`: the profile along the tube at each stage end;
 //! * `summary.json`: [`RunReport::summary`], rewritten (atomically: write, then rename) after
 //!   every stage and on failure, so a run that fails midway loses nothing that had converged;
@@ -383,8 +384,11 @@ impl RunWriter {
         &self.dir
     }
 
+    /// Write a VTU frame at pseudo-time `time` (the PVD timestep: stage − 1 + the fraction of
+    /// the stage done, so 0 is the reference state and k the end of stage k).
     fn frame(
         &mut self,
+        time: f64,
         model: &Model,
         state: &State,
         contact: Option<&tubemem_fem::contact::Contact>,
@@ -448,7 +452,7 @@ impl RunWriter {
         self.vtu_bytes += std::fs::metadata(self.dir.join("vtu").join(&name))
             .map(|m| m.len())
             .unwrap_or(0);
-        self.pvd.push((self.frames as f64, format!("vtu/{name}")));
+        self.pvd.push((time, format!("vtu/{name}")));
         self.frames += 1;
         write_pvd(&self.dir.join("tube.pvd"), &self.pvd)?;
         Ok(())
@@ -540,7 +544,7 @@ impl Observer for RunWriter {
         writeln!(steps, "{STEPS_HEADER}")?;
         steps.flush()?;
         self.steps = Some(steps);
-        self.frame(model, state, None)
+        self.frame(0.0, model, state, None)
     }
 
     fn step(&mut self, view: &StepView) -> Result<(), BoxError> {
@@ -549,7 +553,8 @@ impl Observer for RunWriter {
             steps.flush()?;
             self.rows += 1;
         }
-        self.frame(view.model, view.state, view.load.contact.as_ref())?;
+        let time = (view.plan.index - 1) as f64 + view.fraction;
+        self.frame(time, view.model, view.state, view.load.contact.as_ref())?;
         // the checkpoint of this step, alternating between two files (the last two are kept)
         if self.checkpoint_every == 0 || !self.rows.is_multiple_of(self.checkpoint_every) {
             return Ok(());
