@@ -242,22 +242,130 @@ fn run_outcome<'py>(
     }
 }
 
+/// A converged step, sent from the run's thread to the interpreter's.
+struct StepNote {
+    stage: usize,
+    step: usize,
+    w: f64,
+    lambda_s: f64,
+    newton_iterations: usize,
+    residual: f64,
+    fraction: f64,
+}
+
+/// The observer that forwards every converged step to the interpreter's thread.
+struct Notify(std::sync::mpsc::Sender<StepNote>);
+
+impl tubemem_app::run::Observer for Notify {
+    fn step(&mut self, v: &tubemem_app::run::StepView) -> Result<(), tubemem_app::run::BoxError> {
+        let r = v.record;
+        // a closed channel means the interpreter side has gone: nothing to tell
+        let _ = self.0.send(StepNote {
+            stage: r.stage,
+            step: r.step,
+            w: r.midspan.w,
+            lambda_s: r.midspan.lambda_s,
+            newton_iterations: r.newton_iterations,
+            residual: r.residuals.last().copied().unwrap_or(0.0),
+            fraction: v.fraction,
+        });
+        Ok(())
+    }
+}
+
+/// Run a parsed case into `out` on a thread of its own, while the interpreter's thread waits
+/// without the interpreter lock, reports each step (to `progress`, or to the `tubemem` logger
+/// at DEBUG level: silent by default) and checks for Ctrl-C every 50 ms. Ctrl-C stops the run at
+/// its next Newton iteration (every converged step stays on disk, and the run records that it
+/// was interrupted) and is then raised as `KeyboardInterrupt`.
 fn run_parsed<'py>(
     py: Python<'py>,
     case: &tubemem_app::case::Case,
     label: &str,
     out: &std::path::Path,
     overwrite: bool,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc::RecvTimeoutError;
+    use std::sync::Arc;
     use tubemem_app::output::{FolderMode, RunWriter};
     let mode = if overwrite {
         FolderMode::Overwrite
     } else {
         FolderMode::Fresh
     };
-    let mut writer =
-        RunWriter::create(out, mode, case.hash()).map_err(|e| PyValueError::new_err(e.chain()))?;
-    let outcome = py.detach(|| tubemem_app::run::run(case, label, &mut [&mut writer]));
+    let mut writer = RunWriter::create(out, mode, case.hash())
+        .map_err(|e| PyValueError::new_err(e.chain()))?
+        .checkpoint_every(case.solver.checkpoint_every);
+    let flag = Arc::new(AtomicBool::new(false));
+    let options = tubemem_app::run::RunOptions {
+        interrupt: Some(flag.clone()),
+        ..Default::default()
+    };
+    let logger = py
+        .import("logging")?
+        .call_method1("getLogger", ("tubemem",))?;
+    let (tx, mut rx) = std::sync::mpsc::channel::<StepNote>();
+    let mut raised: Option<PyErr> = None;
+    let outcome = std::thread::scope(|scope| {
+        let run = scope.spawn(|| {
+            let mut notify = Notify(tx);
+            tubemem_app::run::run_with(case, label, &options, &mut [&mut writer, &mut notify])
+        });
+        loop {
+            let r = &mut rx;
+            let next = py.detach(move || r.recv_timeout(std::time::Duration::from_millis(50)));
+            match next {
+                Ok(n) => {
+                    let reported = match progress {
+                        Some(cb) if raised.is_none() => {
+                            let d = pyo3::types::PyDict::new(py);
+                            let fill = || -> PyResult<()> {
+                                d.set_item("stage", n.stage)?;
+                                d.set_item("step", n.step)?;
+                                d.set_item("w", n.w)?;
+                                d.set_item("lambda_s", n.lambda_s)?;
+                                d.set_item("newton_iterations", n.newton_iterations)?;
+                                d.set_item("residual", n.residual)?;
+                                d.set_item("fraction", n.fraction)?;
+                                cb.call1((d.clone(),))?;
+                                Ok(())
+                            };
+                            fill()
+                        }
+                        Some(_) => Ok(()),
+                        None => logger
+                            .call_method1(
+                                "debug",
+                                (format!(
+                                    "stage {} step {}: w = {:.6}, lambda_s = {:.6}, {} Newton iterations, residual {:.1e} ({:.0} %)",
+                                    n.stage, n.step, n.w, n.lambda_s, n.newton_iterations, n.residual, 100.0 * n.fraction
+                                ),),
+                            )
+                            .map(|_| ()),
+                    };
+                    if let Err(e) = reported {
+                        // the callback raised: stop the run, then raise it
+                        flag.store(true, Ordering::Relaxed);
+                        raised.get_or_insert(e);
+                    }
+                }
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => break,
+            }
+            if let Err(e) = py.check_signals() {
+                flag.store(true, Ordering::Relaxed);
+                raised.get_or_insert(e);
+            }
+        }
+        run.join()
+    });
+    let outcome =
+        outcome.map_err(|_| TubememError::new_err("the run's thread stopped abnormally"))?;
+    if let Some(e) = raised {
+        return Err(e);
+    }
     run_outcome(py, outcome, out)
 }
 
@@ -266,28 +374,37 @@ fn run_parsed<'py>(
 /// already in `out` and `TubememError` says which stage, step and residual, and why. A folder
 /// that already holds a run is refused (`ValueError`) unless `overwrite=True`.
 #[pyfunction]
-#[pyo3(signature = (case, out, overwrite=false))]
+#[pyo3(signature = (case, out, overwrite=false, progress=None))]
 fn run_case<'py>(
     py: Python<'py>,
     case: PathBuf,
     out: PathBuf,
     overwrite: bool,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let parsed = tubemem_app::case::Case::read(&case)
         .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
-    run_parsed(py, &parsed, &case.display().to_string(), &out, overwrite)
+    run_parsed(
+        py,
+        &parsed,
+        &case.display().to_string(),
+        &out,
+        overwrite,
+        progress,
+    )
 }
 
 /// Run a case given as TOML text (user mesh files are looked up relative to `base_dir`); as
 /// `run_case` otherwise.
 #[pyfunction]
-#[pyo3(signature = (text, out, base_dir=None, overwrite=false))]
+#[pyo3(signature = (text, out, base_dir=None, overwrite=false, progress=None))]
 fn run_case_text<'py>(
     py: Python<'py>,
     text: &str,
     out: PathBuf,
     base_dir: Option<PathBuf>,
     overwrite: bool,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut case = tubemem_app::case::Case::parse(text).map_err(|e| {
         PyValueError::new_err(format!(
@@ -296,7 +413,14 @@ fn run_case_text<'py>(
         ))
     })?;
     case.base_dir = base_dir.unwrap_or_default();
-    run_parsed(py, &case, "case text from Python", &out, overwrite)
+    run_parsed(
+        py,
+        &case,
+        "case text from Python",
+        &out,
+        overwrite,
+        progress,
+    )
 }
 
 /// The embedded default case (`cases/squeeze_abb30_ls1.3.toml`, the main job's) as TOML text.

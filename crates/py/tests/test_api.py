@@ -154,3 +154,61 @@ def test_a_failing_run_raises_and_keeps_its_converged_steps(tmp_path):
     assert "residual" in str(e.value) and "converged steps are in" in str(e.value)
     rows = list(csv.DictReader(open(out / "steps.csv")))
     assert len(rows) >= 2 and all(math.isfinite(float(r["w"])) for r in rows)
+
+
+def test_progress_goes_to_a_callback_or_stays_silent(tmp_path, capfd):
+    seen = []
+    s = tubemem.run_case_text(SMALL, str(tmp_path / "cb"), progress=seen.append)
+    assert [d["step"] for d in seen] == list(range(1, len(seen) + 1))
+    assert seen[-1]["fraction"] == 1.0 and seen[-1]["lambda_s"] == s["stages"][0]["final"]["lambda_s"]
+    # without a callback nothing is printed (the `tubemem` logger gets DEBUG records)
+    tubemem.run_case_text(SMALL, str(tmp_path / "quiet"))
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_a_callback_that_raises_stops_the_run_and_is_raised(tmp_path):
+    def stop(d):
+        if d["step"] == 2:
+            raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        tubemem.run_case_text(SMALL.replace("steps = 4", "steps = 40"), str(tmp_path / "o"), progress=stop)
+    rows = list(csv.DictReader(open(tmp_path / "o" / "steps.csv")))
+    assert 2 <= len(rows) < 40
+    assert '"interrupted"' in (tmp_path / "o" / "run.json").read_text()
+
+
+def test_ctrl_c_interrupts_a_run_within_seconds_and_keeps_its_steps(tmp_path):
+    """A Python process running a long case is sent SIGINT after its first steps: it raises
+    KeyboardInterrupt within seconds (the run stops at its next Newton iteration), and every
+    converged step is on disk with the run marked interrupted."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    out = tmp_path / "run"
+    case = SMALL.replace("steps = 4", "steps = 2000")
+    script = (
+        "import tubemem, sys\n"
+        "try:\n"
+        f"    tubemem.run_case_text({case!r}, {str(out)!r})\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(3)\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    t0 = time.time()
+    while time.time() - t0 < 60:
+        if (out / "steps.csv").exists() and len((out / "steps.csv").read_text().splitlines()) >= 4:
+            break
+        time.sleep(0.01)
+    t1 = time.time()
+    p.send_signal(signal.SIGINT)
+    stdout, _ = p.communicate(timeout=30)
+    assert p.returncode == 3 and "interrupted" in stdout
+    assert time.time() - t1 < 5, "the prompt comes back within seconds"
+    rows = list(csv.DictReader(open(out / "steps.csv")))
+    assert len(rows) >= 3 and all(math.isfinite(float(r["w"])) for r in rows)
+    assert '"interrupted"' in (out / "run.json").read_text()
