@@ -108,19 +108,80 @@ fn hypothesis(name: &str) -> PyResult<Hypothesis> {
 }
 
 /// Free inflation at hoop stretch `stretch` (eq. 66 under GPS, eq. 70 under PS):
-/// dict with w, lambda_s, lambda_z, n_s, n_z (dimensionless, R = μH = 1).
+/// dict with w, lambda_s, lambda_z, n_s, n_z (dimensionless, R = μH = 1). `stretch` may be a
+/// numpy array (any shape): the dict then holds numpy arrays of that shape, and an entry that
+/// has no solution raises with its index.
 #[pyfunction]
 #[pyo3(signature = (stretch, material=None, hypothesis="gps"))]
 fn gps_inflate<'py>(
     py: Python<'py>,
-    stretch: f64,
+    stretch: &Bound<'py, PyAny>,
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let law = law(material)?;
-    let s = tubemem_gps::inflate(law.as_ref(), self::hypothesis(hypothesis)?, stretch)
-        .map_err(gps_err)?;
-    to_py(py, &s)
+    let hyp = self::hypothesis(hypothesis)?;
+    if let Ok(v) = stretch.extract::<f64>() {
+        let s = tubemem_gps::inflate(law.as_ref(), hyp, v).map_err(gps_err)?;
+        return to_py(py, &s);
+    }
+    vectorized(
+        py,
+        stretch,
+        "stretch",
+        |v| {
+            tubemem_gps::inflate(law.as_ref(), hyp, v)
+                .map(|s| vec![s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z])
+        },
+        &["w", "lambda_s", "lambda_z", "n_s", "n_z"],
+    )
+}
+
+/// Evaluate `f` at every entry of the array-like `input` (any shape) and return a dict of numpy
+/// arrays of that shape, one per key. An entry that fails raises with its index.
+fn vectorized<'py>(
+    py: Python<'py>,
+    input: &Bound<'py, PyAny>,
+    what: &str,
+    f: impl Fn(f64) -> Result<Vec<f64>, GpsError> + Send + Sync,
+    keys: &[&str],
+) -> PyResult<Bound<'py, PyAny>> {
+    use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+    let np = py.import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (input, "float64"))
+        .map_err(|_| PyValueError::new_err(format!("{what}: a number or an array of numbers")))?;
+    let arr = arr
+        .cast::<PyArrayDyn<f64>>()
+        .map_err(|_| PyValueError::new_err(format!("{what}: a number or an array of numbers")))?;
+    let shape = arr.shape().to_vec();
+    let values: Vec<f64> = arr.to_vec().map_err(|_| {
+        PyValueError::new_err(format!("{what}: the array must be contiguous numbers"))
+    })?;
+    let rows: Vec<Vec<f64>> = py
+        .detach(|| {
+            values
+                .iter()
+                .enumerate()
+                .map(|(k, &v)| f(v).map_err(|e| (k, e)))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(|(k, e)| {
+            let err = gps_err(e);
+            let msg = format!("{what}[{k}] = {}: {}", values[k], err.value(py));
+            if err.is_instance_of::<PyValueError>(py) {
+                PyValueError::new_err(msg)
+            } else {
+                TubememError::new_err(msg)
+            }
+        })?;
+    let out = pyo3::types::PyDict::new(py);
+    for (j, key) in keys.iter().enumerate() {
+        let col: Vec<f64> = rows.iter().map(|r| r[j]).collect();
+        let a = numpy::PyArray1::from_vec(py, col).reshape(shape.clone())?;
+        out.set_item(key, a)?;
+    }
+    Ok(out.into_any())
 }
 
 /// `points` free-inflation states equally spaced in λs from `stretch_from` to `stretch_to`: a list
@@ -143,25 +204,54 @@ fn gps_inflation_curve<'py>(
 
 /// The tube inflated to λs* = `initial_stretch`, the gas closed in (Boyle), squeezed between two
 /// plates to half-gap `rho` (GPS eqs. 76–77, PS eqs. 78–79): dict with w, lambda_s, lambda_z, n_s,
-/// n_z, rho, chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81).
+/// n_z, rho, chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81). `rho` may be a numpy
+/// array: the dict then holds arrays of its shape.
 #[pyfunction]
 #[pyo3(signature = (initial_stretch, rho, material=None, hypothesis="gps"))]
 fn gps_flatten<'py>(
     py: Python<'py>,
     initial_stretch: f64,
-    rho: f64,
+    rho: &Bound<'py, PyAny>,
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let law = law(material)?;
-    let s = tubemem_gps::flatten(
-        law.as_ref(),
-        self::hypothesis(hypothesis)?,
-        initial_stretch,
+    let hyp = self::hypothesis(hypothesis)?;
+    if let Ok(r) = rho.extract::<f64>() {
+        let s = tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r).map_err(gps_err)?;
+        return to_py(py, &s);
+    }
+    vectorized(
+        py,
         rho,
+        "rho",
+        |r| {
+            tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r).map(|s| {
+                vec![
+                    s.w,
+                    s.lambda_s,
+                    s.lambda_z,
+                    s.n_s,
+                    s.n_z,
+                    s.rho,
+                    s.chi,
+                    s.force,
+                    s.displacement,
+                ]
+            })
+        },
+        &[
+            "w",
+            "lambda_s",
+            "lambda_z",
+            "n_s",
+            "n_z",
+            "rho",
+            "chi",
+            "force",
+            "displacement",
+        ],
     )
-    .map_err(gps_err)?;
-    to_py(py, &s)
 }
 
 /// `points` flattening states equally spaced in ρ from λs* down to `rho_to`: a list of dicts as in

@@ -212,3 +212,24 @@ def test_ctrl_c_interrupts_a_run_within_seconds_and_keeps_its_steps(tmp_path):
     rows = list(csv.DictReader(open(out / "steps.csv")))
     assert len(rows) >= 3 and all(math.isfinite(float(r["w"])) for r in rows)
     assert '"interrupted"' in (out / "run.json").read_text()
+
+
+def test_the_closed_form_takes_arrays_and_agrees_with_the_scalar_calls():
+    import numpy as np
+
+    ls = np.array([[1.05, 1.3], [2.0, 4.0]])
+    v = tubemem.gps_inflate(ls)
+    assert set(v) == {"w", "lambda_s", "lambda_z", "n_s", "n_z"}
+    for idx in np.ndindex(ls.shape):
+        s = tubemem.gps_inflate(float(ls[idx]))
+        for k in v:
+            assert v[k].shape == ls.shape and v[k][idx] == s[k], (k, idx)
+    rho = np.linspace(1.25, 0.8, 5)
+    f = tubemem.gps_flatten(1.3, rho, hypothesis="ps")
+    for i, r in enumerate(rho):
+        s = tubemem.gps_flatten(1.3, float(r), hypothesis="ps")
+        assert all(f[k][i] == s[k] for k in s)
+    with pytest.raises(ValueError, match=r"stretch\[1\] = 0.5"):
+        tubemem.gps_inflate(np.array([1.2, 0.5]))
+    with pytest.raises(ValueError, match="a number or an array"):
+        tubemem.gps_inflate("abc")
