@@ -315,15 +315,14 @@ fn resultants(l1: f64, l2: f64, material: Option<&Bound<'_, PyAny>>) -> PyResult
     Ok((n1, n2))
 }
 
-/// A run's outcome as Python: the summary dict (summary.json's content, from the typed report,
+/// A run's outcome: its typed report (the summary dict and the step arrays are made from it,
 /// not read back from disk), or `TubememError` with the whole cause chain.
-fn run_outcome<'py>(
-    py: Python<'py>,
+fn run_outcome(
     outcome: tubemem_app::run::RunOutcome,
     out: &std::path::Path,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<tubemem_app::report::RunReport> {
     match outcome.error {
-        None => to_py(py, &outcome.report.summary()),
+        None => Ok(outcome.report),
         Some(e) => Err(TubememError::new_err(format!(
             "{}; the converged steps are in {}",
             e.chain(),
@@ -375,7 +374,7 @@ fn run_parsed<'py>(
     out: &std::path::Path,
     overwrite: bool,
     progress: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<tubemem_app::report::RunReport> {
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::mpsc::RecvTimeoutError;
     use std::sync::Arc;
@@ -456,7 +455,7 @@ fn run_parsed<'py>(
     if let Some(e) = raised {
         return Err(e);
     }
-    run_outcome(py, outcome, out)
+    run_outcome(outcome, out)
 }
 
 /// Run a case file (TOML, as for `tubemem run`), writing steps.csv, summary.json, profiles/ and
@@ -474,14 +473,15 @@ fn run_case<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let parsed = tubemem_app::case::Case::read(&case)
         .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
-    run_parsed(
+    let report = run_parsed(
         py,
         &parsed,
         &case.display().to_string(),
         &out,
         overwrite,
         progress,
-    )
+    )?;
+    to_py(py, &report.summary())
 }
 
 /// Run a case given as TOML text (user mesh files are looked up relative to `base_dir`); as
@@ -503,20 +503,144 @@ fn run_case_text<'py>(
         ))
     })?;
     case.base_dir = base_dir.unwrap_or_default();
-    run_parsed(
+    let report = run_parsed(
         py,
         &case,
         "case text from Python",
         &out,
         overwrite,
         progress,
-    )
+    )?;
+    to_py(py, &report.summary())
 }
 
 /// The embedded default case (`cases/squeeze_abb30_ls1.3.toml`, the main job's) as TOML text.
 #[pyfunction]
 fn default_case() -> &'static str {
     tubemem_app::main_job::DEFAULT_CASE
+}
+
+/// A finished FE run: `summary` (the dict of summary.json), `steps` (a dict of numpy arrays, one
+/// per steps.csv column, NaN where a column does not apply), `path` (the run folder) and
+/// `to_pandas()`; `vtu(k)` is the path of frame k (0 the reference state), readable with meshio.
+#[pyclass(name = "Run", module = "tubemem")]
+struct Run {
+    summary: Py<PyAny>,
+    steps: Py<PyAny>,
+    path: PathBuf,
+    frames: usize,
+}
+
+#[pymethods]
+impl Run {
+    #[getter]
+    fn summary(&self, py: Python<'_>) -> Py<PyAny> {
+        self.summary.clone_ref(py)
+    }
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> Py<PyAny> {
+        self.steps.clone_ref(py)
+    }
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.path.clone()
+    }
+    /// The steps as a pandas DataFrame (pandas is imported on demand).
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("pandas")?
+            .call_method1("DataFrame", (self.steps.clone_ref(py),))
+    }
+    /// The VTU file of frame `k` (0: the reference state; k: after the k-th converged step).
+    fn vtu(&self, k: usize) -> PyResult<PathBuf> {
+        if k >= self.frames {
+            return Err(PyValueError::new_err(format!(
+                "frame {k}: the run has frames 0 to {}",
+                self.frames.saturating_sub(1)
+            )));
+        }
+        Ok(self.path.join("vtu").join(format!("step_{k:05}.vtu")))
+    }
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let n = self
+            .steps
+            .bind(py)
+            .get_item("step")
+            .and_then(|a| a.len())
+            .unwrap_or(0);
+        format!("<tubemem.Run {} ({n} steps)>", self.path.display())
+    }
+}
+
+/// A case given as a path to a TOML file, TOML text, or a dict of the case file's tables.
+fn case_from(
+    py: Python<'_>,
+    case: &Bound<'_, PyAny>,
+    base_dir: Option<PathBuf>,
+) -> PyResult<(tubemem_app::case::Case, String)> {
+    let invalid =
+        |e: tubemem_app::case::CaseError| PyValueError::new_err(tubemem_app::error_chain(&e));
+    if let Ok(d) = case.cast::<pyo3::types::PyDict>() {
+        let value: serde_json::Value = from_py(d.as_any(), "case")?;
+        let table = toml::Value::try_from(value)
+            .map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
+        let text =
+            toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
+        let mut c = tubemem_app::case::Case::parse(&text).map_err(invalid)?;
+        c.base_dir = base_dir.unwrap_or_default();
+        return Ok((c, "case dict from Python".into()));
+    }
+    let text: String = case
+        .str()
+        .and_then(|s| s.extract())
+        .map_err(|_| PyValueError::new_err("case: a path, TOML text or a dict"))?;
+    let path = PathBuf::from(&text);
+    if !text.contains('\n') && path.is_file() {
+        let c = tubemem_app::case::Case::read(&path).map_err(invalid)?;
+        return Ok((c, path.display().to_string()));
+    }
+    let mut c = tubemem_app::case::Case::parse(&text).map_err(invalid)?;
+    c.base_dir = base_dir.unwrap_or_default();
+    let _ = py;
+    Ok((c, "case text from Python".into()))
+}
+
+/// Run a case (a TOML file's path, TOML text, or a dict of its tables, e.g.
+/// `{"geometry": {"radius": 1.0, "length": 20.0}, "material": {...}, "mesh": {...},
+/// "stage": [{...}]}`) into `out`; returns a `Run` with the steps as arrays. Errors, progress and
+/// Ctrl-C as for `run_case`.
+#[pyfunction]
+#[pyo3(signature = (case, out, base_dir=None, overwrite=false, progress=None))]
+fn run<'py>(
+    py: Python<'py>,
+    case: &Bound<'py, PyAny>,
+    out: PathBuf,
+    base_dir: Option<PathBuf>,
+    overwrite: bool,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Run> {
+    let (parsed, label) = case_from(py, case, base_dir)?;
+    let report = run_parsed(py, &parsed, &label, &out, overwrite, progress)?;
+    let header: Vec<&str> = tubemem_app::output::STEPS_HEADER.split(',').collect();
+    let rows: Vec<Vec<f64>> = report
+        .steps()
+        .map(|r| {
+            tubemem_app::output::step_row(r)
+                .into_iter()
+                .map(|v| v.unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let steps = pyo3::types::PyDict::new(py);
+    for (j, name) in header.iter().enumerate() {
+        let col: Vec<f64> = rows.iter().map(|r| r[j]).collect();
+        steps.set_item(name, numpy::PyArray1::from_vec(py, col))?;
+    }
+    Ok(Run {
+        summary: to_py(py, &report.summary())?.unbind(),
+        steps: steps.into_any().unbind(),
+        path: out,
+        frames: rows.len() + 1,
+    })
 }
 
 #[pymodule]
@@ -533,5 +657,7 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_case, m)?)?;
     m.add_function(wrap_pyfunction!(run_case_text, m)?)?;
     m.add_function(wrap_pyfunction!(default_case, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_class::<Run>()?;
     Ok(())
 }

@@ -233,3 +233,33 @@ def test_the_closed_form_takes_arrays_and_agrees_with_the_scalar_calls():
         tubemem.gps_inflate(np.array([1.2, 0.5]))
     with pytest.raises(ValueError, match="a number or an array"):
         tubemem.gps_inflate("abc")
+
+
+def test_run_returns_arrays_equal_to_steps_csv_and_takes_cases_as_dicts(tmp_path):
+    import tomllib
+
+    import numpy as np
+
+    # a case as a dict of its tables equals the same case as TOML
+    as_dict = tomllib.loads(SMALL_CASE)
+    a = tubemem.run(as_dict, str(tmp_path / "dict"))
+    b = tubemem.run(SMALL_CASE, str(tmp_path / "text"))
+    for k in a.steps:
+        np.testing.assert_array_equal(a.steps[k], b.steps[k])
+    # the arrays are steps.csv, column by column (empty fields are NaN)
+    rows = list(csv.DictReader(open(tmp_path / "dict" / "steps.csv")))
+    assert len(rows) == len(a.steps["step"])
+    for k in rows[0]:
+        csv_col = np.array([float(r[k]) if r[k] else np.nan for r in rows])
+        np.testing.assert_array_equal(a.steps[k], csv_col)
+    assert a.summary["case"] == "case dict from Python" and b.summary["case"] == "case text from Python"
+    assert {**a.summary, "case": ""} == {**b.summary, "case": ""}
+    assert a.summary["stages"][1]["kind"] == "squeeze"
+    assert a.vtu(0).name == "step_00000.vtu" and a.vtu(len(rows)).exists()
+    with pytest.raises(ValueError, match="frame"):
+        a.vtu(len(rows) + 1)
+    assert "steps" in repr(a)
+    # a bad dict names its key
+    bad = dict(as_dict, material={"model": "abb", "shear_modulus": 1.0, "kuhm": 3})
+    with pytest.raises(ValueError, match="kuhm"):
+        tubemem.run(bad, str(tmp_path / "bad"))
