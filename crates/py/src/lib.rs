@@ -37,8 +37,10 @@ fn gps_err(e: GpsError) -> PyErr {
     let msg = tubemem_app::error_chain(&e);
     match e {
         GpsError::InvalidInput { .. } => PyValueError::new_err(msg),
+        // a material parameter out of range, or a stretch asked for beyond the locking limit,
+        // is bad input
         GpsError::Material {
-            source: MaterialError::InvalidParameter { .. },
+            source: MaterialError::InvalidParameter { .. } | MaterialError::Locking { .. },
             ..
         } => PyValueError::new_err(msg),
         _ => TubememError::new_err(msg),
@@ -643,6 +645,23 @@ fn run<'py>(
     })
 }
 
+/// tubemem: pressurized membrane tubes — the closed form under generalized plane strain (GPS)
+/// and plane strain (PS), and the 3D nonlinear membrane finite element runs of whole capped
+/// tubes, inflated and squeezed between plates.
+///
+/// Units are dimensionless: R = 1, μH = 1, w = ϖ = pR/(μH) (eq. 67), resultants N/(μH),
+/// rho = r/R, chi = c/(πR) (eq. 72), force = ϖχ (eq. 80). Materials are dicts in the case-file
+/// form ({"model": "abb", "shear_modulus": 1.0, "kuhn": 30}); None is the paper's law.
+///
+/// Closed form: gps_inflate, gps_flatten (numbers or numpy arrays), gps_inflation_curve,
+/// gps_flattening_curve, gps_section_at_pressure, gps_limits, resultants.
+/// FE runs: run (a case as path, TOML text or dict → Run with numpy arrays), run_case,
+/// run_case_text (→ the summary dict), default_case.
+///
+/// Errors: ValueError for bad input (a parameter out of range, a stretch beyond the law's
+/// locking limit, a malformed case naming its key); TubememError (a RuntimeError) for a solve or
+/// run that fails, with the stage, step and cause. Ctrl-C stops a run (KeyboardInterrupt) with
+/// its converged steps kept.
 #[pymodule]
 fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -31,6 +31,14 @@ def rel(a, b):
     return abs(a - b) / abs(b)
 
 
+def test_module_docstring_and_stub():
+    assert "ValueError" in tubemem.__doc__ and "TubememError" in tubemem.__doc__
+    stub = pathlib.Path(__file__).resolve().parents[1] / "tubemem.pyi"
+    text = stub.read_text()
+    for name in ["gps_inflate", "gps_flatten", "run", "Run", "run_case", "TubememError"]:
+        assert f" {name}" in text and hasattr(tubemem, name)
+
+
 def test_module_metadata():
     assert tubemem.__version__
     assert issubclass(tubemem.TubememError, RuntimeError)
@@ -103,6 +111,7 @@ def test_resultants_are_eq_58_and_take_any_material():
         (lambda: tubemem.gps_inflate(1.3, material={"model": "abb", "kuhn": 30}), "shear_modulus"),
         (lambda: tubemem.gps_inflate(1.3, material={"model": "rubber"}), "rubber"),
         (lambda: tubemem.resultants(9.0, 9.0), "locking"),  # I1 = 162 > 3N = 90
+        (lambda: tubemem.gps_inflate(9.0), "locking"),  # beyond locking on the GPS path
         (lambda: tubemem.gps_flattening_curve(1.3, 0.8, points=1), "points"),
         # resource caps, checked before anything is allocated (no PanicException, no abort)
         (lambda: tubemem.gps_inflation_curve(2.0, points=2**62), "at most 10,000,000 points"),

@@ -1,0 +1,85 @@
+"""Type stubs of the `tubemem` module (PyO3). See the module docstring for units and errors."""
+
+from os import PathLike
+from pathlib import Path
+from typing import Any, Callable, Mapping, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class TubememError(RuntimeError):
+    """A closed-form solve or finite element run that failed (stage, step and cause)."""
+
+Material = Optional[Mapping[str, Any]]
+ArrayLike = Union[float, npt.ArrayLike]
+Progress = Optional[Callable[[dict], Any]]
+
+def gps_inflate(
+    stretch: ArrayLike, material: Material = None, hypothesis: str = "gps"
+) -> dict[str, Union[float, np.ndarray]]:
+    """Free inflation at hoop stretch λs (eq. 66 GPS, eq. 70 PS): w, lambda_s, lambda_z, n_s, n_z."""
+
+def gps_inflation_curve(
+    stretch_to: float,
+    points: int = 100,
+    stretch_from: float = 1.0,
+    material: Material = None,
+    hypothesis: str = "gps",
+) -> list[dict[str, float]]: ...
+def gps_flatten(
+    initial_stretch: float, rho: ArrayLike, material: Material = None, hypothesis: str = "gps"
+) -> dict[str, Union[float, np.ndarray]]:
+    """Squeeze between two plates with the gas closed in (eqs. 76–77 GPS, 78–79 PS)."""
+
+def gps_flattening_curve(
+    initial_stretch: float,
+    rho_to: float,
+    points: int = 100,
+    material: Material = None,
+    hypothesis: str = "gps",
+) -> list[dict[str, float]]: ...
+def gps_section_at_pressure(
+    rho: float, w: float, guess: tuple[float, float], material: Material = None
+) -> dict[str, float]:
+    """The GPS cross-section at half-gap rho under a given pressure w (eq. 76, no gas law)."""
+
+def gps_limits(material: Material = None, hypothesis: str = "gps") -> dict[str, Any]: ...
+def resultants(l1: float, l2: float, material: Material = None) -> tuple[float, float]:
+    """Cauchy resultants (N1, N2)/(μH) at principal stretches (eq. 18)."""
+
+def run_case(
+    case: Union[str, PathLike],
+    out: Union[str, PathLike],
+    overwrite: bool = False,
+    progress: Progress = None,
+) -> dict[str, Any]: ...
+def run_case_text(
+    text: str,
+    out: Union[str, PathLike],
+    base_dir: Optional[Union[str, PathLike]] = None,
+    overwrite: bool = False,
+    progress: Progress = None,
+) -> dict[str, Any]: ...
+def default_case() -> str: ...
+
+class Run:
+    """A finished FE run."""
+
+    @property
+    def summary(self) -> dict[str, Any]: ...
+    @property
+    def steps(self) -> dict[str, np.ndarray]: ...
+    @property
+    def path(self) -> Path: ...
+    def to_pandas(self) -> Any: ...
+    def vtu(self, k: int) -> Path: ...
+
+def run(
+    case: Union[str, PathLike, Mapping[str, Any]],
+    out: Union[str, PathLike],
+    base_dir: Optional[Union[str, PathLike]] = None,
+    overwrite: bool = False,
+    progress: Progress = None,
+) -> Run: ...
