@@ -493,13 +493,23 @@ impl RunWriter {
     }
 
     fn write_summary(&self, report: &RunReport) -> Result<()> {
+        self.write_summary_with(report, None)
+    }
+
+    /// summary.json; `error`, when given, goes in as a top-level `error` (a failure that no stage
+    /// records: the mesh, the model, the memory guard, an interrupt between stages).
+    fn write_summary_with(&self, report: &RunReport, error: Option<String>) -> Result<()> {
         let path = self.dir.join("summary.json");
         let tmp = self.dir.join(".summary.json.tmp");
-        let text =
-            serde_json::to_string_pretty(&report.summary()).map_err(|e| AppError::Output {
-                what: path.display().to_string(),
-                source: Box::new(e),
-            })?;
+        let fail = |e: serde_json::Error| AppError::Output {
+            what: path.display().to_string(),
+            source: Box::new(e),
+        };
+        let mut value = serde_json::to_value(report.summary()).map_err(fail)?;
+        if let (Some(e), Some(obj)) = (error, value.as_object_mut()) {
+            obj.insert("error".into(), serde_json::Value::String(e));
+        }
+        let text = serde_json::to_string_pretty(&value).map_err(fail)?;
         atomic_write(&path, &tmp, &text)
     }
 }
@@ -604,7 +614,12 @@ impl Observer for RunWriter {
         // Best effort: the run's error is what the user must see; a summary that cannot be
         // written here would have failed at the last stage end as well.
         if self.dir.is_dir() {
-            let _ = self.write_summary(report);
+            // a failure that no stage holds is recorded at the top
+            let in_a_stage = report
+                .stages
+                .iter()
+                .any(|s| matches!(s.outcome, crate::report::StageOutcome::Failed(_)));
+            let _ = self.write_summary_with(report, (!in_a_stage).then(|| error.chain()));
             let status = if matches!(error, AppError::Interrupted { .. }) {
                 "interrupted"
             } else {

@@ -1212,3 +1212,65 @@ fn resource_guards_refuse_with_their_estimate() {
         );
     }
 }
+
+/// Two real runs, one folder: while a run is writing into a folder, a second `tubemem run` into
+/// it is refused and names the first run's process; the first run is not disturbed.
+#[test]
+fn two_runs_cannot_share_a_folder() {
+    let d = tmp("two-runs");
+    let case = d.join("case.toml");
+    // long enough (a finer mesh, many small steps) that it is still running when the second
+    // starts; the test stops it right after
+    std::fs::write(
+        &case,
+        SMALL_CASE
+            .replace("steps = 4", "steps = 2000")
+            .replace("around = 16", "around = 32")
+            .replace("along = 24", "along = 64"),
+    )
+    .unwrap();
+    let out = d.join("out");
+    let first = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !out.join("run.json").exists() && t0.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let o = run_in(&case, &out, &["--overwrite"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    Command::new("kill")
+        .args(["-INT", &first.id().to_string()])
+        .status()
+        .unwrap();
+    let first_done = first.wait_with_output().unwrap();
+    assert!(!o.status.success(), "the second run must be refused: {err}");
+    assert!(
+        err.contains(&format!("pid {}", first_done_pid(&out))),
+        "{err}"
+    );
+    // the first run kept its own results: a manifest of its own, rows in order
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(manifest["status"], "interrupted");
+    let steps = Steps::read(&out.join("steps.csv"));
+    for (k, row) in steps.rows.iter().enumerate() {
+        assert_eq!(steps.num(row, "step"), (k + 1) as f64);
+    }
+    assert!(first_done.status.code() == Some(130));
+}
+
+/// The pid the manifest of a run folder names.
+fn first_done_pid(out: &std::path::Path) -> u64 {
+    let manifest: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    manifest["pid"].as_u64().unwrap()
+}
