@@ -268,6 +268,9 @@ def test_run_returns_arrays_equal_to_steps_csv_and_takes_cases_as_dicts(tmp_path
     with pytest.raises(ValueError, match="frame"):
         a.vtu(len(rows) + 1)
     assert "steps" in repr(a)
+    df = a.to_pandas()
+    assert list(df.columns) == list(a.steps) and len(df) == len(rows)
+    np.testing.assert_array_equal(df["lambda_s"].to_numpy(), a.steps["lambda_s"])
     # a bad dict names its key
     bad = dict(as_dict, material={"model": "abb", "shear_modulus": 1.0, "kuhm": 3})
     with pytest.raises(ValueError, match="kuhm"):
