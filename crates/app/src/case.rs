@@ -26,6 +26,10 @@
 //! max_iterations = 30
 //! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
 //!
+//! [output]              # optional
+//! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
+//! vtu_every = 1         # with "every": a frame every N steps (and each stage's last)
+//!
 //! [[stage]]
 //! kind = "inflate"
 //! control = "volume"    # "pressure" (target_pressure) | "volume" (target_stretch or target_volume_ratio)
@@ -85,6 +89,8 @@ pub struct Case {
     pub mesh: MeshSpec,
     #[serde(default)]
     pub solver: SolverSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
     #[serde(rename = "stage")]
     pub stages: Vec<StageSpec>,
     /// the stages resolved by validation (filled by [`Case::parse`])
@@ -93,6 +99,44 @@ pub struct Case {
     /// the hash of the case text ([`crate::output::case_hash`])
     #[serde(skip)]
     hash: String,
+}
+
+/// Which converged steps get a VTU frame.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum VtuFrames {
+    /// every converged step (every `vtu_every`-th)
+    #[default]
+    Every,
+    /// the last step of each stage
+    StageEnd,
+    /// none (the reference frame 0 is still written)
+    None,
+}
+
+/// `[output]`: optional.
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// "every" (default) | "stage-end" | "none"
+    #[serde(default)]
+    pub vtu: VtuFrames,
+    /// with `vtu = "every"`: a frame every this many steps (and the last of each stage)
+    #[serde(default = "default_vtu_every")]
+    pub vtu_every: usize,
+}
+
+fn default_vtu_every() -> usize {
+    1
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self {
+            vtu: VtuFrames::default(),
+            vtu_every: default_vtu_every(),
+        }
+    }
 }
 
 /// `[solver]`: optional.
@@ -444,6 +488,9 @@ impl Case {
         }
         if self.solver.max_iterations == 0 {
             invalid!("[solver] `max_iterations` must be ≥ 1");
+        }
+        if self.output.vtu_every == 0 {
+            invalid!("[output] `vtu_every` must be ≥ 1");
         }
         Ok(plan)
     }

@@ -167,6 +167,8 @@ pub struct RunWriter {
     checkpoint_every: usize,
     /// bytes of VTU written so far
     vtu_bytes: u64,
+    /// which steps get a frame
+    vtu: crate::case::OutputSpec,
 }
 
 const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT1";
@@ -366,12 +368,19 @@ impl RunWriter {
             resumed: false,
             checkpoint_every: 1,
             vtu_bytes: 0,
+            vtu: crate::case::OutputSpec::default(),
         })
     }
 
     /// Write a restart checkpoint every `n` converged steps (0: none; default 1).
     pub fn checkpoint_every(mut self, n: usize) -> Self {
         self.checkpoint_every = n;
+        self
+    }
+
+    /// Which steps get a VTU frame (`[output]`).
+    pub fn frames_of(mut self, output: crate::case::OutputSpec) -> Self {
+        self.vtu = output;
         self
     }
 
@@ -563,8 +572,17 @@ impl Observer for RunWriter {
             steps.flush()?;
             self.rows += 1;
         }
-        let time = (view.plan.index - 1) as f64 + view.fraction;
-        self.frame(time, view.model, view.state, view.load.contact.as_ref())?;
+        use crate::case::VtuFrames;
+        let stage_end = view.fraction >= 1.0;
+        let wanted = match self.vtu.vtu {
+            VtuFrames::Every => stage_end || view.record.step.is_multiple_of(self.vtu.vtu_every),
+            VtuFrames::StageEnd => stage_end,
+            VtuFrames::None => false,
+        };
+        if wanted {
+            let time = (view.plan.index - 1) as f64 + view.fraction;
+            self.frame(time, view.model, view.state, view.load.contact.as_ref())?;
+        }
         // the checkpoint of this step, alternating between two files (the last two are kept)
         if self.checkpoint_every == 0 || !self.rows.is_multiple_of(self.checkpoint_every) {
             return Ok(());

@@ -130,7 +130,9 @@ fn run_case(
             None,
         )
     };
-    writer = writer.checkpoint_every(case.solver.checkpoint_every);
+    writer = writer
+        .checkpoint_every(case.solver.checkpoint_every)
+        .frames_of(case.output);
     let mut console = Console::default();
     let options = RunOptions {
         resume: checkpoint,

@@ -1274,3 +1274,38 @@ fn first_done_pid(out: &std::path::Path) -> u64 {
         serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     manifest["pid"].as_u64().unwrap()
 }
+
+/// `[output] vtu`: every step (the default), every N-th step plus each stage's last, each
+/// stage's last only, or none; the PVD lists exactly the frames written.
+#[test]
+fn vtu_output_can_be_thinned_or_switched_off() {
+    let d = tmp("vtu-modes");
+    let text =
+        format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.0\nsteps = 4\n");
+    let mut rows = 0;
+    for (k, output) in ["", "vtu_every = 2", "vtu = \"stage-end\"", "vtu = \"none\""]
+        .iter()
+        .enumerate()
+    {
+        let case = d.join(format!("c{k}.toml"));
+        std::fs::write(
+            &case,
+            text.replace("[mesh]", &format!("[output]\n{output}\n\n[mesh]")),
+        )
+        .unwrap();
+        let out = d.join(format!("o{k}"));
+        assert!(run_in(&case, &out, &[]).status.success());
+        let frames = std::fs::read_dir(out.join("vtu")).unwrap().count();
+        let pvd = std::fs::read_to_string(out.join("tube.pvd")).unwrap();
+        assert_eq!(pvd.matches("<DataSet").count(), frames, "{output}");
+        match k {
+            0 => {
+                rows = Steps::read(&out.join("steps.csv")).rows.len();
+                assert_eq!(frames, rows + 1);
+            }
+            1 => assert!(frames < rows + 1 && frames > 3, "{frames} of {rows}"),
+            2 => assert_eq!(frames, 3, "the reference and two stage ends"),
+            _ => assert_eq!(frames, 1, "the reference only"),
+        }
+    }
+}

@@ -376,7 +376,7 @@ fn run_parsed<'py>(
     out: &std::path::Path,
     overwrite: bool,
     progress: Option<&Bound<'py, PyAny>>,
-) -> PyResult<tubemem_app::report::RunReport> {
+) -> PyResult<(tubemem_app::report::RunReport, usize)> {
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::mpsc::RecvTimeoutError;
     use std::sync::Arc;
@@ -388,7 +388,8 @@ fn run_parsed<'py>(
     };
     let mut writer = RunWriter::create(out, mode, case.hash())
         .map_err(|e| PyValueError::new_err(e.chain()))?
-        .checkpoint_every(case.solver.checkpoint_every);
+        .checkpoint_every(case.solver.checkpoint_every)
+        .frames_of(case.output);
     let flag = Arc::new(AtomicBool::new(false));
     let options = tubemem_app::run::RunOptions {
         interrupt: Some(flag.clone()),
@@ -457,7 +458,7 @@ fn run_parsed<'py>(
     if let Some(e) = raised {
         return Err(e);
     }
-    run_outcome(outcome, out)
+    Ok((run_outcome(outcome, out)?, writer.frames()))
 }
 
 /// Run a case file (TOML, as for `tubemem run`), writing steps.csv, summary.json, profiles/ and
@@ -475,7 +476,7 @@ fn run_case<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let parsed = tubemem_app::case::Case::read(&case)
         .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
-    let report = run_parsed(
+    let (report, _) = run_parsed(
         py,
         &parsed,
         &case.display().to_string(),
@@ -505,7 +506,7 @@ fn run_case_text<'py>(
         ))
     })?;
     case.base_dir = base_dir.unwrap_or_default();
-    let report = run_parsed(
+    let (report, _) = run_parsed(
         py,
         &case,
         "case text from Python",
@@ -524,7 +525,8 @@ fn default_case() -> &'static str {
 
 /// A finished FE run: `summary` (the dict of summary.json), `steps` (a dict of numpy arrays, one
 /// per steps.csv column, NaN where a column does not apply), `path` (the run folder) and
-/// `to_pandas()`; `vtu(k)` is the path of frame k (0 the reference state), readable with meshio.
+/// `to_pandas()`; `vtu(k)` is the path of VTU frame k (0 the reference state; which steps have a
+/// frame follows `[output] vtu`), readable with meshio.
 #[pyclass(name = "Run", module = "tubemem")]
 struct Run {
     summary: Py<PyAny>,
@@ -621,7 +623,7 @@ fn run<'py>(
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Run> {
     let (parsed, label) = case_from(py, case, base_dir)?;
-    let report = run_parsed(py, &parsed, &label, &out, overwrite, progress)?;
+    let (report, frames) = run_parsed(py, &parsed, &label, &out, overwrite, progress)?;
     let header: Vec<&str> = tubemem_app::output::STEPS_HEADER.split(',').collect();
     let rows: Vec<Vec<f64>> = report
         .steps()
@@ -641,7 +643,7 @@ fn run<'py>(
         summary: to_py(py, &report.summary())?.unbind(),
         steps: steps.into_any().unbind(),
         path: out,
-        frames: rows.len() + 1,
+        frames,
     })
 }
 
