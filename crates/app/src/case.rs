@@ -29,6 +29,7 @@
 //! [output]              # optional
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
 //! vtu_every = 1         # with "every": a frame every N steps (and each stage's last)
+//! vtu_format = "binary" # "binary" (default, exact) | "ascii"
 //!
 //! [[stage]]
 //! kind = "inflate"
@@ -124,6 +125,18 @@ pub struct OutputSpec {
     /// with `vtu = "every"`: a frame every this many steps (and the last of each stage)
     #[serde(default = "default_vtu_every")]
     pub vtu_every: usize,
+    /// "binary" (default: base64, exact, about a third of the size) | "ascii"
+    #[serde(default)]
+    pub vtu_format: VtuFormat,
+}
+
+/// How VTU arrays are written.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum VtuFormat {
+    #[default]
+    Binary,
+    Ascii,
 }
 
 fn default_vtu_every() -> usize {
@@ -135,6 +148,7 @@ impl Default for OutputSpec {
         Self {
             vtu: VtuFrames::default(),
             vtu_every: default_vtu_every(),
+            vtu_format: VtuFormat::default(),
         }
     }
 }

@@ -457,6 +457,10 @@ impl RunWriter {
                 cell("wrinkled", &wrinkled),
                 cell("contact_pressure", &pc),
             ],
+            match self.vtu.vtu_format {
+                crate::case::VtuFormat::Binary => tubemem_mesh::vtu::Encoding::Binary,
+                crate::case::VtuFormat::Ascii => tubemem_mesh::vtu::Encoding::Ascii,
+            },
         )?;
         self.vtu_bytes += std::fs::metadata(self.dir.join("vtu").join(&name))
             .map(|m| m.len())

@@ -185,6 +185,7 @@ fn vtu_writer_works_and_rejects_non_finite_fields() {
             components: 1,
             values: &flag,
         }],
+        vtu::Encoding::Ascii,
     )
     .unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
@@ -207,6 +208,7 @@ fn vtu_writer_works_and_rejects_non_finite_fields() {
             values: &bad,
         }],
         &[],
+        vtu::Encoding::Binary,
     );
     assert!(e.unwrap_err().to_string().contains("non-finite"));
 }

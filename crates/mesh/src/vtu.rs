@@ -1,5 +1,11 @@
-//! VTK XML output: one `.vtu` (UnstructuredGrid, ASCII, full precision) per saved step and a
-//! `.pvd` collection that ParaView opens as a time series. meshio reads the `.vtu` files too.
+//! VTK XML output: one `.vtu` (UnstructuredGrid) per saved step and a `.pvd` collection that
+//! ParaView opens as a time series; meshio reads the `.vtu` files too (the python_ref test
+//! `test_run_folder_reads_back` holds the two together).
+//!
+//! Arrays are written inline, either as ASCII text (`%e`, full precision) or binary: base64 of
+//! a UInt64 byte count followed by the little-endian values (`header_type="UInt64"`), exact and
+//! about a third of the size. Kept as a small writer of our own rather than a crate (vtkio):
+//! it is one function, it writes exactly the arrays tubemem needs, and meshio checks it.
 
 use crate::MeshError;
 use std::fmt::Write as _;
@@ -19,7 +25,70 @@ fn io_err(path: &Path, e: impl std::fmt::Display) -> MeshError {
     }
 }
 
-fn data_array(out: &mut String, f: &Field, count: usize) -> Result<(), String> {
+/// How arrays are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Encoding {
+    /// base64 of the little-endian bytes (exact, compact)
+    #[default]
+    Binary,
+    /// text, one tuple a line
+    Ascii,
+}
+
+const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Standard base64 (RFC 4648, with padding).
+pub fn base64(bytes: &[u8]) -> String {
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(B64[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// One DataArray: its XML head and the values, in `encoding`.
+fn array<T: Copy>(
+    out: &mut String,
+    head: &str,
+    values: &[T],
+    per_line: usize,
+    encoding: Encoding,
+    text: impl Fn(T) -> String,
+    bytes: impl Fn(T) -> Vec<u8>,
+) {
+    match encoding {
+        Encoding::Ascii => {
+            let _ = writeln!(out, "        <DataArray {head} format=\"ascii\">");
+            for chunk in values.chunks(per_line.max(1)) {
+                let line: Vec<String> = chunk.iter().map(|&v| text(v)).collect();
+                let _ = writeln!(out, "          {}", line.join(" "));
+            }
+        }
+        Encoding::Binary => {
+            let _ = writeln!(out, "        <DataArray {head} format=\"binary\">");
+            let mut raw: Vec<u8> = Vec::with_capacity(8 + values.len() * 8);
+            let data: Vec<u8> = values.iter().flat_map(|&v| bytes(v)).collect();
+            raw.extend_from_slice(&(data.len() as u64).to_le_bytes());
+            raw.extend_from_slice(&data);
+            let _ = writeln!(out, "          {}", base64(&raw));
+        }
+    }
+    out.push_str("        </DataArray>\n");
+}
+
+fn data_array(out: &mut String, f: &Field, count: usize, encoding: Encoding) -> Result<(), String> {
     if f.values.len() != f.components * count {
         return Err(format!(
             "field `{}` has {} values, expected {} × {}",
@@ -32,16 +101,18 @@ fn data_array(out: &mut String, f: &Field, count: usize) -> Result<(), String> {
     if let Some(v) = f.values.iter().find(|v| !v.is_finite()) {
         return Err(format!("field `{}` holds a non-finite value ({v})", f.name));
     }
-    let _ = writeln!(
+    array(
         out,
-        "        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">",
-        f.name, f.components
+        &format!(
+            "type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\"",
+            f.name, f.components
+        ),
+        f.values,
+        f.components,
+        encoding,
+        |v| format!("{v:e}"),
+        |v| v.to_le_bytes().to_vec(),
     );
-    for chunk in f.values.chunks(f.components.max(1)) {
-        let line: Vec<String> = chunk.iter().map(|v| format!("{v:e}")).collect();
-        let _ = writeln!(out, "          {}", line.join(" "));
-    }
-    out.push_str("        </DataArray>\n");
     Ok(())
 }
 
@@ -52,42 +123,70 @@ pub fn write_vtu(
     quads: &[[usize; 4]],
     point_data: &[Field],
     cell_data: &[Field],
+    encoding: Encoding,
 ) -> Result<(), MeshError> {
     let mut s = String::with_capacity(64 * (points.len() + quads.len()));
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <UnstructuredGrid>\n");
+    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n");
     let _ = writeln!(
         s,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
         points.len(),
         quads.len()
     );
-    s.push_str("      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for p in points {
-        if p.iter().any(|v| !v.is_finite()) {
-            return Err(io_err(path, "a node coordinate is not finite"));
-        }
-        let _ = writeln!(s, "          {:e} {:e} {:e}", p[0], p[1], p[2]);
+    if points.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(io_err(path, "a node coordinate is not finite"));
     }
-    s.push_str("        </DataArray>\n      </Points>\n      <Cells>\n");
-    s.push_str("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-    for q in quads {
-        let _ = writeln!(s, "          {} {} {} {}", q[0], q[1], q[2], q[3]);
-    }
-    s.push_str("        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
-    for i in 0..quads.len() {
-        let _ = writeln!(s, "          {}", 4 * (i + 1));
-    }
-    s.push_str("        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-    for _ in quads {
-        s.push_str("          9\n"); // VTK_QUAD
-    }
-    s.push_str("        </DataArray>\n      </Cells>\n      <PointData>\n");
+    s.push_str("      <Points>\n");
+    let coords: Vec<f64> = points.iter().flatten().copied().collect();
+    array(
+        &mut s,
+        "type=\"Float64\" NumberOfComponents=\"3\"",
+        &coords,
+        3,
+        encoding,
+        |v| format!("{v:e}"),
+        |v| v.to_le_bytes().to_vec(),
+    );
+    s.push_str("      </Points>\n      <Cells>\n");
+    let conn: Vec<i64> = quads.iter().flatten().map(|&i| i as i64).collect();
+    let offsets: Vec<i64> = (1..=quads.len()).map(|i| 4 * i as i64).collect();
+    let types: Vec<u8> = vec![9; quads.len()]; // VTK_QUAD
+    let int = |v: i64| v.to_string();
+    let int_bytes = |v: i64| v.to_le_bytes().to_vec();
+    array(
+        &mut s,
+        "type=\"Int64\" Name=\"connectivity\"",
+        &conn,
+        4,
+        encoding,
+        int,
+        int_bytes,
+    );
+    array(
+        &mut s,
+        "type=\"Int64\" Name=\"offsets\"",
+        &offsets,
+        1,
+        encoding,
+        int,
+        int_bytes,
+    );
+    array(
+        &mut s,
+        "type=\"UInt8\" Name=\"types\"",
+        &types,
+        1,
+        encoding,
+        |v| v.to_string(),
+        |v| vec![v],
+    );
+    s.push_str("      </Cells>\n      <PointData>\n");
     for f in point_data {
-        data_array(&mut s, f, points.len()).map_err(|e| io_err(path, e))?;
+        data_array(&mut s, f, points.len(), encoding).map_err(|e| io_err(path, e))?;
     }
     s.push_str("      </PointData>\n      <CellData>\n");
     for f in cell_data {
-        data_array(&mut s, f, quads.len()).map_err(|e| io_err(path, e))?;
+        data_array(&mut s, f, quads.len(), encoding).map_err(|e| io_err(path, e))?;
     }
     s.push_str("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
     std::fs::write(path, s).map_err(|e| io_err(path, e))
@@ -106,4 +205,25 @@ pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> Result<(), MeshError
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
     std::fs::write(path, s).map_err(|e| io_err(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::base64;
+
+    /// RFC 4648, section 10: the test vectors.
+    #[test]
+    fn base64_matches_rfc_4648() {
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(plain.as_bytes()), coded);
+        }
+    }
 }
