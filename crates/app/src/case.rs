@@ -30,6 +30,7 @@
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
 //! vtu_every = 1         # with "every": a frame every N steps (and each stage's last)
 //! vtu_format = "binary" # "binary" (default, exact) | "ascii"
+//! mirror = false        # true: the whole tube in the VTU, reflected from a reduced model
 //!
 //! [[stage]]
 //! kind = "inflate"
@@ -128,6 +129,9 @@ pub struct OutputSpec {
     /// "binary" (default: base64, exact, about a third of the size) | "ascii"
     #[serde(default)]
     pub vtu_format: VtuFormat,
+    /// write the whole tube, the symmetry-reduced model reflected across its planes
+    #[serde(default)]
+    pub mirror: bool,
 }
 
 /// How VTU arrays are written.
@@ -149,6 +153,7 @@ impl Default for OutputSpec {
             vtu: VtuFrames::default(),
             vtu_every: default_vtu_every(),
             vtu_format: VtuFormat::default(),
+            mirror: false,
         }
     }
 }

@@ -435,6 +435,19 @@ impl RunWriter {
                 .into(),
             }));
         }
+        // `[output] mirror`: the whole tube, the model reflected across its symmetry planes
+        let axes: &[usize] = if self.vtu.mirror {
+            model.mesh().symmetry.planes()
+        } else {
+            &[]
+        };
+        let m = Mirror::new(axes, model.mesh().nodes.len());
+        let (points, quads) = m.geometry(&state.x, &model.mesh().quads);
+        let disp = m.vector_field(&disp);
+        let cellf: Vec<Vec<f64>> = [&hoop, &axial, &n1, &n2, &wrinkled, &pc]
+            .iter()
+            .map(|f| m.cell_field(f))
+            .collect();
         let cell = |name, values| Field {
             name,
             components: 1,
@@ -442,20 +455,20 @@ impl RunWriter {
         };
         write_vtu(
             &self.dir.join("vtu").join(&name),
-            &state.x,
-            &model.mesh().quads,
+            &points,
+            &quads,
             &[Field {
                 name: "displacement",
                 components: 3,
                 values: &disp,
             }],
             &[
-                cell("hoop_stretch", &hoop),
-                cell("axial_stretch", &axial),
-                cell("N1", &n1),
-                cell("N2", &n2),
-                cell("wrinkled", &wrinkled),
-                cell("contact_pressure", &pc),
+                cell("hoop_stretch", &cellf[0]),
+                cell("axial_stretch", &cellf[1]),
+                cell("N1", &cellf[2]),
+                cell("N2", &cellf[3]),
+                cell("wrinkled", &cellf[4]),
+                cell("contact_pressure", &cellf[5]),
             ],
             match self.vtu.vtu_format {
                 crate::case::VtuFormat::Binary => tubemem_mesh::vtu::Encoding::Binary,
@@ -532,6 +545,66 @@ impl RunWriter {
 fn atomic_write(path: &Path, tmp: &Path, text: &str) -> Result<()> {
     std::fs::write(tmp, text).map_err(|e| AppError::io(tmp, e))?;
     std::fs::rename(tmp, path).map_err(|e| AppError::io(path, e))
+}
+
+/// The reflections that make the whole tube of a symmetry-reduced model: every combination of
+/// the mirror planes' axes (2^k copies). A copy reflected an odd number of times has its quads'
+/// node order reversed, so that every normal still points out. Nodes on a plane appear once per
+/// copy (ParaView's "Clean" merges them).
+struct Mirror {
+    /// per copy: the sign of each coordinate
+    signs: Vec<[f64; 3]>,
+    nodes: usize,
+}
+
+impl Mirror {
+    fn new(axes: &[usize], nodes: usize) -> Self {
+        let mut signs = vec![[1.0; 3]];
+        for &ax in axes {
+            let reflected: Vec<[f64; 3]> = signs
+                .iter()
+                .map(|s| {
+                    let mut t = *s;
+                    t[ax] = -t[ax];
+                    t
+                })
+                .collect();
+            signs.extend(reflected);
+        }
+        Self { signs, nodes }
+    }
+
+    fn geometry(&self, x: &[[f64; 3]], quads: &[[usize; 4]]) -> (Vec<[f64; 3]>, Vec<[usize; 4]>) {
+        let mut points = Vec::with_capacity(x.len() * self.signs.len());
+        let mut cells = Vec::with_capacity(quads.len() * self.signs.len());
+        for (k, s) in self.signs.iter().enumerate() {
+            points.extend(x.iter().map(|p| [s[0] * p[0], s[1] * p[1], s[2] * p[2]]));
+            let flip = s.iter().filter(|v| **v < 0.0).count() % 2 == 1;
+            let o = k * self.nodes;
+            cells.extend(quads.iter().map(|q| {
+                if flip {
+                    [q[0] + o, q[3] + o, q[2] + o, q[1] + o]
+                } else {
+                    [q[0] + o, q[1] + o, q[2] + o, q[3] + o]
+                }
+            }));
+        }
+        (points, cells)
+    }
+
+    fn vector_field(&self, v: &[f64]) -> Vec<f64> {
+        self.signs
+            .iter()
+            .flat_map(|s| {
+                v.chunks(3)
+                    .flat_map(move |c| [s[0] * c[0], s[1] * c[1], s[2] * c[2]])
+            })
+            .collect()
+    }
+
+    fn cell_field(&self, v: &[f64]) -> Vec<f64> {
+        self.signs.iter().flat_map(|_| v.iter().copied()).collect()
+    }
 }
 
 /// Write a profile (one row per ring) as CSV.
