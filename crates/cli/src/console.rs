@@ -18,6 +18,25 @@ pub struct Console {
     terminal: bool,
     /// a write error of a method that cannot return one, reported at the next that can
     pending: Option<std::io::Error>,
+    /// `--log FILE`: one line per converged step, like an Abaqus .sta file
+    log: Option<std::io::BufWriter<std::fs::File>>,
+    started: std::time::Instant,
+}
+
+impl Console {
+    /// Also write one line per converged step to `path` (created anew).
+    pub fn with_log(mut self, path: &std::path::Path) -> std::io::Result<Self> {
+        use std::io::Write;
+        let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+        writeln!(
+            f,
+            "{:>6} {:>6} {:>10} {:>14} {:>14} {:>7} {:>10} {:>10}",
+            "stage", "step", "elapsed_s", "w", "lambda_s", "newton", "residual", "fraction"
+        )?;
+        f.flush()?;
+        self.log = Some(f);
+        Ok(self)
+    }
 }
 
 impl Default for Console {
@@ -27,6 +46,8 @@ impl Default for Console {
             bar: None,
             terminal: std::io::stderr().is_terminal(),
             pending: None,
+            log: None,
+            started: std::time::Instant::now(),
         }
     }
 }
@@ -84,6 +105,22 @@ impl Observer for Console {
                 bar.set_message(msg);
             }
             None => say!("  stage {} {msg} ({:.0} %)", r.stage, 100.0 * v.fraction)?,
+        }
+        if let Some(f) = &mut self.log {
+            use std::io::Write;
+            writeln!(
+                f,
+                "{:>6} {:>6} {:>10.3} {:>14.8e} {:>14.8e} {:>7} {:>10.2e} {:>10.6}",
+                r.stage,
+                r.step,
+                self.started.elapsed().as_secs_f64(),
+                r.midspan.w,
+                r.midspan.lambda_s,
+                r.newton_iterations,
+                res,
+                v.fraction
+            )?;
+            f.flush()?;
         }
         Ok(())
     }

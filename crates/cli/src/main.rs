@@ -53,6 +53,10 @@ enum Command {
         /// be the one it started with).
         #[arg(long, conflicts_with = "overwrite")]
         resume: bool,
+        /// Also write one line per converged step to this file (stage, step, elapsed time, ϖ,
+        /// λs, Newton iterations, residual, fraction of the stage), like an Abaqus .sta file.
+        #[arg(long)]
+        log: Option<PathBuf>,
     },
     /// Write PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure.
     Figures {
@@ -107,6 +111,7 @@ fn run_case(
     overwrite: bool,
     force: bool,
     resume: bool,
+    log: Option<&std::path::Path>,
 ) -> Result<()> {
     let case = Case::read(case_path).map_err(|e| app(e.into()))?;
     let (mut writer, checkpoint) = if resume {
@@ -134,6 +139,11 @@ fn run_case(
         .checkpoint_every(case.solver.checkpoint_every)
         .frames_of(case.output);
     let mut console = Console::default();
+    if let Some(path) = log {
+        console = console
+            .with_log(path)
+            .with_context(|| format!("cannot create the log {}", path.display()))?;
+    }
     let options = RunOptions {
         resume: checkpoint,
         force,
@@ -180,7 +190,8 @@ fn run(cli: Cli) -> Result<()> {
             overwrite,
             force,
             resume,
-        }) => run_case(&case, &out, overwrite, force, resume),
+            log,
+        }) => run_case(&case, &out, overwrite, force, resume, log.as_deref()),
         Some(Command::Figures { out, kuhn, overlay }) => {
             let written = tubemem_app::figures::write_all(&out, kuhn, &overlay).map_err(app)?;
             for p in written {

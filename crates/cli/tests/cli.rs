@@ -1309,3 +1309,24 @@ fn vtu_output_can_be_thinned_or_switched_off() {
         }
     }
 }
+
+/// `--log FILE`: a header and one line per converged step (stage, step, elapsed time, ϖ, λs,
+/// Newton iterations, residual, fraction), the ϖ of each line that of steps.csv.
+#[test]
+fn run_log_has_a_line_per_step() {
+    let d = tmp("log");
+    let case = d.join("case.toml");
+    std::fs::write(&case, SMALL_CASE).unwrap();
+    let log = d.join("run.sta");
+    let o = run_in(&case, &d.join("out"), &["--log", log.to_str().unwrap()]);
+    assert!(o.status.success());
+    let steps = Steps::read(&d.join("out").join("steps.csv"));
+    let text = std::fs::read_to_string(&log).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].contains("elapsed_s") && lines[0].contains("residual"));
+    assert_eq!(lines.len(), steps.rows.len() + 1);
+    for (line, row) in lines[1..].iter().zip(&steps.rows) {
+        let w: f64 = line.split_whitespace().nth(3).unwrap().parse().unwrap();
+        assert!((w / steps.num(row, "w") - 1.0).abs() < 1e-8, "{line}");
+    }
+}
