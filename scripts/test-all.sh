@@ -28,11 +28,11 @@ echo "== Python API: maturin develop (crates/py, release)"
 VIRTUAL_ENV="$PWD/.venv" .venv/bin/maturin develop --release --quiet -m crates/py/Cargo.toml
 echo "== pytest: python_ref/tests"
 TUBEMEM_BIN="$PWD/target/release/tubemem" .venv/bin/python -m pytest python_ref/tests -q
-echo "== pytest: crates/py/tests (the Python API)"
-.venv/bin/python -m pytest crates/py/tests -q
 echo "== the Python package installs with plain pip in a fresh venv (no maturin beforehand)"
 WHEEL_VENV=$(mktemp -d)
 "$PY" -m venv "$WHEEL_VENV"
 "$WHEEL_VENV/bin/python" -m pip install --quiet ./crates/py
 "$WHEEL_VENV/bin/python" -c "import numpy, tubemem; w = tubemem.gps_inflate(numpy.array([1.3]))['w'][0]; assert abs(w - 0.6514226) < 1e-6, w; print('pip install ./crates/py: ok, gps_inflate(1.3) =', w)"
 rm -rf "$WHEEL_VENV"
+echo "== pytest: crates/py/tests (the Python API)"
+.venv/bin/python -m pytest crates/py/tests -q
