@@ -366,7 +366,6 @@ pub struct RunOptions {
 /// recorded in the report.
 #[allow(clippy::too_many_arguments)]
 fn setup_stage(
-    _case: &Case,
     plan: &StagePlan,
     stages: usize,
     model: &mut Model,
@@ -694,7 +693,6 @@ fn run_inner(
             Some(ck) => (ck.context, Some(ck.progress), ck.steps.clone()),
             None => {
                 let ctx = setup_stage(
-                    case,
                     plan,
                     stages,
                     &mut model,

@@ -127,15 +127,14 @@ fn gps_inflate<'py>(
         let s = tubemem_gps::inflate(law.as_ref(), hyp, v).map_err(gps_err)?;
         return to_py(py, &s);
     }
+    use tubemem_app::curves::{inflation_values, INFLATION_HEADER};
+    let keys: Vec<&str> = INFLATION_HEADER.split(',').collect();
     vectorized(
         py,
         stretch,
         "stretch",
-        |v| {
-            tubemem_gps::inflate(law.as_ref(), hyp, v)
-                .map(|s| vec![s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z])
-        },
-        &["w", "lambda_s", "lambda_z", "n_s", "n_z"],
+        |v| tubemem_gps::inflate(law.as_ref(), hyp, v).map(|s| inflation_values(&s)),
+        &keys,
     )
 }
 
@@ -223,36 +222,17 @@ fn gps_flatten<'py>(
         let s = tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r).map_err(gps_err)?;
         return to_py(py, &s);
     }
+    use tubemem_app::curves::{flattening_values, FLATTENING_HEADER};
+    let keys: Vec<&str> = FLATTENING_HEADER.split(',').collect();
     vectorized(
         py,
         rho,
         "rho",
         |r| {
-            tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r).map(|s| {
-                vec![
-                    s.w,
-                    s.lambda_s,
-                    s.lambda_z,
-                    s.n_s,
-                    s.n_z,
-                    s.rho,
-                    s.chi,
-                    s.force,
-                    s.displacement,
-                ]
-            })
+            tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r)
+                .map(|s| flattening_values(&s))
         },
-        &[
-            "w",
-            "lambda_s",
-            "lambda_z",
-            "n_s",
-            "n_z",
-            "rho",
-            "chi",
-            "force",
-            "displacement",
-        ],
+        &keys,
     )
 }
 
