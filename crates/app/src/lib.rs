@@ -139,6 +139,21 @@ impl AppError {
             _ => None,
         }
     }
+    /// Whether the failure is the input's (a case, mesh or folder the run cannot take) rather
+    /// than a solve's: front ends map the first to their bad-input error (Python's ValueError).
+    pub fn is_input_error(&self) -> bool {
+        matches!(
+            self,
+            AppError::Case(_)
+                | AppError::MeshFile { .. }
+                | AppError::Mesh(_)
+                | AppError::Material(_)
+                | AppError::StageInput { .. }
+                | AppError::TooLarge { .. }
+                | AppError::Folder { .. }
+        )
+    }
+
     /// The whole message, cause after cause.
     pub fn chain(&self) -> String {
         error_chain(self)

@@ -305,6 +305,8 @@ fn run_outcome(
 ) -> PyResult<tubemem_app::report::RunReport> {
     match outcome.error {
         None => Ok(outcome.report),
+        // the exception policy: bad input is ValueError, a solve that fails TubememError
+        Some(e) if e.is_input_error() => Err(PyValueError::new_err(e.chain())),
         Some(e) => Err(TubememError::new_err(format!(
             "{}; the converged steps are in {}",
             e.chain(),

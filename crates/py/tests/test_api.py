@@ -154,6 +154,19 @@ def test_a_malformed_case_names_the_key(tmp_path):
         tubemem.run_case_text(SMALL_CASE.replace("kuhn = 30", "kuhn = 30\nkuhm = 2"), str(tmp_path))
 
 
+@pytest.mark.parametrize(
+    "old, new, needle",
+    [
+        ("around = 16", "around = 60", "around"),  # not a multiple of 8: found when meshing
+        ("kuhn = 30", "kuhn = 0.5", "kuhn"),
+        ("target_rho = 1.0", "target_rho = 5.0", "target_rho"),  # above the tube: found at the stage
+    ],
+)
+def test_the_exception_policy_bad_input_is_value_error_wherever_it_is_found(tmp_path, old, new, needle):
+    with pytest.raises(ValueError, match=needle):
+        tubemem.run_case_text(SMALL_CASE.replace(old, new), str(tmp_path / "o"))
+
+
 def test_a_failing_run_raises_and_keeps_its_converged_steps(tmp_path):
     # N = 3 locks near lambda_s = 2.4 on the GPS path; the case asks for 3.0
     text = SMALL_CASE.replace("kuhn = 30", "kuhn = 3").replace("target_stretch = 1.2", "target_stretch = 3.0")
