@@ -557,7 +557,81 @@ impl Run {
     }
 }
 
-/// A case given as a path to a TOML file, TOML text, or a dict of the case file's tables.
+/// A validated case. `Case(geometry=…, material=…, mesh=…, stage=[…], solver=…, output=…)` takes
+/// the case file's tables as keyword arguments; `Case.from_dict(d)`, `Case.from_toml(text)` and
+/// `Case.read(path)` the other forms. Validation happens on construction (ValueError naming the
+/// table and key); `to_toml()` and `to_dict()` give it back. `tubemem.run` takes it.
+#[pyclass(name = "Case", module = "tubemem")]
+struct PyCase {
+    toml: String,
+    base_dir: PathBuf,
+}
+
+impl PyCase {
+    fn parse(toml: String, base_dir: PathBuf) -> PyResult<Self> {
+        tubemem_app::case::Case::parse(&toml)
+            .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
+        Ok(Self { toml, base_dir })
+    }
+
+    fn from_value(d: &Bound<'_, PyAny>, base_dir: PathBuf) -> PyResult<Self> {
+        let value: serde_json::Value = from_py(d, "case")?;
+        let table = toml::Value::try_from(value)
+            .map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
+        let text =
+            toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
+        Self::parse(text, base_dir)
+    }
+}
+
+#[pymethods]
+impl PyCase {
+    #[new]
+    #[pyo3(signature = (base_dir=None, **tables))]
+    fn new(
+        base_dir: Option<PathBuf>,
+        tables: Option<&Bound<'_, pyo3::types::PyDict>>,
+    ) -> PyResult<Self> {
+        let py_tables = match tables {
+            Some(t) => t.clone(),
+            None => return Err(PyValueError::new_err("Case: give the case file's tables as keywords (geometry=…, material=…, mesh=…, stage=[…])")),
+        };
+        Self::from_value(py_tables.as_any(), base_dir.unwrap_or_default())
+    }
+    #[staticmethod]
+    #[pyo3(signature = (d, base_dir=None))]
+    fn from_dict(d: &Bound<'_, PyAny>, base_dir: Option<PathBuf>) -> PyResult<Self> {
+        Self::from_value(d, base_dir.unwrap_or_default())
+    }
+    #[staticmethod]
+    #[pyo3(signature = (text, base_dir=None))]
+    fn from_toml(text: String, base_dir: Option<PathBuf>) -> PyResult<Self> {
+        Self::parse(text, base_dir.unwrap_or_default())
+    }
+    /// Read a case file (user meshes are looked up relative to its folder).
+    #[staticmethod]
+    fn read(path: PathBuf) -> PyResult<Self> {
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| PyValueError::new_err(format!("cannot read {}: {e}", path.display())))?;
+        Self::parse(text, path.parent().map(PathBuf::from).unwrap_or_default())
+    }
+    fn to_toml(&self) -> String {
+        self.toml.clone()
+    }
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("tomllib")?
+            .call_method1("loads", (self.toml.as_str(),))
+    }
+    fn __repr__(&self) -> String {
+        format!("<tubemem.Case: {} bytes of TOML>", self.toml.len())
+    }
+    fn __eq__(&self, other: &Self) -> bool {
+        self.toml == other.toml
+    }
+}
+
+/// A case given as a `Case`, a path to a TOML file, TOML text, or a dict of the case file's
+/// tables.
 fn case_from(
     py: Python<'_>,
     case: &Bound<'_, PyAny>,
@@ -565,15 +639,17 @@ fn case_from(
 ) -> PyResult<(tubemem_app::case::Case, String)> {
     let invalid =
         |e: tubemem_app::case::CaseError| PyValueError::new_err(tubemem_app::error_chain(&e));
-    if let Ok(d) = case.cast::<pyo3::types::PyDict>() {
-        let value: serde_json::Value = from_py(d.as_any(), "case")?;
-        let table = toml::Value::try_from(value)
-            .map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
-        let text =
-            toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
-        let mut c = tubemem_app::case::Case::parse(&text).map_err(invalid)?;
-        c.base_dir = base_dir.unwrap_or_default();
-        return Ok((c, "case dict from Python".into()));
+    if let Ok(c) = case.cast::<PyCase>() {
+        let c = c.borrow();
+        let mut parsed = tubemem_app::case::Case::parse(&c.toml).map_err(invalid)?;
+        parsed.base_dir = base_dir.unwrap_or_else(|| c.base_dir.clone());
+        return Ok((parsed, "case from Python".into()));
+    }
+    if case.cast::<pyo3::types::PyDict>().is_ok() {
+        let c = PyCase::from_value(case, PathBuf::new())?;
+        let mut parsed = tubemem_app::case::Case::parse(&c.toml).map_err(invalid)?;
+        parsed.base_dir = base_dir.unwrap_or_default();
+        return Ok((parsed, "case dict from Python".into()));
     }
     let text: String = case
         .str()
@@ -662,5 +738,6 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_case, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Run>()?;
+    m.add_class::<PyCase>()?;
     Ok(())
 }
