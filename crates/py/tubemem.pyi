@@ -96,3 +96,15 @@ def run(
     overwrite: bool = False,
     progress: Progress = None,
 ) -> Run: ...
+
+def sweep(
+    cases: list,
+    out: Union[str, PathLike],
+    params: Optional[list[Mapping[str, Any]]] = None,
+    client: Any = None,
+    processes: Optional[int] = None,
+) -> Any:
+    """Run many cases (locally in processes, or on a Dask client); a pandas DataFrame with one
+    row per case and converged step; failed members keep their `error` and lose no others."""
+
+def _sweep_one(index: int, text: str, out: Union[str, PathLike]) -> dict[str, Any]: ...

@@ -722,6 +722,168 @@ fn run<'py>(
 /// locking limit, a malformed case naming its key); TubememError (a RuntimeError) for a solve or
 /// run that fails, with the stage, step and cause. Ctrl-C stops a run (KeyboardInterrupt) with
 /// its converged steps kept.
+/// One member of a sweep, run where a worker runs it (a process of this machine or a Dask
+/// worker): the case (TOML text) into `out`; returns a dict with the case's index, the steps
+/// as lists (one per steps.csv column), the summary, and the error (None when it finished), so
+/// that a failing member does not lose the others.
+#[pyfunction]
+fn _sweep_one<'py>(
+    py: Python<'py>,
+    index: usize,
+    text: String,
+    out: PathBuf,
+) -> PyResult<Bound<'py, PyAny>> {
+    let result = pyo3::types::PyDict::new(py);
+    result.set_item("index", index)?;
+    result.set_item("out", out.display().to_string())?;
+    let parsed = tubemem_app::case::Case::parse(&text);
+    let outcome = match parsed {
+        Err(e) => Err(tubemem_app::error_chain(&e)),
+        Ok(case) => run_parsed(
+            py,
+            &case,
+            &format!("sweep member {index}"),
+            &out,
+            true,
+            None,
+        )
+        .map_err(|e| e.value(py).to_string()),
+    };
+    match outcome {
+        Ok((report, _)) => {
+            let header: Vec<&str> = tubemem_app::output::STEPS_HEADER.split(',').collect();
+            let steps = pyo3::types::PyDict::new(py);
+            let rows: Vec<Vec<f64>> = report
+                .steps()
+                .map(|r| {
+                    tubemem_app::output::step_row(r)
+                        .into_iter()
+                        .map(|v| v.unwrap_or(f64::NAN))
+                        .collect()
+                })
+                .collect();
+            for (j, name) in header.iter().enumerate() {
+                let col: Vec<f64> = rows.iter().map(|r| r[j]).collect();
+                steps.set_item(name, col)?;
+            }
+            result.set_item("steps", steps)?;
+            result.set_item("summary", to_py(py, &report.summary())?)?;
+            result.set_item("error", py.None())?;
+        }
+        Err(msg) => {
+            result.set_item("steps", pyo3::types::PyDict::new(py))?;
+            result.set_item("summary", py.None())?;
+            result.set_item("error", msg)?;
+        }
+    }
+    Ok(result.into_any())
+}
+
+/// Run a list of cases (each a `Case`, TOML text, a path or a dict) into `out/case_NNN`, and
+/// return a pandas DataFrame with one row per case and converged step: the case's index, its
+/// parameters `params[i]` (a dict per case, optional) and the steps.csv columns (mid-span
+/// values, the closed form at the step). By default the cases run in processes of this
+/// machine (`processes`, default the CPU count); with `client=` (a `dask.distributed.Client`)
+/// they run on its cluster, the same code on a laptop's `LocalCluster` or a multi-node
+/// cluster. A case that fails is a row with its `error` and no steps; the others are kept.
+#[pyfunction]
+#[pyo3(signature = (cases, out, params=None, client=None, processes=None))]
+fn sweep<'py>(
+    py: Python<'py>,
+    cases: &Bound<'py, PyAny>,
+    out: PathBuf,
+    params: Option<&Bound<'py, PyAny>>,
+    client: Option<&Bound<'py, PyAny>>,
+    processes: Option<usize>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut texts = vec![];
+    for c in cases.try_iter()? {
+        let c = c?;
+        // validate every case before any runs: a typo fails the sweep at once
+        case_from(py, &c, None)?;
+        texts.push(case_text(py, &c)?);
+    }
+    std::fs::create_dir_all(&out)
+        .map_err(|e| PyValueError::new_err(format!("cannot create {}: {e}", out.display())))?;
+    let module = py.import("tubemem")?;
+    let one = module.getattr("_sweep_one")?;
+    let n = texts.len();
+    let indices: Vec<usize> = (0..n).collect();
+    let outs: Vec<String> = (0..n)
+        .map(|i| out.join(format!("case_{i:03}")).display().to_string())
+        .collect();
+    let results: Bound<'py, PyAny> = match client {
+        Some(client) => {
+            let futures = client.call_method1("map", (one, indices, texts, outs))?;
+            client.call_method1("gather", (futures,))?
+        }
+        None => {
+            let cf = py.import("concurrent.futures")?;
+            let kwargs = pyo3::types::PyDict::new(py);
+            if let Some(p) = processes {
+                kwargs.set_item("max_workers", p)?;
+            }
+            let pool = cf.call_method("ProcessPoolExecutor", (), Some(&kwargs))?;
+            let mapped = pool.call_method1("map", (one, indices, texts, outs));
+            let listed = mapped.and_then(|m| py.import("builtins")?.call_method1("list", (m,)));
+            pool.call_method0("shutdown")?;
+            listed?
+        }
+    };
+    let rows = pyo3::types::PyList::empty(py);
+    let param_list: Vec<Option<Bound<'py, PyAny>>> = match params {
+        Some(p) => p
+            .try_iter()?
+            .map(|x| x.map(Some))
+            .collect::<PyResult<_>>()?,
+        None => vec![None; n],
+    };
+    for r in results.try_iter()? {
+        let r = r?;
+        let index: usize = r.get_item("index")?.extract()?;
+        let error = r.get_item("error")?;
+        let steps = r.get_item("steps")?;
+        let base = pyo3::types::PyDict::new(py);
+        base.set_item("case", index)?;
+        if let Some(Some(p)) = param_list.get(index) {
+            base.call_method1("update", (p,))?;
+        }
+        base.set_item("error", &error)?;
+        let count = steps.get_item("step").and_then(|c| c.len()).unwrap_or(0);
+        if count == 0 {
+            rows.append(&base)?;
+        }
+        for k in 0..count {
+            let row = base.copy()?;
+            for item in steps.call_method0("items")?.try_iter()? {
+                let item = item?;
+                let (name, col) = (item.get_item(0)?, item.get_item(1)?);
+                row.set_item(name, col.get_item(k)?)?;
+            }
+            rows.append(row)?;
+        }
+    }
+    py.import("pandas")?.call_method1("DataFrame", (rows,))
+}
+
+/// The TOML text of a case given in any of `run`'s forms.
+fn case_text(py: Python<'_>, case: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(c) = case.cast::<PyCase>() {
+        return Ok(c.borrow().toml.clone());
+    }
+    if case.cast::<pyo3::types::PyDict>().is_ok() {
+        return Ok(PyCase::from_value(case, PathBuf::new())?.toml);
+    }
+    let text: String = case.str()?.extract()?;
+    let path = PathBuf::from(&text);
+    if !text.contains('\n') && path.is_file() {
+        return std::fs::read_to_string(&path)
+            .map_err(|e| PyValueError::new_err(format!("cannot read {}: {e}", path.display())));
+    }
+    let _ = py;
+    Ok(text)
+}
+
 #[pymodule]
 fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -739,5 +901,7 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Run>()?;
     m.add_class::<PyCase>()?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(_sweep_one, m)?)?;
     Ok(())
 }

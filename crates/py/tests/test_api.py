@@ -312,3 +312,44 @@ def test_cases_as_data_equal_the_toml(tmp_path):
     lengths = [4.0, 6.0]
     cases = [tubemem.Case(**dict(tables, geometry={"radius": 1.0, "length": L})) for L in lengths]
     assert [tubemem.Case.to_dict(k)["geometry"]["length"] for k in cases] == lengths
+
+
+def _sweep_cases():
+    import tomllib
+
+    tables = tomllib.loads(SMALL_CASE)
+    lengths = [4.0, 6.0, 8.0]
+    cases = [tubemem.Case(**dict(tables, geometry={"radius": 1.0, "length": L})) for L in lengths]
+    # a member that fails (beyond the locking limit of N = 3) must not lose the others
+    bad = dict(tables, material={"model": "abb", "shear_modulus": 1.0, "kuhn": 3})
+    bad["stage"] = [dict(tables["stage"][0], target_stretch=3.0)]
+    return cases + [tubemem.Case(**bad)], [{"L/R": L} for L in lengths] + [{"L/R": 8.0}]
+
+
+def test_sweep_runs_in_local_processes_and_keeps_finished_runs(tmp_path):
+    cases, params = _sweep_cases()
+    df = tubemem.sweep(cases, str(tmp_path), params=params, processes=2)
+    assert set(df["case"]) == {0, 1, 2, 3}
+    ok = df[df["error"].isna()]
+    assert set(ok["case"]) == {0, 1, 2}
+    # one row per case and step, the last row of each case its final state (summary.json)
+    for i in range(3):
+        last = ok[ok["case"] == i].iloc[-1]
+        import json
+
+        summary = json.loads((tmp_path / f"case_{i:03d}" / "summary.json").read_text())
+        assert last["w"] == summary["stages"][-1]["final"]["w"]
+        assert last["L/R"] == [4.0, 6.0, 8.0][i] == summary["geometry"]["length"]
+    failed = df[df["case"] == 3]
+    assert len(failed) == 1 and "locking" in failed["error"].iloc[0]
+
+
+def test_sweep_on_a_dask_local_cluster_equals_the_local_one(tmp_path):
+    import dask.distributed as distributed  # in the test requirements: a missing one fails
+    cases, params = _sweep_cases()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        df = tubemem.sweep(cases, str(tmp_path / "dask"), params=params, client=client)
+    local = tubemem.sweep(cases, str(tmp_path / "local"), params=params, processes=2)
+    cols = [c for c in local.columns if c not in ("error",)]
+    assert df[cols].equals(local[cols])
+    assert (df["error"].isna() == local["error"].isna()).all()
