@@ -705,23 +705,6 @@ fn run<'py>(
     })
 }
 
-/// tubemem: pressurized membrane tubes — the closed form under generalized plane strain (GPS)
-/// and plane strain (PS), and the 3D nonlinear membrane finite element runs of whole capped
-/// tubes, inflated and squeezed between plates.
-///
-/// Units are dimensionless: R = 1, μH = 1, w = ϖ = pR/(μH) (eq. 67), resultants N/(μH),
-/// rho = r/R, chi = c/(πR) (eq. 72), force = ϖχ (eq. 80). Materials are dicts in the case-file
-/// form ({"model": "abb", "shear_modulus": 1.0, "kuhn": 30}); None is the paper's law.
-///
-/// Closed form: gps_inflate, gps_flatten (numbers or numpy arrays), gps_inflation_curve,
-/// gps_flattening_curve, gps_section_at_pressure, gps_limits, resultants.
-/// FE runs: run (a case as path, TOML text or dict → Run with numpy arrays), run_case,
-/// run_case_text (→ the summary dict), default_case.
-///
-/// Errors: ValueError for bad input (a parameter out of range, a stretch beyond the law's
-/// locking limit, a malformed case naming its key); TubememError (a RuntimeError) for a solve or
-/// run that fails, with the stage, step and cause. Ctrl-C stops a run (KeyboardInterrupt) with
-/// its converged steps kept.
 /// One member of a sweep, run where a worker runs it (a process of this machine or a Dask
 /// worker): the case (TOML text) into `out`; returns a dict with the case's index, the steps
 /// as lists (one per steps.csv column), the summary, and the error (None when it finished), so
@@ -823,6 +806,12 @@ fn sweep<'py>(
             if let Some(p) = processes {
                 kwargs.set_item("max_workers", p)?;
             }
+            // fresh interpreters, not forks: a fork of a process whose solver threads hold
+            // locks can deadlock
+            let spawn = py
+                .import("multiprocessing")?
+                .call_method1("get_context", ("spawn",))?;
+            kwargs.set_item("mp_context", spawn)?;
             let pool = cf.call_method("ProcessPoolExecutor", (), Some(&kwargs))?;
             let mapped = pool.call_method1("map", (one, indices, texts, outs));
             let listed = mapped.and_then(|m| py.import("builtins")?.call_method1("list", (m,)));
@@ -884,6 +873,23 @@ fn case_text(py: Python<'_>, case: &Bound<'_, PyAny>) -> PyResult<String> {
     Ok(text)
 }
 
+/// tubemem: pressurized membrane tubes — the closed form under generalized plane strain (GPS)
+/// and plane strain (PS), and the 3D nonlinear membrane finite element runs of whole capped
+/// tubes, inflated and squeezed between plates.
+///
+/// Units are dimensionless: R = 1, μH = 1, w = ϖ = pR/(μH) (eq. 67), resultants N/(μH),
+/// rho = r/R, chi = c/(πR) (eq. 72), force = ϖχ (eq. 80). Materials are dicts in the case-file
+/// form ({"model": "abb", "shear_modulus": 1.0, "kuhn": 30}); None is the paper's law.
+///
+/// Closed form: gps_inflate, gps_flatten (numbers or numpy arrays), gps_inflation_curve,
+/// gps_flattening_curve, gps_section_at_pressure, gps_limits, resultants.
+/// FE runs: run (a case as path, TOML text or dict → Run with numpy arrays), run_case,
+/// run_case_text (→ the summary dict), default_case.
+///
+/// Errors: ValueError for bad input (a parameter out of range, a stretch beyond the law's
+/// locking limit, a malformed case naming its key); TubememError (a RuntimeError) for a solve or
+/// run that fails, with the stage, step and cause. Ctrl-C stops a run (KeyboardInterrupt) with
+/// its converged steps kept.
 #[pymodule]
 fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
