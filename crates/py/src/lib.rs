@@ -505,6 +505,21 @@ fn default_case() -> &'static str {
     tubemem_app::main_job::DEFAULT_CASE
 }
 
+/// The steps of a report as (steps.csv column, values) pairs, NaN where a column does not apply.
+fn step_columns(report: &tubemem_app::report::RunReport) -> Vec<(&'static str, Vec<f64>)> {
+    let rows: Vec<Vec<Option<f64>>> = report.steps().map(tubemem_app::output::step_row).collect();
+    tubemem_app::output::STEPS_HEADER
+        .split(',')
+        .enumerate()
+        .map(|(j, name)| {
+            (
+                name,
+                rows.iter().map(|r| r[j].unwrap_or(f64::NAN)).collect(),
+            )
+        })
+        .collect()
+}
+
 /// A finished FE run: `summary` (the dict of summary.json), `steps` (a dict of numpy arrays, one
 /// per steps.csv column, NaN where a column does not apply), `path` (the run folder) and
 /// `to_pandas()`; `vtu(k)` is the path of VTU frame k (0 the reference state; which steps have a
@@ -682,19 +697,8 @@ fn run<'py>(
 ) -> PyResult<Run> {
     let (parsed, label) = case_from(py, case, base_dir)?;
     let (report, frames) = run_parsed(py, &parsed, &label, &out, overwrite, progress)?;
-    let header: Vec<&str> = tubemem_app::output::STEPS_HEADER.split(',').collect();
-    let rows: Vec<Vec<f64>> = report
-        .steps()
-        .map(|r| {
-            tubemem_app::output::step_row(r)
-                .into_iter()
-                .map(|v| v.unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
     let steps = pyo3::types::PyDict::new(py);
-    for (j, name) in header.iter().enumerate() {
-        let col: Vec<f64> = rows.iter().map(|r| r[j]).collect();
+    for (name, col) in step_columns(&report) {
         steps.set_item(name, numpy::PyArray1::from_vec(py, col))?;
     }
     Ok(Run {
@@ -734,19 +738,8 @@ fn _sweep_one<'py>(
     };
     match outcome {
         Ok((report, _)) => {
-            let header: Vec<&str> = tubemem_app::output::STEPS_HEADER.split(',').collect();
             let steps = pyo3::types::PyDict::new(py);
-            let rows: Vec<Vec<f64>> = report
-                .steps()
-                .map(|r| {
-                    tubemem_app::output::step_row(r)
-                        .into_iter()
-                        .map(|v| v.unwrap_or(f64::NAN))
-                        .collect()
-                })
-                .collect();
-            for (j, name) in header.iter().enumerate() {
-                let col: Vec<f64> = rows.iter().map(|r| r[j]).collect();
+            for (name, col) in step_columns(&report) {
                 steps.set_item(name, col)?;
             }
             result.set_item("steps", steps)?;
