@@ -1,24 +1,36 @@
-//! PNG and CSV reproductions of the paper's Figs. 5–7, plus λz versus λs.
+//! Reproductions of the paper's Figs. 5–7, plus λz versus λs, for any membrane law, as SVG and
+//! anti-aliased PNG, with their data as CSV.
 //!
 //! Fig. 5: ϖ versus λs, GPS and PS inflation (solid) and the flattening branches from
-//! λs* = 1.3 and 6.0 (dashed), with the GPS limit points and Maxwell pressure marked.
+//! λs* = 1.3 (dashed) and 6.0 (dotted), with the GPS limit points and Maxwell pressure marked.
 //! Figs. 6 and 7: reduced force ϖχ versus reduced displacement λs* − ρ (eqs. 80–81) for
-//! λs* = 1.3 and 6.0. The flattening runs to ρ = λs*/2.
+//! λs* = 1.3 and 6.0; with FE runs overlaid, an error panel (FE − GPS at the same ρ, from the
+//! run's own λs*) sits under the curves. The flattening runs to ρ = λs*/2.
+//!
+//! Rendering: plotters draws each figure once as SVG (its SVG backend); resvg rasterizes that
+//! SVG into the PNG, anti-aliased, at the requested DPI (plotters' own bitmap backend draws
+//! aliased lines). Text uses the bundled DejaVu Sans in both, so no system font is needed.
+//!
+//! FE points come from [`Overlay`]s: a run's typed report ([`Overlay::from_report`], the main
+//! job) or a `tubemem run` folder ([`Overlay::read`], `tubemem figures --overlay`). An overlay of
+//! another law than the curves' is refused.
 
 use crate::curves::{
     flattening_values, inflation_values, write_csv, FLATTENING_HEADER, INFLATION_HEADER,
 };
+use crate::report::RunReport;
 use crate::{AppError, Result};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
-use std::sync::Once;
+use std::sync::{Arc, Once};
 use tubemem_gps::limits::limit_points;
-use tubemem_gps::{flattening_curve, inflation_curve, Hypothesis};
-use tubemem_material::laws::AnssariBenamBucchi;
+use tubemem_gps::{flattening_curve, inflation_curve, FlatteningState, Hypothesis};
+use tubemem_material::MaterialSpec;
 
 static FONT: Once = Once::new();
 const FONT_BYTES: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
+const FONT_FAMILY: &str = "DejaVu Sans";
 
 fn register_font(path: &Path) -> Result<()> {
     let mut ok = true;
@@ -37,28 +49,97 @@ fn register_font(path: &Path) -> Result<()> {
 
 const GPS_COLOR: RGBColor = RGBColor(31, 90, 180);
 const PS_COLOR: RGBColor = RGBColor(200, 50, 40);
+const GREY: RGBColor = RGBColor(90, 90, 90);
+const FE_COLORS: [RGBColor; 3] = [
+    RGBColor(20, 140, 60),
+    RGBColor(150, 60, 170),
+    RGBColor(230, 130, 0),
+];
+
+/// The figure canvas in pixels at [`BASE_DPI`].
+pub const CANVAS: (u32, u32) = (1100, 760);
+/// The DPI at which the PNG is [`CANVAS`] pixels.
+pub const BASE_DPI: f64 = 100.0;
+
+/// Which files a figure is written as.
+#[derive(Clone, Debug)]
+pub struct FigureOptions {
+    pub png: bool,
+    pub svg: bool,
+    /// PNG resolution; the canvas is 11 × 7.6 in
+    pub dpi: f64,
+}
+
+impl Default for FigureOptions {
+    fn default() -> Self {
+        Self {
+            png: true,
+            svg: true,
+            dpi: BASE_DPI,
+        }
+    }
+}
+
+impl FigureOptions {
+    fn check(&self) -> Result<()> {
+        if !(self.png || self.svg) {
+            return Err(AppError::Figure {
+                path: PathBuf::new(),
+                message: "no figure format chosen (PNG, SVG or both)".into(),
+            });
+        }
+        // 25 dpi is a 275-pixel-wide thumbnail; 1200 dpi is 13200 × 9120 pixels (480 MB RGBA)
+        if !(25.0..=1200.0).contains(&self.dpi) {
+            return Err(AppError::Figure {
+                path: PathBuf::new(),
+                message: format!("dpi = {} is outside 25–1200", self.dpi),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// How a curve is stroked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stroke {
+    Solid,
+    Dashed,
+    Dotted,
+}
 
 /// One curve of a figure.
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64)>,
     pub color: RGBColor,
-    pub dashed: bool,
+    pub stroke: Stroke,
+    pub width: u32,
 }
 
-/// Isolated markers with a legend entry.
+/// Isolated markers with a legend entry; hollow markers leave the curves under them visible.
 pub struct Markers {
     pub label: String,
     pub points: Vec<(f64, f64)>,
     pub color: RGBColor,
+    pub hollow: bool,
 }
 
-pub struct Figure<'a> {
-    pub title: &'a str,
-    pub x_label: &'a str,
-    pub y_label: &'a str,
+/// A panel under the main plot (shared x axis), e.g. FE − GPS.
+pub struct Panel {
+    pub y_label: String,
     pub series: Vec<Series>,
     pub markers: Vec<Markers>,
+}
+
+pub struct Figure {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub markers: Vec<Markers>,
+    pub panel: Option<Panel>,
+    /// lines of text printed in the plot's lower right corner
+    pub notes: Vec<String>,
 }
 
 fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
@@ -67,6 +148,9 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
         lo = lo.min(v);
         hi = hi.max(v);
     }
+    if !lo.is_finite() || !hi.is_finite() {
+        return (0.0, 1.0);
+    }
     if from_zero {
         lo = lo.min(0.0);
     }
@@ -74,169 +158,559 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
     (if from_zero && lo >= 0.0 { lo } else { lo - pad }, hi + pad)
 }
 
-/// Draw `fig` to a PNG at `path`.
-pub fn draw(path: &Path, fig: &Figure) -> Result<()> {
-    register_font(path)?;
-    let all = || {
-        fig.series
-            .iter()
-            .flat_map(|s| s.points.iter())
-            .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
-    };
-    let (x0, x1) = range(all().map(|p| p.0), false);
-    let (y0, y1) = range(all().map(|p| p.1), true);
-    let root = BitMapBackend::new(path, (1100, 760)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Display| AppError::Figure {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(fig.title, ("sans-serif", 26))
-        .margin(18)
-        .x_label_area_size(58)
-        .y_label_area_size(78)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc(fig.x_label)
-        .y_desc(fig.y_label)
-        .axis_desc_style(("sans-serif", 22))
-        .label_style(("sans-serif", 17))
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()
-        .map_err(|e| err(&e))?;
-    for s in &fig.series {
-        let style = s.color.stroke_width(3);
-        let anno = if s.dashed {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    s.points.iter().copied(),
-                    12,
-                    7,
-                    style,
-                ))
-                .map_err(|e| err(&e))?
-        } else {
-            chart
-                .draw_series(LineSeries::new(s.points.iter().copied(), style))
-                .map_err(|e| err(&e))?
-        };
-        let c = s.color;
-        let dashed = s.dashed;
-        anno.label(s.label.clone()).legend(move |(x, y)| {
-            if dashed {
-                PathElement::new(vec![(x, y), (x + 9, y)], c.stroke_width(3))
-            } else {
-                PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3))
-            }
-        });
+fn stroke_pattern(s: Stroke) -> Option<(u32, u32)> {
+    match s {
+        Stroke::Solid => None,
+        Stroke::Dashed => Some((12, 7)),
+        Stroke::Dotted => Some((3, 5)),
     }
-    for m in &fig.markers {
-        let c = m.color;
-        chart
-            .draw_series(m.points.iter().map(|&p| Circle::new(p, 6, c.filled())))
-            .map_err(|e| err(&e))?
-            .label(m.label.clone())
-            .legend(move |(x, y)| Circle::new((x + 12, y), 6, c.filled()));
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font(("sans-serif", 18))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+fn draw_series<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    s: &Series,
+    err: &dyn Fn(String) -> AppError,
+) -> Result<()> {
+    let style = s.color.stroke_width(s.width);
+    let anno = match stroke_pattern(s.stroke) {
+        Some((dash, gap)) => chart
+            .draw_series(DashedLineSeries::new(
+                s.points.iter().copied(),
+                dash,
+                gap,
+                style,
+            ))
+            .map_err(|e| err(e.to_string()))?,
+        None => chart
+            .draw_series(LineSeries::new(s.points.iter().copied(), style))
+            .map_err(|e| err(e.to_string()))?,
+    };
+    let pattern = stroke_pattern(s.stroke);
+    anno.label(s.label.clone()).legend(move |(x, y)| {
+        // the legend sample shows the stroke's own pattern over 30 pixels: four segments
+        // (repeated where the pattern has fewer in that length)
+        let (dash, gap) = pattern.unwrap_or((8, 0));
+        let mut seg = vec![];
+        let mut a = 0;
+        while a < 30 && seg.len() < 4 {
+            let b = (a + dash as i32).min(30);
+            seg.push(vec![(x + a, y), (x + b, y)]);
+            a = b + gap as i32;
+        }
+        while seg.len() < 4 {
+            seg.push(seg[0].clone());
+        }
+        EmptyElement::at((0, 0))
+            + PathElement::new(seg[0].clone(), style)
+            + PathElement::new(seg[1].clone(), style)
+            + PathElement::new(seg[2].clone(), style)
+            + PathElement::new(seg[3].clone(), style)
+    });
     Ok(())
 }
 
-/// FE points read from a `tubemem run` folder.
-#[derive(Default)]
-struct RunPoints {
-    label: String,
-    /// (λs, ϖ) of inflation steps
-    inflation: Vec<(f64, f64)>,
-    /// (λs, ϖ, displacement, force, λs*) of squeeze steps
-    squeeze: Vec<(f64, f64, f64, f64, f64)>,
+fn draw_markers<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    m: &Markers,
+    err: &dyn Fn(String) -> AppError,
+) -> Result<()> {
+    let c = m.color;
+    let style = if m.hollow {
+        c.stroke_width(2)
+    } else {
+        c.filled()
+    };
+    chart
+        .draw_series(m.points.iter().map(|&p| Circle::new(p, 5, style)))
+        .map_err(|e| err(e.to_string()))?
+        .label(m.label.clone())
+        .legend(move |(x, y)| Circle::new((x + 15, y), 5, style));
+    Ok(())
 }
 
-fn read_run(dir: &Path) -> Result<RunPoints> {
-    let path = dir.join("steps.csv");
-    let overlay = |message: String| AppError::Overlay {
-        path: path.clone(),
+/// The figure as an SVG document.
+pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
+    register_font(path)?;
+    let err = |message: String| AppError::Figure {
+        path: path.to_path_buf(),
         message,
     };
-    let text = std::fs::read_to_string(&path).map_err(|e| {
-        overlay(format!(
-            "cannot read it ({e}): is this a tubemem run folder?"
-        ))
-    })?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| overlay(format!("no column `{name}`")))
-    };
-    let (cw, cls, crho, cdisp, cforce) = (
-        col("w")?,
-        col("lambda_s")?,
-        col("rho")?,
-        col("displacement")?,
-        col("force")?,
-    );
-    let mut pts = RunPoints {
-        label: dir
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default(),
-        ..Default::default()
-    };
-    for (k, line) in lines.enumerate() {
-        let f: Vec<&str> = line.split(',').collect();
-        let num = |i: usize| -> Result<f64> {
-            f.get(i)
-                .and_then(|v| v.parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| overlay(format!("row {}: column {i} is not a finite number", k + 2)))
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, CANVAS).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+        let root = root
+            .titled(&fig.title, ("sans-serif", 26))
+            .map_err(|e| err(e.to_string()))?;
+        let (top, bottom) = match fig.panel {
+            Some(_) => {
+                let (t, b) = root.split_vertically(CANVAS.1 * 64 / 100);
+                (t, Some(b))
+            }
+            None => (root, None),
         };
-        if f.get(crho).is_some_and(|v| !v.is_empty()) {
-            let (ls, w, rho, d, force) =
-                (num(cls)?, num(cw)?, num(crho)?, num(cdisp)?, num(cforce)?);
-            pts.squeeze.push((ls, w, d, force, d + rho));
-        } else {
-            pts.inflation.push((num(cls)?, num(cw)?));
+        let all = || {
+            fig.series
+                .iter()
+                .flat_map(|s| s.points.iter())
+                .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
+        };
+        let (x0, x1) = range(all().map(|p| p.0), false);
+        let (y0, y1) = range(all().map(|p| p.1), true);
+        let mut chart = ChartBuilder::on(&top)
+            .margin(14)
+            .x_label_area_size(if bottom.is_some() { 30 } else { 58 })
+            .y_label_area_size(86)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| err(e.to_string()))?;
+        let mut mesh = chart.configure_mesh();
+        mesh.y_desc(fig.y_label.as_str())
+            .axis_desc_style(("sans-serif", 21))
+            .label_style(("sans-serif", 16))
+            .light_line_style(RGBColor(235, 235, 235));
+        if bottom.is_none() {
+            mesh.x_desc(fig.x_label.as_str());
         }
+        mesh.draw().map_err(|e| err(e.to_string()))?;
+        for m in &fig.markers {
+            draw_markers(&mut chart, m, &err)?;
+        }
+        // curves over the markers: hollow FE markers never hide a branch
+        for s in &fig.series {
+            draw_series(&mut chart, s, &err)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font(("sans-serif", 16))
+            .background_style(WHITE.mix(0.92))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(e.to_string()))?;
+        let (w, h) = top.dim_in_pixel();
+        for (k, note) in fig.notes.iter().rev().enumerate() {
+            top.draw(&Text::new(
+                note.clone(),
+                (w as i32 - 24, h as i32 - 80 - 22 * k as i32),
+                ("sans-serif", 16).into_font().color(&BLACK).pos(
+                    plotters::style::text_anchor::Pos::new(
+                        plotters::style::text_anchor::HPos::Right,
+                        plotters::style::text_anchor::VPos::Bottom,
+                    ),
+                ),
+            ))
+            .map_err(|e| err(e.to_string()))?;
+        }
+        if let (Some(panel), Some(bottom)) = (&fig.panel, bottom) {
+            let pts = || {
+                panel
+                    .series
+                    .iter()
+                    .flat_map(|s| s.points.iter())
+                    .chain(panel.markers.iter().flat_map(|m| m.points.iter()))
+            };
+            let (py0, py1) = range(pts().map(|p| p.1), true);
+            let (py0, py1) = (py0.min(-0.02 * py1.abs()), py1.max(0.02 * py0.abs()));
+            let mut chart = ChartBuilder::on(&bottom)
+                .margin(14)
+                .x_label_area_size(58)
+                .y_label_area_size(86)
+                .build_cartesian_2d(x0..x1, py0..py1)
+                .map_err(|e| err(e.to_string()))?;
+            chart
+                .configure_mesh()
+                .x_desc(fig.x_label.as_str())
+                .y_desc(panel.y_label.as_str())
+                .axis_desc_style(("sans-serif", 19))
+                .label_style(("sans-serif", 15))
+                .y_label_formatter(&|v| {
+                    if *v == 0.0 || v.abs() >= 1e-2 {
+                        format!("{v:.3}")
+                    } else {
+                        format!("{v:.1e}")
+                    }
+                })
+                .light_line_style(RGBColor(235, 235, 235))
+                .draw()
+                .map_err(|e| err(e.to_string()))?;
+            chart
+                .draw_series(LineSeries::new(
+                    [(x0, 0.0), (x1, 0.0)],
+                    BLACK.stroke_width(1),
+                ))
+                .map_err(|e| err(e.to_string()))?;
+            for m in &panel.markers {
+                draw_markers(&mut chart, m, &err)?;
+            }
+            for s in &panel.series {
+                draw_series(&mut chart, s, &err)?;
+            }
+        }
+        top.present().map_err(|e| err(e.to_string()))?;
     }
-    Ok(pts)
+    Ok(svg)
 }
 
-const FE_COLORS: [RGBColor; 3] = [
-    RGBColor(20, 140, 60),
-    RGBColor(150, 60, 170),
-    RGBColor(230, 130, 0),
-];
+fn font_database() -> Arc<resvg::usvg::fontdb::Database> {
+    static DB: std::sync::OnceLock<Arc<resvg::usvg::fontdb::Database>> = std::sync::OnceLock::new();
+    DB.get_or_init(|| {
+        let mut db = resvg::usvg::fontdb::Database::new();
+        db.load_font_data(FONT_BYTES.to_vec());
+        db.set_sans_serif_family(FONT_FAMILY);
+        Arc::new(db)
+    })
+    .clone()
+}
 
-/// Compute the curves and write every CSV and PNG into `dir`, with the FE points of the run
-/// folders in `overlays` on Figs. 5–7; returns the files written.
-pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    let runs: Vec<RunPoints> = overlays
+/// Rasterize an SVG document into PNG bytes at `dpi` (anti-aliased, resvg).
+pub fn rasterize(svg: &str, dpi: f64, path: &Path) -> Result<Vec<u8>> {
+    let err = |message: String| AppError::Figure {
+        path: path.to_path_buf(),
+        message,
+    };
+    let opt = resvg::usvg::Options {
+        fontdb: font_database(),
+        font_family: FONT_FAMILY.to_string(),
+        ..Default::default()
+    };
+    let tree = resvg::usvg::Tree::from_str(svg, &opt).map_err(|e| err(e.to_string()))?;
+    let scale = (dpi / BASE_DPI) as f32;
+    let size = tree
+        .size()
+        .to_int_size()
+        .scale_by(scale)
+        .ok_or_else(|| err(format!("dpi = {dpi} gives an empty image")))?;
+    let mut pixmap =
+        resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or_else(|| {
+            err(format!(
+                "cannot allocate a {}×{} image",
+                size.width(),
+                size.height()
+            ))
+        })?;
+    pixmap.fill(resvg::tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::from_scale(scale, scale),
+        &mut pixmap.as_mut(),
+    );
+    pixmap.encode_png().map_err(|e| err(e.to_string()))
+}
+
+/// Write `fig` as `<stem>.svg` and/or `<stem>.png`; returns the files written.
+pub fn save(fig: &Figure, stem: &Path, opts: &FigureOptions) -> Result<Vec<PathBuf>> {
+    opts.check()?;
+    // (not `with_extension`: a stem like `…_ls1.3` has a dot of its own)
+    let with = |ext: &str| {
+        let mut p = stem.as_os_str().to_owned();
+        p.push(ext);
+        PathBuf::from(p)
+    };
+    let (svg_path, png_path) = (with(".svg"), with(".png"));
+    let svg = render_svg(fig, &svg_path)?;
+    let mut written = vec![];
+    if opts.svg {
+        std::fs::write(&svg_path, &svg).map_err(|e| AppError::io(&svg_path, e))?;
+        written.push(svg_path);
+    }
+    if opts.png {
+        let png = rasterize(&svg, opts.dpi, &png_path)?;
+        std::fs::write(&png_path, png).map_err(|e| AppError::io(&png_path, e))?;
+        written.push(png_path);
+    }
+    Ok(written)
+}
+
+/// One FE point of a squeeze step.
+#[derive(Clone, Debug)]
+pub struct SqueezePoint {
+    pub lambda_s: f64,
+    pub w: f64,
+    pub rho: f64,
+    pub displacement: f64,
+    pub force: f64,
+    /// the run's λs* (mid-span stretch when the squeeze started)
+    pub initial_stretch: f64,
+    /// GPS flattening from the run's λs* at the same ρ, when it has a solution
+    pub gps_force: Option<f64>,
+}
+
+/// The FE points of one run to draw over the closed-form curves.
+#[derive(Clone, Debug)]
+pub struct Overlay {
+    pub label: String,
+    /// where it came from (the run folder), for messages
+    pub source: PathBuf,
+    pub material: MaterialSpec,
+    /// (λs, ϖ) of the inflation steps
+    pub inflation: Vec<(f64, f64)>,
+    pub squeeze: Vec<SqueezePoint>,
+}
+
+impl Overlay {
+    /// The points of a run's typed report.
+    pub fn from_report(report: &RunReport, label: &str, source: &Path) -> Self {
+        let mut o = Overlay {
+            label: label.to_string(),
+            source: source.to_path_buf(),
+            material: report.material_spec,
+            inflation: vec![],
+            squeeze: vec![],
+        };
+        for s in report.steps() {
+            match &s.contact {
+                Some(c) => o.squeeze.push(SqueezePoint {
+                    lambda_s: s.midspan.lambda_s,
+                    w: s.midspan.w,
+                    rho: c.values.rho,
+                    displacement: c.displacement,
+                    force: c.values.force,
+                    initial_stretch: c.initial_stretch,
+                    gps_force: s.closed_form.gps_flattening.as_ref().map(|g| g.force),
+                }),
+                None => o.inflation.push((s.midspan.lambda_s, s.midspan.w)),
+            }
+        }
+        o
+    }
+
+    /// The points of a `tubemem run` folder: the law from summary.json, the steps from
+    /// steps.csv.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let summary_path = dir.join("summary.json");
+        let overlay = |path: &Path, message: String| AppError::Overlay {
+            path: path.to_path_buf(),
+            message,
+        };
+        let text = std::fs::read_to_string(&summary_path).map_err(|e| {
+            overlay(
+                &summary_path,
+                format!("cannot read it ({e}): is this a tubemem run folder?"),
+            )
+        })?;
+        let summary: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| overlay(&summary_path, format!("not valid JSON: {e}")))?;
+        let material: MaterialSpec =
+            serde_json::from_value(summary.get("material_spec").cloned().unwrap_or_default())
+                .map_err(|e| overlay(&summary_path, format!("no readable `material_spec`: {e}")))?;
+        let path = dir.join("steps.csv");
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            overlay(
+                &path,
+                format!("cannot read it ({e}): is this a tubemem run folder?"),
+            )
+        })?;
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+        let col = |name: &str| {
+            header
+                .iter()
+                .position(|h| *h == name)
+                .ok_or_else(|| overlay(&path, format!("no column `{name}`")))
+        };
+        let (cw, cls, crho, cdisp, cforce, cgps) = (
+            col("w")?,
+            col("lambda_s")?,
+            col("rho")?,
+            col("displacement")?,
+            col("force")?,
+            col("gps_force").ok(),
+        );
+        let mut o = Overlay {
+            label: dir
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_else(|| dir.display().to_string()),
+            source: dir.to_path_buf(),
+            material,
+            inflation: vec![],
+            squeeze: vec![],
+        };
+        for (k, line) in lines.enumerate() {
+            let f: Vec<&str> = line.split(',').collect();
+            let num = |i: usize| -> Result<f64> {
+                f.get(i)
+                    .and_then(|v| v.parse::<f64>().ok())
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        overlay(
+                            &path,
+                            format!("row {}: column {i} is not a finite number", k + 2),
+                        )
+                    })
+            };
+            if f.get(crho).is_some_and(|v| !v.is_empty()) {
+                let (rho, d) = (num(crho)?, num(cdisp)?);
+                o.squeeze.push(SqueezePoint {
+                    lambda_s: num(cls)?,
+                    w: num(cw)?,
+                    rho,
+                    displacement: d,
+                    force: num(cforce)?,
+                    initial_stretch: d + rho,
+                    gps_force: match cgps {
+                        Some(c) if f.get(c).is_some_and(|v| !v.is_empty()) => Some(num(c)?),
+                        _ => None,
+                    },
+                });
+            } else {
+                o.inflation.push((num(cls)?, num(cw)?));
+            }
+        }
+        Ok(o)
+    }
+}
+
+/// The law in a few words, for titles and messages.
+pub fn law_label(spec: &MaterialSpec) -> String {
+    match *spec {
+        MaterialSpec::Abb { kuhn, .. } => format!("ABB, Kuhn N = {kuhn}"),
+        MaterialSpec::MooneyRivlin { alpha, .. } => format!("Mooney–Rivlin, α = {alpha}"),
+        MaterialSpec::NeoHookean { .. } => "neo-Hookean".into(),
+    }
+}
+
+/// Whether two specs are the same law (the shear modulus only scales, results are per μH).
+pub fn same_law(a: &MaterialSpec, b: &MaterialSpec) -> bool {
+    let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * x.abs().max(y.abs());
+    match (*a, *b) {
+        (MaterialSpec::Abb { kuhn: x, .. }, MaterialSpec::Abb { kuhn: y, .. }) => close(x, y),
+        (
+            MaterialSpec::MooneyRivlin { alpha: x, .. },
+            MaterialSpec::MooneyRivlin { alpha: y, .. },
+        ) => close(x, y),
+        (MaterialSpec::NeoHookean { .. }, MaterialSpec::NeoHookean { .. }) => true,
+        (MaterialSpec::NeoHookean { .. }, MaterialSpec::MooneyRivlin { alpha, .. })
+        | (MaterialSpec::MooneyRivlin { alpha, .. }, MaterialSpec::NeoHookean { .. }) => {
+            alpha == 0.0
+        }
+        _ => false,
+    }
+}
+
+/// The paper's law, the figures' default without overlays: ABB with 𝒩 = 30.
+pub const PAPER_LAW: MaterialSpec = MaterialSpec::Abb {
+    shear_modulus: 1.0,
+    kuhn: 30.0,
+};
+
+/// A file-name-safe form of a label.
+fn slug(s: &str) -> String {
+    let t: String = s
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    t.trim_matches('_').to_string()
+}
+
+/// The overlays' points as CSV, one file each: every FE point drawn, with the GPS force at the
+/// same ρ from the run's λs* and the difference shown in the error panels.
+fn write_points(dir: &Path, k: usize, o: &Overlay) -> Result<PathBuf> {
+    let p = dir.join(format!("fe_points_{}_{}.csv", k + 1, slug(&o.label)));
+    let mut rows: Vec<Vec<f64>> = o
+        .inflation
         .iter()
-        .map(|d| read_run(d))
-        .collect::<Result<_>>()?;
+        .map(|&(ls, w)| {
+            vec![
+                0.0,
+                ls,
+                w,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+            ]
+        })
+        .collect();
+    for s in &o.squeeze {
+        let (g, d) = match s.gps_force {
+            Some(g) => (g, s.force - g),
+            None => (f64::NAN, f64::NAN),
+        };
+        rows.push(vec![
+            1.0,
+            s.lambda_s,
+            s.w,
+            s.rho,
+            s.displacement,
+            s.force,
+            s.initial_stretch,
+            g,
+            d,
+        ]);
+    }
+    // empty fields, not NaN, for what a point does not have
+    let mut text = String::from(
+        "squeeze,lambda_s,w,rho,displacement,force,initial_stretch,gps_force,force_minus_gps\n",
+    );
+    for r in rows {
+        let fields: Vec<String> = r
+            .iter()
+            .map(|v| {
+                if v.is_finite() {
+                    v.to_string()
+                } else {
+                    String::new()
+                }
+            })
+            .collect();
+        text.push_str(&fields.join(","));
+        text.push('\n');
+    }
+    std::fs::write(&p, text).map_err(|e| AppError::io(&p, e))?;
+    Ok(p)
+}
+
+/// Compute the curves of `law` (or, when `None`, of the overlays' law, else the paper's) and
+/// write every CSV and figure into `dir`, with the FE points of `overlays` on Figs. 5–7; returns
+/// the files written. An overlay of another law is refused.
+pub fn write_all(
+    dir: &Path,
+    law: Option<MaterialSpec>,
+    overlays: &[Overlay],
+    opts: &FigureOptions,
+) -> Result<Vec<PathBuf>> {
+    opts.check()?;
+    let spec = law
+        .or_else(|| overlays.first().map(|o| o.material))
+        .unwrap_or(PAPER_LAW);
+    for o in overlays {
+        if !same_law(&o.material, &spec) {
+            return Err(AppError::Overlay {
+                path: o.source.clone(),
+                message: format!(
+                    "the run is {}, the curves are {}: its points do not belong on them (leave the material out to take it from the run)",
+                    law_label(&o.material),
+                    law_label(&spec)
+                ),
+            });
+        }
+    }
     std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
-    let law = AnssariBenamBucchi::new(1.0, kuhn)?;
+    let built = spec.build()?;
+    let law = built.as_ref();
+    let name = law_label(&spec);
     let mut written = vec![];
     let hyps = [(Hypothesis::Gps, GPS_COLOR), (Hypothesis::Ps, PS_COLOR)];
-    let starts = [1.3, 6.0];
+    let starts = [(1.3, Stroke::Dashed), (6.0, Stroke::Dotted)];
 
     let mut inflation = vec![];
     for (h, _) in hyps {
-        let c = inflation_curve(&law, h, 1.0, 7.5, 651)
+        let c = inflation_curve(law, h, 1.0, 7.5, 651)
             .map_err(|e| AppError::gps("the inflation curve", e))?;
         let p = dir.join(format!("inflation_{}.csv", h.label().to_lowercase()));
         write_csv(&p, INFLATION_HEADER, c.iter().map(inflation_values))?;
@@ -244,12 +718,12 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
         inflation.push(c);
     }
     // flattening[start][hyp]
-    let mut flattening = vec![];
-    for ls0 in starts {
+    let mut flattening: Vec<Vec<Vec<FlatteningState>>> = vec![];
+    for (ls0, _) in starts {
         let mut per = vec![];
         for (h, _) in hyps {
-            let c = flattening_curve(&law, h, ls0, 0.5 * ls0, 201)
-                .map_err(|e| AppError::gps("the flattening curve", e))?;
+            let c = flattening_curve(law, h, ls0, 0.5 * ls0, 201)
+                .map_err(|e| AppError::gps(format!("the flattening curve from λs* = {ls0}"), e))?;
             let p = dir.join(format!(
                 "flattening_ls{ls0:.1}_{}.csv",
                 h.label().to_lowercase()
@@ -261,7 +735,10 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
         flattening.push(per);
     }
     let limits =
-        limit_points(&law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))?;
+        limit_points(law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))?;
+    for (k, o) in overlays.iter().enumerate() {
+        written.push(write_points(dir, k, o)?);
+    }
 
     // Fig. 5
     let mut series = vec![];
@@ -270,16 +747,18 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
             label: format!("{} inflation", h.label()),
             points: c.iter().map(|s| (s.lambda_s, s.w)).collect(),
             color: *color,
-            dashed: false,
+            stroke: Stroke::Solid,
+            width: 3,
         });
     }
-    for (ls0, per) in starts.iter().zip(&flattening) {
+    for ((ls0, stroke), per) in starts.iter().zip(&flattening) {
         for ((h, color), c) in hyps.iter().zip(per) {
             series.push(Series {
                 label: format!("{} flattening from λs* = {ls0}", h.label()),
                 points: c.iter().map(|s| (s.lambda_s, s.w)).collect(),
                 color: *color,
-                dashed: true,
+                stroke: *stroke,
+                width: 3,
             });
         }
     }
@@ -294,83 +773,125 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
             label: "GPS limit points".into(),
             points: lp,
             color: BLACK,
+            hollow: false,
         });
     }
     if let Some(m) = limits.maxwell {
         series.push(Series {
             label: format!("GPS Maxwell pressure ϖ = {:.4}", m.w),
             points: vec![(m.lambda_s_lower, m.w), (m.lambda_s_upper, m.w)],
-            color: RGBColor(90, 90, 90),
-            dashed: true,
+            color: GREY,
+            stroke: Stroke::Dashed,
+            width: 2,
         });
     }
-    for (run, color) in runs.iter().zip(FE_COLORS.iter().cycle()) {
+    for (run, color) in overlays.iter().zip(FE_COLORS.iter().cycle()) {
         let mut pts = run.inflation.clone();
-        pts.extend(run.squeeze.iter().map(|s| (s.0, s.1)));
+        pts.extend(run.squeeze.iter().map(|s| (s.lambda_s, s.w)));
         if !pts.is_empty() {
             markers.push(Markers {
-                label: format!("FE run `{}`", run.label),
+                label: format!("FE: {}", run.label),
                 points: pts,
                 color: *color,
+                hollow: true,
             });
         }
     }
-    let title5 = format!("Fig. 5 — reduced pressure vs hoop stretch (ABB, Kuhn N = {kuhn})");
-    let p = dir.join("fig5_pressure_stretch.png");
-    draw(
-        &p,
+    written.extend(save(
         &Figure {
-            title: &title5,
-            x_label: "hoop stretch λs",
-            y_label: "reduced pressure ϖ = pR/(μH)",
+            title: format!("Fig. 5 — reduced pressure vs hoop stretch ({name})"),
+            x_label: "hoop stretch λs".into(),
+            y_label: "reduced pressure ϖ = pR/(μH)".into(),
             series,
             markers,
+            panel: None,
+            notes: vec![],
         },
-    )?;
-    written.push(p);
+        &dir.join("fig5_pressure_stretch"),
+        opts,
+    )?);
 
     // Figs. 6 and 7
-    for ((ls0, per), num) in starts.iter().zip(&flattening).zip([6, 7]) {
-        let series = hyps
+    for (((ls0, _), per), num) in starts.iter().zip(&flattening).zip([6, 7]) {
+        let mut series: Vec<Series> = hyps
             .iter()
             .zip(per)
             .map(|((h, color), c)| Series {
                 label: h.label().to_string(),
                 points: c.iter().map(|s| (s.displacement, s.force)).collect(),
                 color: *color,
-                dashed: false,
+                stroke: Stroke::Solid,
+                width: 3,
             })
             .collect();
         let mut markers = vec![];
-        for (run, color) in runs.iter().zip(FE_COLORS.iter().cycle()) {
+        let mut errors = vec![];
+        let mut notes = vec![];
+        for (run, color) in overlays.iter().zip(FE_COLORS.iter().cycle()) {
             // squeeze steps that start from (about) this λs*
-            let pts: Vec<(f64, f64)> = run
+            let pts: Vec<&SqueezePoint> = run
                 .squeeze
                 .iter()
-                .filter(|s| (s.4 - ls0).abs() < 0.05 * ls0)
-                .map(|s| (s.2, s.3))
+                .filter(|s| (s.initial_stretch - ls0).abs() < 0.05 * ls0)
                 .collect();
-            if !pts.is_empty() {
-                markers.push(Markers {
-                    label: format!("FE run `{}`", run.label),
-                    points: pts,
+            let Some(first) = pts.first() else { continue };
+            let run_ls0 = first.initial_stretch;
+            let mut label = format!("FE: {}", run.label);
+            if (run_ls0 / ls0 - 1.0).abs() > 1e-3 {
+                // the curves start at the paper's λs*; this run's starts elsewhere: say so and
+                // draw the GPS curve from the run's own λs* (the error panel's reference)
+                label = format!("{label} (λs* = {run_ls0:.4})");
+                notes.push(format!(
+                    "{}: the run's λs* = {run_ls0:.4} differs from the curves' {ls0}; thin line: GPS from {run_ls0:.4}",
+                    run.label
+                ));
+                if let Ok(c) = flattening_curve(law, Hypothesis::Gps, run_ls0, 0.5 * run_ls0, 201) {
+                    series.push(Series {
+                        label: format!("GPS from the run's λs* = {run_ls0:.4}"),
+                        points: c.iter().map(|s| (s.displacement, s.force)).collect(),
+                        color: *color,
+                        stroke: Stroke::Dashed,
+                        width: 1,
+                    });
+                }
+            }
+            markers.push(Markers {
+                label: label.clone(),
+                points: pts.iter().map(|s| (s.displacement, s.force)).collect(),
+                color: *color,
+                hollow: true,
+            });
+            let e: Vec<(f64, f64)> = pts
+                .iter()
+                .filter_map(|s| s.gps_force.map(|g| (s.displacement, s.force - g)))
+                .collect();
+            if !e.is_empty() {
+                errors.push(Markers {
+                    label: label.clone(),
+                    points: e,
                     color: *color,
+                    hollow: false,
                 });
             }
         }
-        let title = format!("Fig. {num} — flattening from λs* = {ls0} (ABB, Kuhn N = {kuhn})");
-        let p = dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}.png"));
-        draw(
-            &p,
+        let panel = (!errors.is_empty()).then(|| Panel {
+            y_label: "FE − GPS, same ρ".into(),
+            series: vec![],
+            markers: errors,
+        });
+        written.extend(save(
             &Figure {
-                title: &title,
-                x_label: "reduced displacement λs* − ρ",
-                y_label: "reduced force ϖχ = pc/(πμH)",
+                title: format!("Fig. {num} — flattening from λs* = {ls0} ({name})"),
+                x_label: "reduced displacement λs* − ρ".into(),
+                y_label: "reduced force ϖχ = pc/(πμH)".into(),
                 series,
                 markers,
+                panel,
+                notes,
             },
-        )?;
-        written.push(p);
+            &dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}")),
+            opts,
+        )?);
     }
 
     // λz versus λs
@@ -381,34 +902,37 @@ pub fn write_all(dir: &Path, kuhn: f64, overlays: &[PathBuf]) -> Result<Vec<Path
             .map(|s| (s.lambda_s, s.lambda_z))
             .collect(),
         color: GPS_COLOR,
-        dashed: false,
+        stroke: Stroke::Solid,
+        width: 3,
     }];
-    for (ls0, per) in starts.iter().zip(&flattening) {
+    for ((ls0, stroke), per) in starts.iter().zip(&flattening) {
         series.push(Series {
             label: format!("GPS flattening from λs* = {ls0}"),
             points: per[0].iter().map(|s| (s.lambda_s, s.lambda_z)).collect(),
             color: RGBColor(20, 150, 90),
-            dashed: true,
+            stroke: *stroke,
+            width: 3,
         });
     }
     series.push(Series {
         label: "PS (λz = 1)".into(),
         points: vec![(1.0, 1.0), (7.5, 1.0)],
         color: PS_COLOR,
-        dashed: false,
+        stroke: Stroke::Solid,
+        width: 3,
     });
-    let title = format!("Axial stretch vs hoop stretch (ABB, Kuhn N = {kuhn})");
-    let p = dir.join("fig_lambda_z.png");
-    draw(
-        &p,
+    written.extend(save(
         &Figure {
-            title: &title,
-            x_label: "hoop stretch λs",
-            y_label: "axial stretch λz",
+            title: format!("Axial stretch vs hoop stretch ({name})"),
+            x_label: "hoop stretch λs".into(),
+            y_label: "axial stretch λz".into(),
             series,
             markers: vec![],
+            panel: None,
+            notes: vec![],
         },
-    )?;
-    written.push(p);
+        &dir.join("fig_lambda_z"),
+        opts,
+    )?);
     Ok(written)
 }

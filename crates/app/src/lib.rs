@@ -151,6 +151,7 @@ impl AppError {
                 | AppError::StageInput { .. }
                 | AppError::TooLarge { .. }
                 | AppError::Folder { .. }
+                | AppError::Overlay { .. }
         )
     }
 

@@ -100,7 +100,14 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
                 .map(|l| l.force),
         });
     }
-    let figures = figures::write_all(&out.join("figures"), 30.0, std::slice::from_ref(&run_dir))?;
+    // the FE points from the report itself, not read back from the files just written
+    let overlay = figures::Overlay::from_report(&report, "embedded default case", &run_dir);
+    let figures = figures::write_all(
+        &out.join("figures"),
+        Some(figures::PAPER_LAW),
+        &[overlay],
+        &figures::FigureOptions::default(),
+    )?;
     Ok(MainJob {
         limits,
         run_dir,

@@ -58,18 +58,32 @@ enum Command {
         #[arg(long)]
         log: Option<PathBuf>,
     },
-    /// Write PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure.
+    /// Write SVG/PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure,
+    /// for any law, with FE runs overlaid (their points also as CSV, and an FE − GPS panel under
+    /// Figs. 6–7).
     Figures {
         /// Output folder (created if missing).
         #[arg(long, default_value = "tubemem-out/figures")]
         out: PathBuf,
-        /// Kuhn segment number 𝒩 of the Anssari-Benam–Bucchi law.
-        #[arg(long, default_value_t = 30.0)]
-        kuhn: f64,
+        #[command(flatten)]
+        material: tubemem_cli::material_args::OptionalMaterialArgs,
         /// A `tubemem run` output folder whose FE points are drawn over Figs. 5–7 (repeatable).
+        /// A run of another law than the curves' is refused.
         #[arg(long)]
         overlay: Vec<PathBuf>,
+        /// File formats to write (comma-separated).
+        #[arg(long, value_delimiter = ',', default_value = "png,svg")]
+        format: Vec<FigureFormat>,
+        /// PNG resolution (the canvas is 11 × 7.6 in; 100 dpi = 1100 × 760 pixels).
+        #[arg(long, default_value_t = tubemem_app::figures::BASE_DPI)]
+        dpi: f64,
     },
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum FigureFormat {
+    Png,
+    Svg,
 }
 
 /// An application error as an `anyhow` chain (its causes kept).
@@ -192,8 +206,26 @@ fn run(cli: Cli) -> Result<()> {
             resume,
             log,
         }) => run_case(&case, &out, overwrite, force, resume, log.as_deref()),
-        Some(Command::Figures { out, kuhn, overlay }) => {
-            let written = tubemem_app::figures::write_all(&out, kuhn, &overlay).map_err(app)?;
+        Some(Command::Figures {
+            out,
+            material,
+            overlay,
+            format,
+            dpi,
+        }) => {
+            use tubemem_app::figures;
+            let overlays = overlay
+                .iter()
+                .map(|d| figures::Overlay::read(d))
+                .collect::<tubemem_app::Result<Vec<_>>>()
+                .map_err(app)?;
+            let opts = figures::FigureOptions {
+                png: format.contains(&FigureFormat::Png),
+                svg: format.contains(&FigureFormat::Svg),
+                dpi,
+            };
+            let written =
+                figures::write_all(&out, material.spec()?, &overlays, &opts).map_err(app)?;
             for p in written {
                 tubemem_cli::say!("wrote {}", p.display())?;
             }

@@ -29,40 +29,76 @@ pub struct MaterialArgs {
     pub shear_modulus: f64,
 }
 
+/// The spec of `--material` with its parameters, or why the flags do not make one.
+pub fn spec_of(
+    material: Model,
+    kuhn: Option<f64>,
+    alpha: Option<f64>,
+    mu: f64,
+) -> Result<MaterialSpec> {
+    Ok(match (material, kuhn, alpha) {
+        (Model::Abb, Some(kuhn), None) => MaterialSpec::Abb {
+            shear_modulus: mu,
+            kuhn,
+        },
+        (Model::Abb, None, _) => {
+            bail!("--material abb needs --kuhn (the Kuhn segment number 𝒩 > 1)")
+        }
+        (Model::MooneyRivlin, None, Some(alpha)) => MaterialSpec::MooneyRivlin {
+            shear_modulus: mu,
+            alpha,
+        },
+        (Model::MooneyRivlin, _, None) => {
+            bail!("--material mooney-rivlin needs --alpha (the hardening parameter α ≥ 0)")
+        }
+        (Model::NeoHookean, None, None) => MaterialSpec::NeoHookean { shear_modulus: mu },
+        (m, _, _) => bail!(
+            "--material {} does not take {}",
+            m.to_possible_value()
+                .map(|v| v.get_name().to_string())
+                .unwrap_or_default(),
+            if kuhn.is_some() && m != Model::Abb {
+                "--kuhn"
+            } else {
+                "--alpha"
+            }
+        ),
+    })
+}
+
 impl MaterialArgs {
     pub fn spec(&self) -> Result<MaterialSpec> {
-        let mu = self.shear_modulus;
-        Ok(match (self.material, self.kuhn, self.alpha) {
-            (Model::Abb, Some(kuhn), None) => MaterialSpec::Abb {
-                shear_modulus: mu,
-                kuhn,
-            },
-            (Model::Abb, None, _) => {
-                bail!("--material abb needs --kuhn (the Kuhn segment number 𝒩 > 1)")
-            }
-            (Model::MooneyRivlin, None, Some(alpha)) => MaterialSpec::MooneyRivlin {
-                shear_modulus: mu,
-                alpha,
-            },
-            (Model::MooneyRivlin, _, None) => {
-                bail!("--material mooney-rivlin needs --alpha (the hardening parameter α ≥ 0)")
-            }
-            (Model::NeoHookean, None, None) => MaterialSpec::NeoHookean { shear_modulus: mu },
-            (m, _, _) => bail!(
-                "--material {} does not take {}",
-                m.to_possible_value()
-                    .map(|v| v.get_name().to_string())
-                    .unwrap_or_default(),
-                if self.kuhn.is_some() && m != Model::Abb {
-                    "--kuhn"
-                } else {
-                    "--alpha"
-                }
-            ),
-        })
+        spec_of(self.material, self.kuhn, self.alpha, self.shear_modulus)
     }
 
     pub fn build(&self) -> Result<Box<dyn MembraneLaw>> {
         Ok(self.spec()?.build()?)
+    }
+}
+
+/// The law of `tubemem figures`: optional, since an overlaid run says its own.
+#[derive(Args, Debug, Clone)]
+pub struct OptionalMaterialArgs {
+    /// Membrane law of the curves (default: the overlaid runs' law, else the paper's abb 𝒩 = 30).
+    #[arg(long, value_enum)]
+    pub material: Option<Model>,
+    /// Kuhn segment number 𝒩 (> 1) of the abb law (alone, it means --material abb).
+    #[arg(long)]
+    pub kuhn: Option<f64>,
+    /// Hardening parameter α (≥ 0) of the mooney-rivlin law.
+    #[arg(long)]
+    pub alpha: Option<f64>,
+}
+
+impl OptionalMaterialArgs {
+    pub fn spec(&self) -> Result<Option<MaterialSpec>> {
+        match (self.material, self.kuhn, self.alpha) {
+            (None, None, None) => Ok(None),
+            (None, Some(_), _) => spec_of(Model::Abb, self.kuhn, self.alpha, 1.0).map(Some),
+            (None, None, Some(_)) => {
+                bail!("--alpha needs --material mooney-rivlin")
+            }
+            (Some(m), k, a) => spec_of(m, k, a, 1.0).map(Some),
+        }
     }
 }

@@ -419,6 +419,8 @@ fn figures_writes_pngs_and_csvs() {
     ] {
         let bytes = std::fs::read(d.join(f)).unwrap();
         assert!(bytes.len() > 10_000 && bytes.starts_with(b"\x89PNG"), "{f}");
+        let svg = std::fs::read_to_string(d.join(f).with_extension("svg")).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("</svg>"), "{f}");
     }
     for f in [
         "inflation_gps.csv",
@@ -743,10 +745,16 @@ fn squeeze_stage_writes_contact_outputs() {
         .contains("Name=\"contact_pressure\""));
 }
 
+/// `figures --overlay`: the run's law is taken for the curves, its points are written as CSV
+/// with FE − GPS (checked here against steps.csv's own force and gps_force columns), a run whose
+/// λs* differs from the curve's is said to, and a run of another law is refused.
 #[test]
 fn figures_overlay_a_run_folder() {
-    let text =
-        format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.0\nsteps = 4\n");
+    // λs* = 1.25 is drawn on Fig. 6 (within 5 % of its 1.3) with the note that it differs
+    let text = format!(
+        "{}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.05\nsteps = 4\n",
+        SMALL_CASE.replace("target_stretch = 1.2", "target_stretch = 1.25")
+    );
     let case = write_case("overlay", &text);
     let run = case.parent().unwrap().join("run");
     assert!(tubemem(&[
@@ -764,11 +772,89 @@ fn figures_overlay_a_run_folder() {
         figs.to_str().unwrap(),
         "--overlay",
         run.to_str().unwrap(),
+        "--dpi",
+        "150",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(std::fs::read(figs.join("fig5_pressure_stretch.png"))
-        .unwrap()
-        .starts_with(b"\x89PNG"));
+    let png = std::fs::read(figs.join("fig6_force_displacement_ls1.3.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+    // the PNG's width (IHDR) follows the DPI: 11 in × 150
+    assert_eq!(u32::from_be_bytes(png[16..20].try_into().unwrap()), 1650);
+    let svg = std::fs::read_to_string(figs.join("fig6_force_displacement_ls1.3.svg")).unwrap();
+    assert!(svg.contains("FE − GPS"), "the error panel");
+    assert!(svg.contains("differs from the curves"), "the λs* note");
+    assert!(svg.contains("ABB, Kuhn N = 30"));
+    // the points CSV: FE − GPS equals steps.csv's force − gps_force, row by row
+    let steps = Steps::read(&run.join("steps.csv"));
+    let pts = Steps::read(&figs.join("fe_points_1_run.csv"));
+    let squeeze: Vec<&Vec<String>> = steps
+        .rows
+        .iter()
+        .filter(|r| !steps.field(r, "rho").is_empty())
+        .collect();
+    let pts_sq: Vec<&Vec<String>> = pts
+        .rows
+        .iter()
+        .filter(|r| pts.field(r, "squeeze") == "1")
+        .collect();
+    assert_eq!(squeeze.len(), 4);
+    assert_eq!(pts_sq.len(), squeeze.len());
+    for (a, b) in squeeze.iter().zip(&pts_sq) {
+        let d = steps.num(a, "force") - steps.num(a, "gps_force");
+        assert!((pts.num(b, "force_minus_gps") - d).abs() <= 1e-15, "{d}");
+        assert!(d.abs() > 0.0);
+    }
+    // a Mooney–Rivlin run: its law by default; refused on the ABB curves
+    let mr = write_case(
+        "overlay-mr",
+        &SMALL_CASE.replace(
+            "model = \"abb\"\nshear_modulus = 1.0\nkuhn = 30",
+            "model = \"mooney-rivlin\"\nshear_modulus = 1.0\nalpha = 0.1",
+        ),
+    );
+    let mr_run = mr.parent().unwrap().join("run");
+    assert!(tubemem(&[
+        "run",
+        mr.to_str().unwrap(),
+        "--out",
+        mr_run.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let mr_figs = mr.parent().unwrap().join("figs");
+    let o = tubemem(&[
+        "figures",
+        "--out",
+        mr_figs.to_str().unwrap(),
+        "--overlay",
+        mr_run.to_str().unwrap(),
+        "--format",
+        "svg",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        std::fs::read_to_string(mr_figs.join("fig5_pressure_stretch.svg"))
+            .unwrap()
+            .contains("Mooney–Rivlin, α = 0.1")
+    );
+    assert!(
+        !mr_figs.join("fig5_pressure_stretch.png").exists(),
+        "--format svg only"
+    );
+    assert_clean_failure(
+        &[
+            "figures",
+            "--out",
+            mr_figs.to_str().unwrap(),
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--overlay",
+            mr_run.to_str().unwrap(),
+        ],
+        "the run is Mooney–Rivlin, α = 0.1, the curves are ABB, Kuhn N = 30",
+    );
     let not_a_run = case.parent().unwrap();
     assert_clean_failure(
         &[
@@ -779,6 +865,10 @@ fn figures_overlay_a_run_folder() {
             not_a_run.join("nothing").to_str().unwrap(),
         ],
         "is this a tubemem run folder",
+    );
+    assert_clean_failure(
+        &["figures", "--out", figs.to_str().unwrap(), "--dpi", "5"],
+        "dpi = 5 is outside 25–1200",
     );
 }
 
@@ -1194,6 +1284,11 @@ fn resource_guards_refuse_with_their_estimate() {
     // an overlay run folder whose steps.csv is corrupt
     let run = d.join("corrupt");
     std::fs::create_dir_all(&run).unwrap();
+    std::fs::write(
+        run.join("summary.json"),
+        r#"{"material_spec": {"model": "abb", "shear_modulus": 1.0, "kuhn": 30.0}}"#,
+    )
+    .unwrap();
     let header = "stage,step,w,lambda_s,rho,displacement,force";
     for (k, row) in ["1,1,NaN,1.1,,,", "1,1,0.5\u{0}\u{0},1.1,,,"]
         .iter()
