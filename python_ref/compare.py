@@ -10,7 +10,8 @@ and the relative differences.
   profile_stageN.png and reports the largest difference along the tube;
 - squeeze stage: the scikit-fem GPS cross-section with contact at the FE's λs* and ρ, and GPS
   flattening (eqs. 76-77).
-Only the Anssari-Benam--Bucchi law is implemented in the references.
+The law is read from summary.json's material_spec: Anssari-Benam--Bucchi, Mooney--Rivlin or
+neo-Hookean, in every reference.
 """
 
 import argparse
@@ -40,11 +41,14 @@ def compare(run_dir, out_dir, plot=True):
     out_dir.mkdir(parents=True, exist_ok=True)
     summary = runs.read_summary(run_dir)
     spec, geo = summary["material_spec"], summary["geometry"]
-    if spec.get("model") != "abb":
-        raise SystemExit(f"the references implement the abb law only, not {spec.get('model')!r}")
+    try:
+        law = closed_form.law_of_spec(spec)
+    except ValueError as e:
+        raise SystemExit(f"{run_dir / 'summary.json'}: {e}")
     if geo.get("caps") != "hemisphere":
         raise SystemExit("the axisymmetric reference models hemispherical caps only")
-    kuhn, length = spec["kuhn"], geo["length"] / geo["radius"]
+    length = geo["length"] / geo["radius"]
+    print(f"law: {law[0]} {law[1]:g} (from summary.json)")
     rows = []
     ls_star = None
     for st in summary["stages"]:
@@ -54,14 +58,14 @@ def compare(run_dir, out_dir, plot=True):
         if st["kind"] == "inflate":
             ls = fin["lambda_s"]
             try:
-                tube, q, p = axisym.inflate_to(length, ls, kuhn=kuhn, cylinder_elements=int(8 * length))
+                tube, q, p = axisym.inflate_to(length, ls, law=law, cylinder_elements=int(8 * length))
             except RuntimeError as e:
                 # past the pressure maximum the mid-span stretch plateaus while a bulge
                 # propagates: the stretch-controlled reference cannot follow such a path
                 print(f"stage {idx}: no axisymmetric reference ({e}); bulge inflations are not replicated")
                 continue
             ax = tube.midspan(q, p)
-            w, lz = closed_form.gps_inflation(ls, kuhn)
+            w, lz = closed_form.gps_inflation(ls, law=law)
             for k, fe, sk, cf in [("w", fin["w"], ax["w"], w), ("lambda_z", fin["lambda_z"], ax["lambda_z"], lz)]:
                 rows.append((idx, "inflate", k, fe, sk, cf, rel(fe, sk), rel(fe, cf), rel(sk, cf)))
             # summary.json names the profile relative to the run folder
@@ -94,8 +98,8 @@ def compare(run_dir, out_dir, plot=True):
             ls_star = ls
         elif st["kind"] == "squeeze":
             ls0, rho = fin["initial_stretch"], fin["rho"]
-            sec = gps_section.squeeze(ls0, [rho], kuhn=kuhn, elements=64, penalty=1e5)[0]
-            cf = closed_form.gps_flattening(ls0, [rho], kuhn)[0]
+            sec = gps_section.squeeze(ls0, [rho], elements=64, penalty=1e5, law=law)[0]
+            cf = closed_form.gps_flattening(ls0, [rho], law=law)[0]
             for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
                 rows.append((idx, "squeeze", k, fin[k], sec[k], cf[k], rel(fin[k], sec[k]), rel(fin[k], cf[k]), rel(sec[k], cf[k])))
     header = ["stage", "kind", "quantity", "fe", "scikit_fem", "closed_form", "fe_vs_skfem", "fe_vs_closed", "skfem_vs_closed"]

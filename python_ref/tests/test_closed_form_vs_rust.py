@@ -35,6 +35,25 @@ def test_gps_flattening(tubemem, ls0, rhos):
             assert rel(s[k], r[k]) < 1e-9, (k, s[k], r[k])
 
 
+LAWS = {"mooney-rivlin": ("--material", "mooney-rivlin", "--alpha", "0.1"), "neo-hookean": ("--material", "neo-hookean")}
+
+
+@pytest.mark.parametrize("name,law", [("mooney-rivlin", ("mooney-rivlin", 0.1)), ("neo-hookean", ("mooney-rivlin", 0.0))])
+def test_other_laws_inflation_and_flattening(tubemem, name, law):
+    """The references for any law: Mooney-Rivlin and neo-Hookean inflation (GPS, PS) and GPS
+    flattening from 1.3 (Python eqs. 86-87 against the Rust law code), same tolerances."""
+    for ls in [1.1, 1.3, 1.6]:
+        g = tubemem("gps", "inflate", *LAWS[name], "--hypothesis", "gps", "--stretch", ls, "--json")
+        w, lz = cf.gps_inflation(ls, law=law)
+        assert rel(g["w"], w) < 1e-10 and rel(g["lambda_z"], lz) < 1e-10
+        p = tubemem("gps", "inflate", *LAWS[name], "--hypothesis", "ps", "--stretch", ls, "--json")
+        assert rel(p["w"], cf.ps_inflation(ls, law=law)) < 1e-10
+    for r in cf.gps_flattening(1.3, [1.1, 0.8], law=law):
+        s = tubemem("gps", "flatten", *LAWS[name], "--initial-stretch", 1.3, "--rho", r["rho"], "--json")
+        for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
+            assert rel(s[k], r[k]) < 1e-9, (k, s[k], r[k])
+
+
 def test_limit_points_and_maxwell(tubemem):
     lim = tubemem("gps", "limits", *ABB, "--json")
     (lmax, wmax), (lmin, wmin) = cf.gps_limit_points()

@@ -6,6 +6,7 @@ at most 2.9e-5 (chi, force); FE end-cap profile against the axisymmetric one, ma
 measured values, so that a regression of the FE profile or of the references fails the test).
 The CSV and the plot are written."""
 
+import json
 import pathlib
 import subprocess
 import sys
@@ -34,3 +35,30 @@ def test_compare_a_run_folder(tmp_path, tubemem_exe):
     # FE profile against the axisymmetric reference
     assert table[(1, "profile max |Δλs|")][3] < 2e-3, table[(1, "profile max |Δλs|")]
     assert (tmp_path / "cmp" / "compare.csv").exists() and (tmp_path / "cmp" / "profile_stage1.png").exists()
+
+
+MR_CASE = CASE.replace('model = "abb"\nshear_modulus = 1.0\nkuhn = 30', 'model = "mooney-rivlin"\nshear_modulus = 1.0\nalpha = 0.1')
+
+
+def test_compare_a_mooney_rivlin_run(tmp_path, tubemem_exe):
+    """compare.py reads the law from summary.json: the same small run with Mooney-Rivlin
+    alpha = 0.1. Bounds as for ABB above: the section against the closed form at the penalty
+    level (1e-4), the axisymmetric mid-span against GPS (3e-4, the end effect at L/R = 8), and
+    the FE profile (2e-3, the coarse mesh). And the references are the MR ones: the closed-form
+    column equals the MR GPS inflation and differs from the ABB one."""
+    assert MR_CASE != CASE
+    case = tmp_path / "case.toml"
+    case.write_text(MR_CASE)
+    out = subprocess.run([tubemem_exe, "run", str(case), "--out", str(tmp_path / "run")], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    rows = compare.compare(tmp_path / "run", tmp_path / "cmp", plot=False)
+    table = {(r[0], r[2]): r for r in rows}
+    assert abs(table[(1, "w")][8]) < 3e-4
+    for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
+        assert abs(table[(2, k)][8]) < 1e-4, (k, table[(2, k)])
+    assert table[(1, "profile max |Δλs|")][3] < 2e-3, table[(1, "profile max |Δλs|")]
+    from tubemem_ref import closed_form as cf
+    ls = json.loads((tmp_path / "run" / "summary.json").read_text())["stages"][0]["final"]["lambda_s"]
+    w_mr, _ = cf.gps_inflation(ls, law=("mooney-rivlin", 0.1))
+    w_abb, _ = cf.gps_inflation(ls, 30.0)
+    assert table[(1, "w")][5] == w_mr and abs(w_mr / w_abb - 1) > 1e-2

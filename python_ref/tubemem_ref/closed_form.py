@@ -8,7 +8,10 @@ Different formulations on purpose, so that agreement means something:
 * limit points: zeros of dw/dlambda_s from a complex-step derivative of eq. (68) + eq. (66);
 * Maxwell pressure: equal areas on the (v, w) curve with scipy.integrate.quad.
 
-Only the Anssari-Benam--Bucchi law (eqs. 58-59, 62) is implemented here.
+Laws: the Anssari-Benam--Bucchi law (eqs. 58-59, 62) everywhere; Mooney-Rivlin (eqs. 86-87,
+alpha = 0 is neo-Hookean) for free inflation and flattening (`law=("mooney-rivlin", alpha)`;
+`law_of_spec` maps a summary.json material_spec). Limit points, Maxwell pressure and the
+channel/polygon hand calculations are the paper's ABB example only.
 """
 
 import numpy as np
@@ -34,37 +37,71 @@ def lock_lambda_z(ls, kuhn):
     return optimize.brentq(f, 1.0, np.sqrt(3 * kuhn), xtol=1e-15)
 
 
-def gps_inflation(ls, kuhn=30.0):
+def law_of_spec(spec):
+    """The `law` tuple of a summary.json `material_spec` (results are per mu H: mu drops out)."""
+    model = spec.get("model")
+    if model == "abb":
+        return ("abb", float(spec["kuhn"]))
+    if model == "mooney-rivlin":
+        return ("mooney-rivlin", float(spec["alpha"]))
+    if model == "neo-hookean":
+        return ("mooney-rivlin", 0.0)
+    raise ValueError(f"unknown material model {model!r}")
+
+
+def resultants(ls, lz, law):
+    """(N_s, N_z)/(mu H) of `law` = ("abb", kuhn) (eq. 58) or ("mooney-rivlin", alpha) (eqs. 86-87)."""
+    kind, param = law
+    if kind == "abb":
+        return abb_resultants(ls, lz, param)
+    if kind == "mooney-rivlin":
+        return mr_resultants(ls, lz, param)
+    raise ValueError(f"unknown law {kind!r}")
+
+
+def _lz_bracket(ls, law):
+    """An interval of lambda_z holding the root of N_s - 2 N_z (ABB: below locking)."""
+    if law[0] == "abb":
+        return 0.5, lock_lambda_z(ls, law[1]) * (1 - 1e-12)
+    return 0.5, 20.0
+
+
+def gps_inflation(ls, kuhn=30.0, law=None):
     """(w, lambda_z) for free inflation under GPS, eq. (66)."""
+    law = law or ("abb", kuhn)
     if ls == 1.0:
         return 0.0, 1.0
     def g(lz):
-        ns, nz = abb_resultants(ls, lz, kuhn)
+        ns, nz = resultants(ls, lz, law)
         return ns - 2 * nz
 
-    lz = optimize.brentq(g, 0.5, lock_lambda_z(ls, kuhn) * (1 - 1e-12), xtol=1e-15, rtol=1e-15)
-    ns, _ = abb_resultants(ls, lz, kuhn)
+    lo, hi = _lz_bracket(ls, law)
+    lz = optimize.brentq(g, lo, hi, xtol=1e-15, rtol=1e-15)
+    ns, _ = resultants(ls, lz, law)
     return ns / ls, lz
 
 
-def ps_inflation(ls, kuhn=30.0):
-    """w for free inflation under PS, eq. (70)."""
-    k = kuhn
+def ps_inflation(ls, kuhn=30.0, law=None):
+    """w for free inflation under PS, eq. (70) (ABB) or N_s(ls, 1)/ls for any law."""
+    if law is not None and law[0] != "abb":
+        return resultants(ls, 1.0, law)[0] / ls
+    k = law[1] if law is not None else kuhn
     return ((1 - k) * (ls**4 - 1) * (1 + ls**2 * (ls**2 + 1 - 9 * k))
             / (ls**4 * (1 - 3 * k) * (1 + ls**2 * (ls**2 + 1 - 3 * k))))
 
 
-def gps_flattening(ls0, rhos, kuhn=30.0):
+def gps_flattening(ls0, rhos, kuhn=30.0, law=None):
     """States along the GPS flattening, eqs. (76)-(77), for the decreasing half-gaps `rhos`.
 
     Unknowns x = (w, ls, lz, chi); returns a list of dicts.
     """
-    w0, lz0 = gps_inflation(ls0, kuhn)
+    law = law or ("abb", kuhn)
+    w0, lz0 = gps_inflation(ls0, law=law)
     gas = w0 * ls0**2 * lz0
 
     def residual(x, rho):
         w, ls, lz, chi = x
-        ns, nz = abb_resultants(ls, lz, kuhn)
+        ns, nz = resultants(ls, lz, law)
         return [w * rho - ns,
                 0.5 * w * rho * (rho + 2 * chi) / (rho + chi) - nz,
                 ls - rho - chi,
@@ -167,9 +204,7 @@ def mr_resultants(ls, lz, alpha):
 
 def gps_inflation_mr(ls, alpha):
     """(w, lambda_z) of GPS free inflation for Mooney-Rivlin: eq. (66) with eqs. (86)-(87)."""
-    g = lambda lz: mr_resultants(ls, lz, alpha)[0] - 2 * mr_resultants(ls, lz, alpha)[1]
-    lz = optimize.brentq(g, 0.5, 20.0, xtol=1e-15, rtol=1e-15)
-    return mr_resultants(ls, lz, alpha)[0] / ls, lz
+    return gps_inflation(ls, law=("mooney-rivlin", alpha))
 
 
 def gps_polygon(ls0, lines, hs, kuhn=30.0):

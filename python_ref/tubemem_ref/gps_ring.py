@@ -16,8 +16,9 @@ from .gps_section import GpsSection
 
 
 class GpsRing(GpsSection):
-    def __init__(self, kuhn=30.0, elements=128, penalty=1e5, intorder=8, rigid=(0, 1, 2)):
+    def __init__(self, kuhn=30.0, elements=128, penalty=1e5, intorder=8, rigid=(0, 1, 2), law=None):
         self.kuhn = kuhn
+        self.law = law or ("abb", kuhn)
         # which rigid modes to pin: 0 mean x, 1 mean y, 2 mean rotation (tangential sliding)
         self.rigid = list(rigid)
         self.kappa = penalty
@@ -93,11 +94,12 @@ class GpsRing(GpsSection):
         return dict(w=m / (lz * a), lambda_s=length / (2 * np.pi), lambda_z=lz, area=a, forces=forces)
 
 
-def squeeze(ls0, walls, hs, kuhn=30.0, elements=128, penalty=1e5, substeps=0.01, rigid=(0, 1, 2)):
+def squeeze(ls0, walls, hs, kuhn=30.0, elements=128, penalty=1e5, substeps=0.01, rigid=(0, 1, 2), law=None):
     """The full ring inflated to ls0 (closed form), gas closed in, walls(h) moved from h = ls0 to
     each h in `hs`; `rigid` selects the rigid modes that the walls do not hold."""
-    ring = GpsRing(kuhn, elements, penalty, rigid=rigid)
-    w0, lz0 = gps_inflation(ls0, kuhn)
+    law = law or ("abb", kuhn)
+    ring = GpsRing(kuhn, elements, penalty, rigid=rigid, law=law)
+    w0, lz0 = gps_inflation(ls0, law=law)
     m = w0 * lz0 * np.pi * ls0**2
     q, lz = ring.circle(ls0), lz0
     out, h_prev = [], ls0

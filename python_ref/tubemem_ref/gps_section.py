@@ -18,7 +18,8 @@ symmetry planes pass through the origin, so the quarter's (1/2)∫(x y' − y x'
 the area). Newton with the consistent tangent, assembled from one `LinearForm` / `BilinearForm`
 per term; the gas term's rank-one part and the λz border are added as dense blocks.
 
-Only the Anssari-Benam–Bucchi law (eq. 19) is implemented here.
+Laws: `law=("abb", 𝒩)` (eq. 19, the default with `kuhn`) or `("mooney-rivlin", α)` (eq. 85;
+α = 0 is neo-Hookean), through `law_derivatives`.
 """
 
 import numpy as np
@@ -79,8 +80,9 @@ class GpsSection:
     """The quarter cross-section in frictionless contact with planes (nx, ny, d), gap
     g = nx x + ny y − d, all parallel to the axis."""
 
-    def __init__(self, kuhn=30.0, elements=64, penalty=1e4, intorder=8):
+    def __init__(self, kuhn=30.0, elements=64, penalty=1e4, intorder=8, law=None):
         self.kuhn = kuhn
+        self.law = law or ("abb", kuhn)
         self.kappa = penalty
         mesh = MeshLine1.init_tensor(np.linspace(0.0, np.pi / 2, elements + 1))
         self.basis = Basis(mesh, ElementVector(ElementLineP2(), 2), intorder=intorder)
@@ -101,7 +103,7 @@ class GpsSection:
         return q
 
     def _forms(self, lz, planes):
-        kappa, kuhn = self.kappa, self.kuhn
+        kappa, law = self.kappa, self.law
 
         def gaps(x, y):
             return [(nx, ny, nx * x + ny * y - d) for nx, ny, d in planes]
@@ -120,12 +122,12 @@ class GpsSection:
         @Functional
         def w_z(w):
             _, _, _, _, ls = geo(w)
-            return abb_derivatives(ls, lz, kuhn)[2]
+            return law_derivatives(ls, lz, law)[2]
 
         @Functional
         def w_zz(w):
             _, _, _, _, ls = geo(w)
-            return abb_derivatives(ls, lz, kuhn)[5]
+            return law_derivatives(ls, lz, law)[5]
 
         def contact_force(k):
             nx0, ny0, d0 = planes[k]
@@ -140,7 +142,7 @@ class GpsSection:
         @LinearForm
         def r_membrane(v, w):
             _, y, gx, gy, ls = geo(w)
-            ws = abb_derivatives(ls, lz, kuhn)[1]
+            ws = law_derivatives(ls, lz, law)[1]
             x = w["u"][0]
             out = ws / ls * (gx * v.grad[0][0] + gy * v.grad[1][0])
             for nx, ny, g in gaps(x, y):
@@ -155,13 +157,13 @@ class GpsSection:
         @LinearForm
         def k_membrane_lz(v, w):
             _, _, gx, gy, ls = geo(w)
-            wsz = abb_derivatives(ls, lz, kuhn)[4]
+            wsz = law_derivatives(ls, lz, law)[4]
             return wsz / ls * (gx * v.grad[0][0] + gy * v.grad[1][0])
 
         @BilinearForm
         def k_membrane(u, v, w):
             _, y, gx, gy, ls = geo(w)
-            _, ws, _, wss, _, _ = abb_derivatives(ls, lz, kuhn)
+            _, ws, _, wss, _, _ = law_derivatives(ls, lz, law)
             gu = gx * u.grad[0][0] + gy * u.grad[1][0]
             gv = gx * v.grad[0][0] + gy * v.grad[1][0]
             uv = u.grad[0][0] * v.grad[0][0] + u.grad[1][0] * v.grad[1][0]
@@ -240,12 +242,13 @@ class GpsSection:
                     force=forces[0], chi=forces[0] / w)
 
 
-def squeeze(ls0, rhos, kuhn=30.0, elements=64, penalty=1e4, substeps=0.05, walls=plates):
+def squeeze(ls0, rhos, kuhn=30.0, elements=64, penalty=1e4, substeps=0.05, walls=plates, law=None):
     """Inflate exactly to λs* (the closed-form inflated circle is the model's equilibrium under
     that pressure), close the gas in, and move the walls `walls(h)` from h = λs* to each ρ in
     `rhos` (decreasing); list of outputs (with `rho` and the largest penetration)."""
-    sec = GpsSection(kuhn, elements, penalty)
-    w0, lz0 = gps_inflation(ls0, kuhn)
+    law = law or ("abb", kuhn)
+    sec = GpsSection(kuhn, elements, penalty, law=law)
+    w0, lz0 = gps_inflation(ls0, law=law)
     m4 = w0 * lz0 * np.pi * ls0**2 / 4.0
     q, lz = sec.circle(ls0), lz0
     out, h_prev = [], ls0
