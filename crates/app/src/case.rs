@@ -116,6 +116,17 @@ pub enum VtuFrames {
     None,
 }
 
+/// Which converged steps get a profile along the tube (stage ends always do).
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProfileFrames {
+    /// every converged step (each costs about one residual assembly)
+    #[default]
+    Every,
+    /// the last step of each stage only
+    StageEnd,
+}
+
 /// `[output]`: optional.
 #[derive(Debug, Deserialize, Clone, Copy)]
 #[serde(deny_unknown_fields)]
@@ -132,6 +143,10 @@ pub struct OutputSpec {
     /// write the whole tube, the symmetry-reduced model reflected across its planes
     #[serde(default)]
     pub mirror: bool,
+    /// "every" (default) | "stage-end": profiles along the tube (with the contact width per
+    /// ring) at every converged step, or at stage ends only
+    #[serde(default)]
+    pub profiles: ProfileFrames,
 }
 
 /// How VTU arrays are written.
@@ -154,6 +169,7 @@ impl Default for OutputSpec {
             vtu_every: default_vtu_every(),
             vtu_format: VtuFormat::default(),
             mirror: false,
+            profiles: ProfileFrames::default(),
         }
     }
 }

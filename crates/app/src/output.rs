@@ -4,6 +4,8 @@
 //! * `vtu/step_NNNNN.vtu` + `tube.pvd`: a frame per step (frame 0 is the reference state); the
 //!   PVD timestep is the load path: stage − 1 + the fraction of the stage done;
 //! * `profiles/stageN_final.csv`: the profile along the tube at each stage end;
+//! * `profiles/profiles.csv`: the profile at every converged step ([`PROFILES_HEADER`]; `row`
+//!   is the step's row in steps.csv), unless `[output] profiles = "stage-end"`;
 //! * `summary.json`: [`RunReport::summary`], rewritten (atomically: write, then rename) after
 //!   every stage and on failure, so a run that fails midway loses nothing that had converged;
 //! * `run.json`: the manifest — status `running`, `finished`, `failed` or `interrupted`, the
@@ -154,6 +156,7 @@ struct Manifest<'a> {
 pub struct RunWriter {
     dir: PathBuf,
     steps: Option<BufWriter<File>>,
+    profiles: Option<BufWriter<File>>,
     pvd: Vec<(f64, String)>,
     frames: usize,
     rows: usize,
@@ -319,6 +322,29 @@ impl RunWriter {
             .open(&path)
             .map_err(|e| AppError::io(&path, e))?;
         w.steps = Some(BufWriter::new(steps));
+        // profiles.csv: the rows of the kept steps
+        let path = dir.join("profiles").join("profiles.csv");
+        if let Ok(text) = std::fs::read_to_string(&path) {
+            let kept: Vec<&str> = text
+                .lines()
+                .enumerate()
+                .filter(|(k, l)| {
+                    *k == 0
+                        || l.split(',')
+                            .next()
+                            .and_then(|r| r.parse::<usize>().ok())
+                            .is_some_and(|r| r <= ck.rows)
+                })
+                .map(|(_, l)| l)
+                .collect();
+            std::fs::write(&path, format!("{}\n", kept.join("\n")))
+                .map_err(|e| AppError::io(&path, e))?;
+            let f = std::fs::OpenOptions::new()
+                .append(true)
+                .open(&path)
+                .map_err(|e| AppError::io(&path, e))?;
+            w.profiles = Some(BufWriter::new(f));
+        }
         w.pvd = ck.pvd.clone();
         w.frames = ck.frames;
         w.rows = ck.rows;
@@ -359,6 +385,7 @@ impl RunWriter {
         Ok(Self {
             dir: dir.to_path_buf(),
             steps: None,
+            profiles: None,
             pvd: vec![],
             frames: 0,
             rows: 0,
@@ -607,15 +634,43 @@ impl Mirror {
     }
 }
 
+/// The columns of a stage-end profile (one row per ring).
+pub const PROFILE_HEADER: &str = "z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width";
+/// The columns of profiles.csv: the step's row in steps.csv, its stage and step, then
+/// [`PROFILE_HEADER`].
+pub const PROFILES_HEADER: &str =
+    "row,stage,step,z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width";
+
+/// The values of one ring, in [`PROFILE_HEADER`]'s order.
+pub fn ring_row(r: &RingValues) -> [f64; 9] {
+    let v = &r.values;
+    [
+        r.z_ref,
+        r.z,
+        r.radius,
+        v.lambda_s,
+        v.lambda_z,
+        v.n_s,
+        v.n_z,
+        v.n_sz,
+        r.contact_width,
+    ]
+}
+
+fn join(values: &[f64]) -> String {
+    values
+        .iter()
+        .map(|v| v.to_string())
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
 /// Write a profile (one row per ring) as CSV.
 pub fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
-    let mut text = String::from("z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz\n");
+    let mut text = format!("{PROFILE_HEADER}\n");
     for r in rings {
-        let v = &r.values;
-        text.push_str(&format!(
-            "{},{},{},{},{},{},{},{}\n",
-            r.z_ref, r.z, r.radius, v.lambda_s, v.lambda_z, v.n_s, v.n_z, v.n_sz
-        ));
+        text.push_str(&join(&ring_row(r)));
+        text.push('\n');
     }
     std::fs::write(path, text).map_err(|e| AppError::io(path, e))
 }
@@ -640,6 +695,11 @@ impl Observer for RunWriter {
         writeln!(steps, "{STEPS_HEADER}")?;
         steps.flush()?;
         self.steps = Some(steps);
+        let path = self.dir.join("profiles").join("profiles.csv");
+        let mut profiles = BufWriter::new(File::create(&path).map_err(|e| AppError::io(&path, e))?);
+        writeln!(profiles, "{PROFILES_HEADER}")?;
+        profiles.flush()?;
+        self.profiles = Some(profiles);
         self.frame(0.0, model, state, None)
     }
 
@@ -648,6 +708,14 @@ impl Observer for RunWriter {
             writeln!(steps, "{}", format_row(view.record))?;
             steps.flush()?;
             self.rows += 1;
+        }
+        if let Some(profiles) = &mut self.profiles {
+            let r = view.record;
+            for ring in &r.profile {
+                let head = [self.rows as f64, r.stage as f64, r.step as f64];
+                writeln!(profiles, "{},{}", join(&head), join(&ring_row(ring)))?;
+            }
+            profiles.flush()?;
         }
         use crate::case::VtuFrames;
         let stage_end = view.fraction >= 1.0;

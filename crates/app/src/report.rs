@@ -65,6 +65,10 @@ pub struct StepRecord {
     pub residuals: Vec<f64>,
     pub contact: Option<ContactRecord>,
     pub closed_form: StepClosedForm,
+    /// the profile along the tube at this step (`[output] profiles = "every"`, the default;
+    /// empty otherwise)
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profile: Vec<RingValues>,
 }
 
 /// The final state of a stage (the `final` entry of summary.json).

@@ -732,6 +732,7 @@ fn run_inner(
             settings,
         };
         let mut steps: Vec<StepRecord> = restored;
+        let every_profile = case.output.profiles == crate::case::ProfileFrames::Every;
         let finished: &RunReport = report;
         let result = run_stage_from(
             &mut model,
@@ -787,6 +788,12 @@ fn run_inner(
                     &ms,
                     contact.as_ref().map(|c| (&c.values, start_lambda_s)),
                 );
+                let profile = if every_profile {
+                    ring_profile(m, st, info.load.contact.as_ref())
+                        .map_err(|e| Box::new(e) as BoxError)?
+                } else {
+                    vec![]
+                };
                 let record = StepRecord {
                     stage: i,
                     step: info.step,
@@ -797,6 +804,7 @@ fn run_inner(
                     residuals: info.newton.history.clone(),
                     contact,
                     closed_form,
+                    profile,
                 };
                 steps.push(record);
                 let view = StepView {
@@ -867,8 +875,15 @@ fn run_inner(
                 None,
             ),
         };
-        let rings =
-            ring_profile(&model, &state).map_err(|source| AppError::Post { stage: i, source })?;
+        // the stage end's profile: the last step's, or computed for it (with its plates)
+        let rings = match steps.last() {
+            Some(l) if !l.profile.is_empty() => l.profile.clone(),
+            _ => {
+                let plates = contact.map(|c| Contact::plates(c.values.rho, c.penalty));
+                ring_profile(&model, &state, plates.as_ref())
+                    .map_err(|source| AppError::Post { stage: i, source })?
+            }
+        };
         let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
         let wrinkling = wrinkle_report(&model, &state, i)?;
         let ([(gps, gps_err), (ps, ps_err)], local_section, local_err) = stage_closed_form(

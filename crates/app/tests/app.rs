@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 use tubemem_app::case::Case;
-use tubemem_app::output::{step_row, FolderMode, RunWriter};
+use tubemem_app::output::{ring_row, step_row, FolderMode, RunWriter, PROFILES_HEADER};
 use tubemem_app::report::StageOutcome;
 use tubemem_app::run::run;
 
@@ -59,6 +59,66 @@ fn the_files_are_the_report() {
     // the target is plain data, not a debug string
     assert_eq!(on_disk["stages"][0]["target"]["control"], "stretch");
     assert_eq!(on_disk["stages"][0]["target"]["value"], 1.2);
+    // profiles.csv: every step's profile, as in the report, field for field
+    let text = std::fs::read_to_string(out.join("profiles/profiles.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(PROFILES_HEADER));
+    let mut rows = 0;
+    for (k, rec) in report.steps().enumerate() {
+        assert!(rec.profile.len() >= 10, "a profile at every step");
+        for ring in &rec.profile {
+            let line = lines.next().unwrap();
+            let v: Vec<f64> = line.split(',').map(|f| f.parse().unwrap()).collect();
+            assert_eq!(v[..3], [(k + 1) as f64, rec.stage as f64, rec.step as f64]);
+            assert_eq!(v[3..], ring_row(ring), "{line}");
+            rows += 1;
+        }
+        // the mid-span ring of the profile is the step's mid-span state, and its contact width
+        // the mid-span contact record's geometric width (two computations of the same thing)
+        let mid = rec.profile.iter().find(|r| r.z_ref == 0.0).unwrap();
+        assert_eq!(mid.values, rec.midspan);
+        match &rec.contact {
+            Some(c) => {
+                assert_eq!(mid.contact_width, c.values.chi_geometric);
+                assert!(mid.contact_width > 0.0);
+            }
+            None => assert_eq!(mid.contact_width, 0.0),
+        }
+    }
+    assert!(lines.next().is_none() && rows > 0);
+    // the stage-end profile is the last step's
+    for st in &report.stages {
+        assert_eq!(
+            serde_json::to_value(&st.profile).unwrap(),
+            serde_json::to_value(&st.steps.last().unwrap().profile).unwrap()
+        );
+    }
+}
+
+/// `[output] profiles = "stage-end"`: no per-step profiles, the stage-end one still there (with
+/// the contact width of the plates at the stage end).
+#[test]
+fn profiles_at_stage_ends_only() {
+    let case = Case::parse(&format!(
+        "{SMALL}{SQUEEZE}\n[output]\nprofiles = \"stage-end\"\n"
+    ))
+    .unwrap();
+    let out = tmp("profiles-stage-end");
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let report = run(&case, "small", &mut [&mut writer])
+        .into_result()
+        .unwrap();
+    assert!(report.steps().all(|r| r.profile.is_empty()));
+    let text = std::fs::read_to_string(out.join("profiles/profiles.csv")).unwrap();
+    assert_eq!(text.lines().count(), 1, "the header only");
+    let squeeze = &report.stages[1];
+    let mid = squeeze.profile.iter().find(|r| r.z_ref == 0.0).unwrap();
+    let last = squeeze.steps.last().unwrap();
+    assert_eq!(mid.values, last.midspan);
+    assert_eq!(
+        mid.contact_width,
+        last.contact.as_ref().unwrap().values.chi_geometric
+    );
 }
 
 /// A stage whose precondition fails (the plates would start above the tube) is recorded: the

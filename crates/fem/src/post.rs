@@ -88,6 +88,25 @@ pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
 /// the edges leaving the ring, and resultants averaged over the Gauss points of the elements
 /// that touch it. `volume` is the total enclosed volume.
 pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, FemError> {
+    let on_ring = ring.contains_set();
+    let touching: Vec<usize> = (0..model.elements().len())
+        .filter(|&e| {
+            model.elements()[e]
+                .nodes
+                .iter()
+                .any(|i| on_ring.contains(i))
+        })
+        .collect();
+    ring_state_of(model, state, ring, &touching)
+}
+
+/// [`ring_state`] given the elements that touch the ring (in ascending order).
+fn ring_state_of(
+    model: &Model,
+    state: &State,
+    ring: &Ring,
+    touching: &[usize],
+) -> Result<MidSpan, FemError> {
     let mesh = model.mesh();
     let mut cur = 0.0;
     let mut reference = 0.0;
@@ -99,11 +118,9 @@ pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, 
     let mut lz_sum = 0.0;
     let mut lz_n = 0usize;
     let (mut ns, mut nz, mut nsz, mut ng) = (0.0, 0.0, 0.0, 0usize);
-    for (e, el) in model.elements().iter().enumerate() {
+    for &e in touching {
+        let el = &model.elements()[e];
         let q = el.nodes;
-        if !q.iter().any(|i| on_ring.contains(i)) {
-            continue;
-        }
         for k in 0..4 {
             let (a, b) = (q[k], q[(k + 1) % 4]);
             if on_ring.contains(&a) != on_ring.contains(&b) {
@@ -235,11 +252,21 @@ pub struct RingValues {
     /// mean distance from the axis
     pub radius: f64,
     pub values: MidSpan,
+    /// the ring's geometric contact width against the plate y = h, as at mid-span
+    /// ([`ContactValues::chi_geometric`], c/(πR) over all symmetry copies); 0 without plates
+    #[serde(default)]
+    pub contact_width: f64,
 }
 
 /// Profiles along the cylinder: one entry per ring of nodes at the reference radius (the
-/// cylinder and the cap equators), from the lowest Z to the highest.
-pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, FemError> {
+/// cylinder and the cap equators), from the lowest Z to the highest, with each ring's contact
+/// width against the plates of `contact`. One pass over the nodes and elements (each element is
+/// visited for the rings it touches), so it costs about one residual assembly.
+pub fn ring_profile(
+    model: &Model,
+    state: &State,
+    contact: Option<&Contact>,
+) -> Result<Vec<RingValues>, FemError> {
     let mesh = model.mesh();
     let tol = 1e-9 * mesh.scale();
     let radius = mesh
@@ -255,10 +282,43 @@ pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, Fem
         .collect();
     heights.sort_by(f64::total_cmp);
     heights.dedup_by(|a, b| (*a - *b).abs() <= tol);
+    // each node's ring (the nodes within `tol` of a height, as `Ring::at` takes them)
+    let ring_of = |z: f64| -> Option<usize> {
+        let k = heights.partition_point(|&h| h < z - tol);
+        (k < heights.len() && (heights[k] - z).abs() <= tol).then_some(k)
+    };
+    let mut nodes: Vec<Vec<usize>> = vec![vec![]; heights.len()];
+    let mut node_ring = vec![None; mesh.nodes.len()];
+    for (i, p) in mesh.nodes.iter().enumerate() {
+        if let Some(k) = ring_of(p[2]) {
+            nodes[k].push(i);
+            node_ring[i] = Some(k);
+        }
+    }
+    let mut touching: Vec<Vec<usize>> = vec![vec![]; heights.len()];
+    for (e, el) in model.elements().iter().enumerate() {
+        let mut rings: Vec<usize> = el.nodes.iter().filter_map(|&i| node_ring[i]).collect();
+        rings.sort_unstable();
+        rings.dedup();
+        for k in rings {
+            touching[k].push(e);
+        }
+    }
+    let half_gap = contact.and_then(Contact::half_gap);
+    let closed = mesh.symmetry.rings_closed();
     heights
-        .into_iter()
-        .map(|z| {
-            let ring = Ring::at(model, z);
+        .iter()
+        .zip(nodes)
+        .zip(&touching)
+        .map(|((&z, mut ring_nodes), touching)| {
+            ring_nodes.sort_by(|&a, &b| {
+                let ang = |i: usize| mesh.nodes[i][1].atan2(mesh.nodes[i][0]);
+                ang(a).total_cmp(&ang(b))
+            });
+            let ring = Ring {
+                nodes: ring_nodes,
+                closed,
+            };
             let n = ring.nodes.len() as f64;
             Ok(RingValues {
                 z_ref: z,
@@ -269,10 +329,36 @@ pub fn ring_profile(model: &Model, state: &State) -> Result<Vec<RingValues>, Fem
                     .map(|&i| state.x[i][0].hypot(state.x[i][1]))
                     .sum::<f64>()
                     / n,
-                values: ring_state(model, state, &ring)?,
+                values: ring_state_of(model, state, &ring, touching)?,
+                contact_width: half_gap.map_or(0.0, |h| contact_width(model, state, &ring, h)),
             })
         })
         .collect()
+}
+
+/// The geometric contact width of `ring` against the plate y = `h`: the penetrated length of the
+/// ring polygon (zero crossings of the nodal gap interpolated linearly, O(h) accurate), over π,
+/// for all copies across the x = 0 symmetry plane.
+fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64) -> f64 {
+    let gap = |p: [f64; 3]| h - p[1];
+    let mut c = 0.0;
+    for (ia, ib) in ring.segments() {
+        let (a, b) = (state.x[ia], state.x[ib]);
+        let (ga, gb) = (gap(a), gap(b));
+        let len = dist(a, b);
+        c += match (ga < 0.0, gb < 0.0) {
+            (true, true) => len,
+            (true, false) => len * ga / (ga - gb),
+            (false, true) => len * gb / (gb - ga),
+            _ => 0.0,
+        };
+    }
+    let x_copies = if model.mesh().symmetry.planes().contains(&0) {
+        2.0
+    } else {
+        1.0
+    };
+    x_copies * c / std::f64::consts::PI
 }
 
 /// Mid-span contact values of a squeeze, dimensionless.
@@ -307,20 +393,8 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
     let x_copies = if planes.contains(&0) { 2.0 } else { 1.0 };
     let z_copies = if planes.contains(&2) { 2.0 } else { 1.0 };
     let gap = |p: [f64; 3]| h - p[1];
-    // contact width along the mid-span ring polygon (zero crossings interpolated linearly)
     let ring = Ring::midspan(model);
-    let mut c = 0.0;
-    for (ia, ib) in ring.segments() {
-        let (a, b) = (state.x[ia], state.x[ib]);
-        let (ga, gb) = (gap(a), gap(b));
-        let len = dist(a, b);
-        c += match (ga < 0.0, gb < 0.0) {
-            (true, true) => len,
-            (true, false) => len * ga / (ga - gb),
-            (false, true) => len * gb / (gb - ga),
-            _ => 0.0,
-        };
-    }
+    let chi_geometric = contact_width(model, state, &ring, h);
     let on_ring = ring.contains_set();
     // force per unit length from the element rows next to the ring, side by side
     let mut side_force = [0.0; 2];
@@ -382,7 +456,7 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
         } else {
             0.0
         },
-        chi_geometric: x_copies * c / pi,
+        chi_geometric,
         force: x_copies * f_per_len / pi,
         contact_pressure: if pc_n > 0 { pc_sum / pc_n as f64 } else { 0.0 },
         penetration,

@@ -555,3 +555,40 @@ fn the_step_limit_stops_a_stage() {
         e => panic!("{e:?}"),
     }
 }
+
+/// The one-pass profile is the per-ring extraction: on an inflated, squeezed quarter tube,
+/// `ring_profile` gives, ring by ring, exactly (bitwise) what `ring_state` at `Ring::at` gives
+/// (same elements, same summation order), and its contact width at mid-span is the mid-span
+/// contact record's; a ring that the plate does not reach has width 0.
+#[test]
+fn the_one_pass_profile_is_the_per_ring_extraction() {
+    use crate::post::{midspan_contact, ring_profile, ring_state, Ring};
+    let mut m = Model::new(
+        capped_tube(1.0, 6.0, 16, 24, Symmetry::Quarter).unwrap(),
+        Box::new(AnssariBenamBucchi::new(1.0, 30.0).unwrap()),
+    )
+    .unwrap();
+    let mut st = m.reference_state();
+    m.solve(&mut st, &Load::pressure(0.5)).unwrap();
+    let ymax = st.x.iter().map(|p| p[1]).fold(0.0, f64::max);
+    // a plate just below the top of the inflated tube: only the cylinder touches it
+    let contact = Contact::plates(0.98 * ymax, 200.0);
+    m.solve(
+        &mut st,
+        &Load::with_contact(Loading::Pressure(0.5), contact.clone()),
+    )
+    .unwrap();
+    let rings = ring_profile(&m, &st, Some(&contact)).unwrap();
+    assert!(rings.len() >= 13, "{}", rings.len());
+    for r in &rings {
+        let per_ring = ring_state(&m, &st, &Ring::at(&m, r.z_ref)).unwrap();
+        assert_eq!(r.values, per_ring, "ring at Z = {}", r.z_ref);
+    }
+    let mid = rings.iter().find(|r| r.z_ref == 0.0).unwrap();
+    let mc = midspan_contact(&m, &st, &contact).unwrap();
+    assert_eq!(mid.contact_width, mc.chi_geometric);
+    assert!(mid.contact_width > 0.0);
+    // the highest ring (a cap equator) is below the plate: no contact there
+    let top = rings.last().unwrap();
+    assert!(top.z_ref > 2.9 && top.contact_width == 0.0, "{top:?}");
+}
