@@ -2,7 +2,7 @@
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Callable, Mapping, Optional, Union
+from typing import Any, Callable, Iterator, Literal, Mapping, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -14,12 +14,27 @@ class TubememError(RuntimeError):
 
 Material = Optional[Mapping[str, Any]]
 ArrayLike = Union[float, npt.ArrayLike]
-Progress = Optional[Callable[[dict], Any]]
+Progress = Optional[Union[Callable[[dict], Any], Literal["tqdm"]]]
+
+class Table:
+    """Named numpy columns of equal shape (a curve, a vectorized closed form, a run's steps or
+    profiles): t["w"], t.columns, len(t), iteration over the names, to_pandas(), to_dict()."""
+
+    def __getitem__(self, key: str) -> np.ndarray: ...
+    def __contains__(self, key: str) -> bool: ...
+    def __iter__(self) -> Iterator[str]: ...
+    def __len__(self) -> int: ...
+    @property
+    def columns(self) -> list[str]: ...
+    def keys(self) -> list[str]: ...
+    def to_dict(self) -> dict[str, np.ndarray]: ...
+    def to_pandas(self) -> Any: ...
 
 def gps_inflate(
     stretch: ArrayLike, material: Material = None, hypothesis: str = "gps"
-) -> dict[str, Union[float, np.ndarray]]:
-    """Free inflation at hoop stretch λs (eq. 66 GPS, eq. 70 PS): w, lambda_s, lambda_z, n_s, n_z."""
+) -> Union[dict[str, float], Table]:
+    """Free inflation at hoop stretch λs (eq. 66 GPS, eq. 70 PS): w, lambda_s, lambda_z, n_s, n_z
+    (a dict for a number, a Table of arrays of the input's shape for an array)."""
 
 def gps_inflation_curve(
     stretch_to: float,
@@ -27,10 +42,10 @@ def gps_inflation_curve(
     stretch_from: float = 1.0,
     material: Material = None,
     hypothesis: str = "gps",
-) -> list[dict[str, float]]: ...
+) -> Table: ...
 def gps_flatten(
     initial_stretch: float, rho: ArrayLike, material: Material = None, hypothesis: str = "gps"
-) -> dict[str, Union[float, np.ndarray]]:
+) -> Union[dict[str, float], Table]:
     """Squeeze between two plates with the gas closed in (eqs. 76–77 GPS, 78–79 PS)."""
 
 def gps_flattening_curve(
@@ -39,7 +54,7 @@ def gps_flattening_curve(
     points: int = 100,
     material: Material = None,
     hypothesis: str = "gps",
-) -> list[dict[str, float]]: ...
+) -> Table: ...
 def gps_section_at_pressure(
     rho: float, w: float, guess: tuple[float, float], material: Material = None
 ) -> dict[str, float]:
@@ -83,7 +98,9 @@ class Run:
     @property
     def summary(self) -> dict[str, Any]: ...
     @property
-    def steps(self) -> dict[str, np.ndarray]: ...
+    def steps(self) -> Table: ...
+    @property
+    def profiles(self) -> Table: ...
     @property
     def path(self) -> Path: ...
     def to_pandas(self) -> Any: ...

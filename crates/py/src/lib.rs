@@ -1,8 +1,8 @@
 //! Python bindings: `import tubemem`.
 //!
-//! The closed form (`gps_*`, `resultants`) and the 3D FE runs (`run_case`, `run_case_text`) of the
-//! Rust crates, with results as plain Python dicts and lists (the same keys as `summary.json` and
-//! the `tubemem gps` CSV columns). Materials are dicts in the case-file form, e.g.
+//! The closed form (`gps_*`, `resultants`) and the 3D FE runs (`run`, `run_case`,
+//! `run_case_text`) of the Rust crates, with results as dicts and `Table`s of numpy columns (the
+//! same keys as `summary.json` and the `tubemem gps` CSV columns). Materials are dicts in the case-file form, e.g.
 //! `{"model": "abb", "shear_modulus": 1.0, "kuhn": 30}`; `None` means that one (the paper's law).
 //!
 //! Errors: invalid input raises `ValueError` (naming the parameter and its admissible range);
@@ -182,11 +182,37 @@ fn vectorized<'py>(
         let a = numpy::PyArray1::from_vec(py, col).reshape(shape.clone())?;
         out.set_item(key, a)?;
     }
-    Ok(out.into_any())
+    let table = Table {
+        columns: keys.iter().map(|k| k.to_string()).collect(),
+        data: out.unbind(),
+        rows: values.len(),
+    };
+    Ok(Bound::new(py, table)?.into_any())
 }
 
-/// `points` free-inflation states equally spaced in λs from `stretch_from` to `stretch_to`: a list
-/// of dicts as in `gps_inflate`.
+/// A closed-form curve as a [`Table`] with the CSV header's columns.
+fn curve_table<'py, S: Send>(
+    py: Python<'py>,
+    header: &str,
+    values: impl Fn(&S) -> Vec<f64>,
+    f: impl FnOnce() -> Result<Vec<S>, GpsError> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let states = py.detach(f).map_err(gps_err)?;
+    let cols = header
+        .split(',')
+        .enumerate()
+        .map(|(j, name)| {
+            (
+                name.to_string(),
+                states.iter().map(|s| values(s)[j]).collect::<Vec<f64>>(),
+            )
+        })
+        .collect();
+    Ok(Bound::new(py, Table::from_columns(py, cols)?)?.into_any())
+}
+
+/// `points` free-inflation states equally spaced in λs from `stretch_from` to `stretch_to`: a
+/// `Table` with the columns of `gps_inflate` (numpy arrays; `.to_pandas()`).
 #[pyfunction]
 #[pyo3(signature = (stretch_to, points=100, stretch_from=1.0, material=None, hypothesis="gps"))]
 fn gps_inflation_curve<'py>(
@@ -198,7 +224,8 @@ fn gps_inflation_curve<'py>(
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
-    detached(py, || {
+    use tubemem_app::curves::{inflation_values, INFLATION_HEADER};
+    curve_table(py, INFLATION_HEADER, inflation_values, || {
         tubemem_gps::inflation_curve(law.as_ref(), hyp, stretch_from, stretch_to, points)
     })
 }
@@ -236,8 +263,8 @@ fn gps_flatten<'py>(
     )
 }
 
-/// `points` flattening states equally spaced in ρ from λs* down to `rho_to`: a list of dicts as in
-/// `gps_flatten` (the curves of the paper's Figs. 6–7).
+/// `points` flattening states equally spaced in ρ from λs* down to `rho_to`: a `Table` with the
+/// columns of `gps_flatten` (the curves of the paper's Figs. 6–7).
 #[pyfunction]
 #[pyo3(signature = (initial_stretch, rho_to, points=100, material=None, hypothesis="gps"))]
 fn gps_flattening_curve<'py>(
@@ -249,7 +276,8 @@ fn gps_flattening_curve<'py>(
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
-    detached(py, || {
+    use tubemem_app::curves::{flattening_values, FLATTENING_HEADER};
+    curve_table(py, FLATTENING_HEADER, flattening_values, || {
         tubemem_gps::flattening_curve(law.as_ref(), hyp, initial_stretch, rho_to, points)
     })
 }
@@ -368,6 +396,27 @@ fn run_parsed<'py>(
     } else {
         FolderMode::Fresh
     };
+    // progress = "tqdm": a tqdm bar over the stages (tqdm imported on demand: optional)
+    let mut progress = progress;
+    let mut bar: Option<Bound<'py, PyAny>> = None;
+    if let Some(name) = progress.and_then(|p| p.extract::<String>().ok()) {
+        if name != "tqdm" {
+            return Err(PyValueError::new_err(format!(
+                "progress = {name:?}: a callable, \"tqdm\" or None"
+            )));
+        }
+        let tqdm = py.import("tqdm.auto").map_err(|_| {
+            pyo3::exceptions::PyImportError::new_err(
+                "progress=\"tqdm\" needs the tqdm package: pip install tqdm",
+            )
+        })?;
+        let kwargs = pyo3::types::PyDict::new(py);
+        kwargs.set_item("total", case.plan().len() as f64)?;
+        kwargs.set_item("unit", "stage")?;
+        kwargs.set_item("desc", "tubemem")?;
+        bar = Some(tqdm.getattr("tqdm")?.call((), Some(&kwargs))?);
+        progress = None;
+    }
     let mut writer = RunWriter::create(out, mode, case.hash())
         .map_err(|e| PyValueError::new_err(e.chain()))?
         .checkpoint_every(case.solver.checkpoint_every)
@@ -392,8 +441,21 @@ fn run_parsed<'py>(
             let next = py.detach(move || r.recv_timeout(std::time::Duration::from_millis(50)));
             match next {
                 Ok(n) => {
-                    let reported = match progress {
-                        Some(cb) if raised.is_none() => {
+                    let reported = match (progress, &bar) {
+                        (_, Some(b)) if raised.is_none() => (|| -> PyResult<()> {
+                            b.setattr("n", (n.stage - 1) as f64 + n.fraction)?;
+                            b.call_method1(
+                                "set_postfix_str",
+                                (format!(
+                                    "stage {} step {}: w={:.5} residual {:.1e}",
+                                    n.stage, n.step, n.w, n.residual
+                                ),),
+                            )?;
+                            b.call_method0("refresh")?;
+                            Ok(())
+                        })(),
+                        (_, Some(_)) => Ok(()),
+                        (Some(cb), None) if raised.is_none() => {
                             let d = pyo3::types::PyDict::new(py);
                             let fill = || -> PyResult<()> {
                                 d.set_item("stage", n.stage)?;
@@ -408,8 +470,8 @@ fn run_parsed<'py>(
                             };
                             fill()
                         }
-                        Some(_) => Ok(()),
-                        None => logger
+                        (Some(_), None) => Ok(()),
+                        (None, None) => logger
                             .call_method1(
                                 "debug",
                                 (format!(
@@ -435,6 +497,9 @@ fn run_parsed<'py>(
         }
         run.join()
     });
+    if let Some(b) = &bar {
+        b.call_method0("close")?;
+    }
     let outcome =
         outcome.map_err(|_| TubememError::new_err("the run's thread stopped abnormally"))?;
     if let Some(e) = raised {
@@ -520,14 +585,115 @@ fn step_columns(report: &tubemem_app::report::RunReport) -> Vec<(&'static str, V
         .collect()
 }
 
-/// A finished FE run: `summary` (the dict of summary.json), `steps` (a dict of numpy arrays, one
-/// per steps.csv column, NaN where a column does not apply), `path` (the run folder) and
-/// `to_pandas()`; `vtu(k)` is the path of VTU frame k (0 the reference state; which steps have a
-/// frame follows `[output] vtu`), readable with meshio.
+/// Named numpy columns of equal shape: a closed-form curve, a vectorized closed form, the
+/// steps or profiles of a run. `t["w"]` is a column, `t.columns` their names, `len(t)` the
+/// number of rows, `t.to_pandas()` a DataFrame (columns flattened), `t.to_dict()` a plain dict.
+#[pyclass(name = "Table", module = "tubemem", mapping)]
+struct Table {
+    columns: Vec<String>,
+    data: Py<pyo3::types::PyDict>,
+    rows: usize,
+}
+
+impl Table {
+    /// A table of 1-D columns.
+    fn from_columns(py: Python<'_>, cols: Vec<(String, Vec<f64>)>) -> PyResult<Self> {
+        let data = pyo3::types::PyDict::new(py);
+        let rows = cols.first().map_or(0, |c| c.1.len());
+        let mut columns = vec![];
+        for (name, col) in cols {
+            data.set_item(&name, numpy::PyArray1::from_vec(py, col))?;
+            columns.push(name);
+        }
+        Ok(Table {
+            columns,
+            data: data.unbind(),
+            rows,
+        })
+    }
+}
+
+#[pymethods]
+impl Table {
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        self.data.bind(py).get_item(key)?.ok_or_else(|| {
+            pyo3::exceptions::PyKeyError::new_err(format!(
+                "{key:?}: the columns are {}",
+                self.columns.join(", ")
+            ))
+        })
+    }
+    /// Iterates over the column names, as a dict or a DataFrame does.
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        pyo3::types::PyList::new(py, &self.columns)?
+            .as_any()
+            .try_iter()
+            .map(|i| i.into_any())
+    }
+    fn __contains__(&self, key: &str) -> bool {
+        self.columns.iter().any(|c| c == key)
+    }
+    fn __len__(&self) -> usize {
+        self.rows
+    }
+    /// The column names, in order.
+    #[getter]
+    fn columns(&self) -> Vec<String> {
+        self.columns.clone()
+    }
+    fn keys(&self) -> Vec<String> {
+        self.columns.clone()
+    }
+    /// A dict of the numpy columns.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        self.data.bind(py).copy()
+    }
+    /// A pandas DataFrame (pandas is imported on demand; n-d columns are flattened).
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let flat = pyo3::types::PyDict::new(py);
+        for c in &self.columns {
+            flat.set_item(c, self.__getitem__(py, c)?.call_method0("ravel")?)?;
+        }
+        py.import("pandas")?.call_method1("DataFrame", (flat,))
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "<tubemem.Table {} rows × {} columns: {}>",
+            self.rows,
+            self.columns.len(),
+            self.columns.join(", ")
+        )
+    }
+}
+
+/// The per-step profiles of a run in long form: the columns of profiles/profiles.csv.
+fn profile_columns(report: &tubemem_app::report::RunReport) -> Vec<(String, Vec<f64>)> {
+    use tubemem_app::output::{ring_row, PROFILES_HEADER};
+    let mut rows: Vec<Vec<f64>> = vec![];
+    for (k, r) in report.steps().enumerate() {
+        for ring in &r.profile {
+            let mut row = vec![(k + 1) as f64, r.stage as f64, r.step as f64];
+            row.extend(ring_row(ring));
+            rows.push(row);
+        }
+    }
+    PROFILES_HEADER
+        .split(',')
+        .enumerate()
+        .map(|(j, name)| (name.to_string(), rows.iter().map(|r| r[j]).collect()))
+        .collect()
+}
+
+/// A finished FE run: `summary` (the dict of summary.json), `steps` (a `Table` of numpy arrays,
+/// one per steps.csv column, NaN where a column does not apply), `profiles` (a `Table` in long
+/// form: one row per ring and step, the columns of profiles/profiles.csv), `path` (the run
+/// folder) and `to_pandas()` (the steps); `vtu(k)` is the path of VTU frame k (0 the reference
+/// state; which steps have a frame follows `[output] vtu`), readable with meshio.
 #[pyclass(name = "Run", module = "tubemem")]
 struct Run {
     summary: Py<PyAny>,
-    steps: Py<PyAny>,
+    steps: Py<Table>,
+    profiles: Py<Table>,
     path: PathBuf,
     frames: usize,
 }
@@ -539,8 +705,12 @@ impl Run {
         self.summary.clone_ref(py)
     }
     #[getter]
-    fn steps(&self, py: Python<'_>) -> Py<PyAny> {
+    fn steps(&self, py: Python<'_>) -> Py<Table> {
         self.steps.clone_ref(py)
+    }
+    #[getter]
+    fn profiles(&self, py: Python<'_>) -> Py<Table> {
+        self.profiles.clone_ref(py)
     }
     #[getter]
     fn path(&self) -> PathBuf {
@@ -548,8 +718,7 @@ impl Run {
     }
     /// The steps as a pandas DataFrame (pandas is imported on demand).
     fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        py.import("pandas")?
-            .call_method1("DataFrame", (self.steps.clone_ref(py),))
+        self.steps.borrow(py).to_pandas(py)
     }
     /// The VTU file of frame `k` (0: the reference state; k: after the k-th converged step).
     fn vtu(&self, k: usize) -> PyResult<PathBuf> {
@@ -562,12 +731,7 @@ impl Run {
         Ok(self.path.join("vtu").join(format!("step_{k:05}.vtu")))
     }
     fn __repr__(&self, py: Python<'_>) -> String {
-        let n = self
-            .steps
-            .bind(py)
-            .get_item("step")
-            .and_then(|a| a.len())
-            .unwrap_or(0);
+        let n = self.steps.borrow(py).rows;
         format!("<tubemem.Run {} ({n} steps)>", self.path.display())
     }
 }
@@ -697,13 +861,14 @@ fn run<'py>(
 ) -> PyResult<Run> {
     let (parsed, label) = case_from(py, case, base_dir)?;
     let (report, frames) = run_parsed(py, &parsed, &label, &out, overwrite, progress)?;
-    let steps = pyo3::types::PyDict::new(py);
-    for (name, col) in step_columns(&report) {
-        steps.set_item(name, numpy::PyArray1::from_vec(py, col))?;
-    }
+    let steps = step_columns(&report)
+        .into_iter()
+        .map(|(name, col)| (name.to_string(), col))
+        .collect();
     Ok(Run {
         summary: to_py(py, &report.summary())?.unbind(),
-        steps: steps.into_any().unbind(),
+        steps: Py::new(py, Table::from_columns(py, steps)?)?,
+        profiles: Py::new(py, Table::from_columns(py, profile_columns(&report))?)?,
         path: out,
         frames,
     })
@@ -874,10 +1039,12 @@ fn case_text(py: Python<'_>, case: &Bound<'_, PyAny>) -> PyResult<String> {
 /// rho = r/R, chi = c/(πR) (eq. 72), force = ϖχ (eq. 80). Materials are dicts in the case-file
 /// form ({"model": "abb", "shear_modulus": 1.0, "kuhn": 30}); None is the paper's law.
 ///
-/// Closed form: gps_inflate, gps_flatten (numbers or numpy arrays), gps_inflation_curve,
-/// gps_flattening_curve, gps_section_at_pressure, gps_limits, resultants.
-/// FE runs: run (a case as path, TOML text or dict → Run with numpy arrays), run_case,
-/// run_case_text (→ the summary dict), default_case.
+/// Closed form: gps_inflate, gps_flatten (numbers → dict; numpy arrays → Table),
+/// gps_inflation_curve, gps_flattening_curve (→ Table), gps_section_at_pressure, gps_limits,
+/// resultants. A Table is named numpy columns: t["w"], t.columns, t.to_pandas().
+/// FE runs: run (a case as path, TOML text or dict → Run: steps and profiles as Tables),
+/// run_case, run_case_text (→ the summary dict), default_case; progress= a callable, "tqdm" or
+/// None (the `tubemem` logger at DEBUG level, silent by default).
 ///
 /// Errors: ValueError for bad input (a parameter out of range, a stretch beyond the law's
 /// locking limit, a malformed case naming its key); TubememError (a RuntimeError) for a solve or
@@ -888,6 +1055,7 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("TubememError", m.py().get_type::<TubememError>())?;
     m.add_function(wrap_pyfunction!(gps_inflate, m)?)?;
+    m.add_class::<Table>()?;
     m.add_function(wrap_pyfunction!(gps_inflation_curve, m)?)?;
     m.add_function(wrap_pyfunction!(gps_flatten, m)?)?;
     m.add_function(wrap_pyfunction!(gps_flattening_curve, m)?)?;

@@ -71,7 +71,7 @@ def test_limit_points_match_the_scipy_closed_form():
 def test_flattening_matches_the_scipy_closed_form_and_the_local_section():
     ref = cf.gps_flattening(1.3, [1.0, 0.8], 30.0)
     curve = tubemem.gps_flattening_curve(1.3, 0.8, points=3)
-    assert [round(s["rho"], 12) for s in curve] == [1.3, 1.05, 0.8]
+    assert [round(r, 12) for r in curve["rho"]] == [1.3, 1.05, 0.8]
     for rho, r in zip([1.0, 0.8], ref):
         s = tubemem.gps_flatten(1.3, rho)
         for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
@@ -81,7 +81,7 @@ def test_flattening_matches_the_scipy_closed_form_and_the_local_section():
         loc = tubemem.gps_section_at_pressure(rho, s["w"], (s["lambda_s"], s["lambda_z"]))
         assert rel(loc["chi"], s["chi"]) < TOL
     # PS is stiffer than GPS in the squeeze (paper Figs. 6-7)
-    assert tubemem.gps_flatten(1.3, 0.8, hypothesis="ps")["force"] > curve[-1]["force"]
+    assert tubemem.gps_flatten(1.3, 0.8, hypothesis="ps")["force"] > curve["force"][-1]
 
 
 def test_resultants_are_eq_58_and_take_any_material():
@@ -251,6 +251,12 @@ def test_the_closed_form_takes_arrays_and_agrees_with_the_scalar_calls():
     for i, r in enumerate(rho):
         s = tubemem.gps_flatten(1.3, float(r), hypothesis="ps")
         assert all(f[k][i] == s[k] for k in s)
+    assert isinstance(v, tubemem.Table) and len(v) == 4 and "w" in v
+    df = f.to_pandas()
+    assert list(df.columns) == list(f) and len(df) == len(rho)
+    np.testing.assert_array_equal(df["force"].to_numpy(), f["force"])
+    with pytest.raises(KeyError, match="the columns are w, lambda_s"):
+        v["pressure"]
     with pytest.raises(ValueError, match=r"stretch\[1\] = 0.5"):
         tubemem.gps_inflate(np.array([1.2, 0.5]))
     with pytest.raises(ValueError, match="a number or an array"):
@@ -284,6 +290,19 @@ def test_run_returns_arrays_equal_to_steps_csv_and_takes_cases_as_dicts(tmp_path
     df = a.to_pandas()
     assert list(df.columns) == list(a.steps) and len(df) == len(rows)
     np.testing.assert_array_equal(df["lambda_s"].to_numpy(), a.steps["lambda_s"])
+    # the profiles: long form, every step's rings, equal to profiles/profiles.csv
+    prof = list(csv.DictReader(open(tmp_path / "dict" / "profiles" / "profiles.csv")))
+    assert list(a.profiles) == list(prof[0]) and len(a.profiles) == len(prof)
+    for k in prof[0]:
+        np.testing.assert_array_equal(a.profiles[k], np.array([float(r[k]) for r in prof]))
+    pdf = a.profiles.to_pandas()
+    assert set(pdf["row"]) == set(range(1, len(rows) + 1))
+    # the mid-span ring of every step is that step's mid-span state; squeezed, it touches
+    mid = pdf[pdf["z_ref"] == 0.0].set_index("row")
+    np.testing.assert_array_equal(mid["lambda_s"].to_numpy(), a.steps["lambda_s"])
+    sq = a.steps["rho"] == a.steps["rho"]  # squeeze rows (rho is NaN for inflation)
+    np.testing.assert_array_equal(mid["contact_width"].to_numpy()[sq], a.steps["chi_geometric"][sq])
+    assert (mid["contact_width"].to_numpy()[sq] > 0).all() and (mid["contact_width"].to_numpy()[~sq] == 0).all()
     # a bad dict names its key
     bad = dict(as_dict, material={"model": "abb", "shear_modulus": 1.0, "kuhm": 3})
     with pytest.raises(ValueError, match="kuhm"):
@@ -353,3 +372,33 @@ def test_sweep_on_a_dask_local_cluster_equals_the_local_one(tmp_path):
     cols = [c for c in local.columns if c not in ("error",)]
     assert df[cols].equals(local[cols])
     assert (df["error"].isna() == local["error"].isna()).all()
+
+
+def test_curves_are_tables_of_arrays():
+    import numpy as np
+
+    c = tubemem.gps_inflation_curve(2.0, points=11)
+    assert c.columns == ["w", "lambda_s", "lambda_z", "n_s", "n_z"] and len(c) == 11
+    np.testing.assert_allclose(c["lambda_s"], np.linspace(1.0, 2.0, 11), rtol=0, atol=1e-15)
+    # each row is the scalar closed form at that stretch (the curve continues from the previous
+    # state, the scalar call starts afresh: both converge to rounding, 1e-12)
+    for i in [3, 10]:
+        s = tubemem.gps_inflate(float(c["lambda_s"][i]))
+        assert abs(c["w"][i] / s["w"] - 1) < 1e-12
+    assert list(c.to_pandas().columns) == c.columns
+    assert "11 rows" in repr(c)
+
+
+def test_progress_with_tqdm_or_a_clear_import_error(tmp_path, monkeypatch, capsys):
+    """progress="tqdm" draws a tqdm bar over the stages (on stderr); without tqdm installed it
+    is an ImportError that says how to get it, before anything runs."""
+    pytest.importorskip("tqdm")
+    tubemem.run(SMALL_CASE, str(tmp_path / "bar"), progress="tqdm")
+    err = capsys.readouterr().err
+    assert "tubemem" in err and "100%" in err and "2.0/2.0" in err and "stage 2 step 4" in err
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    with pytest.raises(ImportError, match="pip install tqdm"):
+        tubemem.run(SMALL_CASE, str(tmp_path / "nobar"), progress="tqdm")
+    assert not (tmp_path / "nobar" / "steps.csv").exists()
+    with pytest.raises(ValueError, match="a callable"):
+        tubemem.run(SMALL_CASE, str(tmp_path / "nobar2"), progress="bar")
