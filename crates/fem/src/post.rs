@@ -97,15 +97,62 @@ pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, 
                 .any(|i| on_ring.contains(i))
         })
         .collect();
-    ring_state_of(model, state, ring, &touching)
+    let projected = touching
+        .iter()
+        .map(|&e| projected_resultants(model, state, e))
+        .collect::<Result<Vec<_>, _>>()?;
+    ring_state_of(
+        model,
+        state,
+        ring,
+        &touching,
+        |k, _| projected[k],
+        model.total_volume(&state.x),
+    )
 }
 
-/// [`ring_state`] given the elements that touch the ring (in ascending order).
+/// (t·Nt, a·Na, t·Na) at the four Gauss points of element `e`: the resultants projected on the
+/// current hoop tangent t (image of the reference hoop direction, made horizontal) and the axial
+/// direction a in the tangent plane. They do not depend on the ring, so a profile computes them
+/// once per element.
+fn projected_resultants(model: &Model, state: &State, e: usize) -> Result<[[f64; 3]; 4], FemError> {
+    let el = &model.elements()[e];
+    let xe = el.gather(&state.x);
+    let x0 = el.gather(&model.mesh().nodes);
+    let mut out = [[0.0; 3]; 4];
+    for (g, o) in out.iter_mut().enumerate() {
+        let ps = point_state(model.law(), el, g, &xe).map_err(|source| FemError::Material {
+            element: e,
+            gauss_point: g,
+            source,
+        })?;
+        // reference hoop direction at the Gauss point and its image F T
+        let xr = el.position(g, &x0);
+        let t_ref = Vec3::new(-xr[1], xr[0], 0.0).normalize();
+        let f = el.gradient(g, &xe);
+        let ft = el.push_forward(g, &f, &t_ref);
+        let t = Vec3::new(ft[0], ft[1], 0.0).normalize();
+        let normal = f[0].cross(&f[1]).normalize();
+        let ez = Vec3::z();
+        let a = (ez - normal * ez.dot(&normal)).normalize();
+        *o = [
+            t.dot(&(ps.cauchy * t)),
+            a.dot(&(ps.cauchy * a)),
+            t.dot(&(ps.cauchy * a)),
+        ];
+    }
+    Ok(out)
+}
+
+/// [`ring_state`] given the elements that touch the ring (in ascending order), their projected
+/// resultants (`projected(k, e)` for the k-th of them, element e) and the enclosed volume.
 fn ring_state_of(
     model: &Model,
     state: &State,
     ring: &Ring,
     touching: &[usize],
+    projected: impl Fn(usize, usize) -> [[f64; 3]; 4],
+    volume: f64,
 ) -> Result<MidSpan, FemError> {
     let mesh = model.mesh();
     let mut cur = 0.0;
@@ -118,37 +165,22 @@ fn ring_state_of(
     let mut lz_sum = 0.0;
     let mut lz_n = 0usize;
     let (mut ns, mut nz, mut nsz, mut ng) = (0.0, 0.0, 0.0, 0usize);
-    for &e in touching {
+    for (k, &e) in touching.iter().enumerate() {
         let el = &model.elements()[e];
         let q = el.nodes;
-        for k in 0..4 {
-            let (a, b) = (q[k], q[(k + 1) % 4]);
+        for j in 0..4 {
+            let (a, b) = (q[j], q[(j + 1) % 4]);
             if on_ring.contains(&a) != on_ring.contains(&b) {
                 // meridian edge: each is shared by two elements, so each is counted twice
                 lz_sum += dist(state.x[a], state.x[b]) / dist(mesh.nodes[a], mesh.nodes[b]);
                 lz_n += 1;
             }
         }
-        let xe = el.gather(&state.x);
-        let x0 = el.gather(&mesh.nodes);
-        for g in 0..4 {
-            let ps = point_state(model.law(), el, g, &xe).map_err(|source| FemError::Material {
-                element: e,
-                gauss_point: g,
-                source,
-            })?;
-            // reference hoop direction at the Gauss point and its image F T
-            let xr = el.position(g, &x0);
-            let t_ref = Vec3::new(-xr[1], xr[0], 0.0).normalize();
-            let f = el.gradient(g, &xe);
-            let ft = el.push_forward(g, &f, &t_ref);
-            let t = Vec3::new(ft[0], ft[1], 0.0).normalize();
-            let normal = f[0].cross(&f[1]).normalize();
-            let ez = Vec3::z();
-            let a = (ez - normal * ez.dot(&normal)).normalize();
-            ns += t.dot(&(ps.cauchy * t));
-            nz += a.dot(&(ps.cauchy * a));
-            nsz += t.dot(&(ps.cauchy * a));
+        // summed Gauss point by Gauss point, in element order (as before the split)
+        for [s, z, sz] in projected(k, e) {
+            ns += s;
+            nz += z;
+            nsz += sz;
             ng += 1;
         }
     }
@@ -160,7 +192,7 @@ fn ring_state_of(
         n_s: ns / ng,
         n_z: nz / ng,
         n_sz: nsz / ng,
-        volume: model.total_volume(&state.x),
+        volume,
     })
 }
 
@@ -306,6 +338,16 @@ pub fn ring_profile(
     }
     let half_gap = contact.and_then(Contact::half_gap);
     let closed = mesh.symmetry.rings_closed();
+    // every element's projected resultants once (in parallel; collected in element order, so
+    // the result does not depend on the thread count), and the volume once
+    let projected = {
+        use rayon::prelude::*;
+        (0..model.elements().len())
+            .into_par_iter()
+            .map(|e| projected_resultants(model, state, e))
+            .collect::<Result<Vec<_>, _>>()?
+    };
+    let volume = model.total_volume(&state.x);
     heights
         .iter()
         .zip(nodes)
@@ -329,7 +371,7 @@ pub fn ring_profile(
                     .map(|&i| state.x[i][0].hypot(state.x[i][1]))
                     .sum::<f64>()
                     / n,
-                values: ring_state_of(model, state, &ring, touching)?,
+                values: ring_state_of(model, state, &ring, touching, |_, e| projected[e], volume)?,
                 contact_width: half_gap.map_or(0.0, |h| contact_width(model, state, &ring, h)),
             })
         })
