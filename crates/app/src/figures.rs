@@ -263,8 +263,25 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
         };
         let (x0, x1) = range(all().map(|p| p.0), false);
         let (y0, y1) = range(all().map(|p| p.1), true);
+        // the notes go under the title, above the plot, where no curve can be under them
+        let (w, _) = top.dim_in_pixel();
+        for (k, note) in fig.notes.iter().enumerate() {
+            top.draw(&Text::new(
+                note.clone(),
+                (w as i32 / 2, 2 + 20 * k as i32),
+                ("sans-serif", 15)
+                    .into_font()
+                    .color(&RGBColor(60, 60, 60))
+                    .pos(plotters::style::text_anchor::Pos::new(
+                        plotters::style::text_anchor::HPos::Center,
+                        plotters::style::text_anchor::VPos::Top,
+                    )),
+            ))
+            .map_err(|e| err(e.to_string()))?;
+        }
         let mut chart = ChartBuilder::on(&top)
             .margin(14)
+            .margin_top(14 + 20 * fig.notes.len() as u32)
             .x_label_area_size(if bottom.is_some() { 30 } else { 58 })
             .y_label_area_size(86)
             .build_cartesian_2d(x0..x1, y0..y1)
@@ -293,20 +310,6 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
             .border_style(BLACK)
             .draw()
             .map_err(|e| err(e.to_string()))?;
-        let (w, h) = top.dim_in_pixel();
-        for (k, note) in fig.notes.iter().rev().enumerate() {
-            top.draw(&Text::new(
-                note.clone(),
-                (w as i32 - 24, h as i32 - 80 - 22 * k as i32),
-                ("sans-serif", 16).into_font().color(&BLACK).pos(
-                    plotters::style::text_anchor::Pos::new(
-                        plotters::style::text_anchor::HPos::Right,
-                        plotters::style::text_anchor::VPos::Bottom,
-                    ),
-                ),
-            ))
-            .map_err(|e| err(e.to_string()))?;
-        }
         if let (Some(panel), Some(bottom)) = (&fig.panel, bottom) {
             let pts = || {
                 panel
@@ -330,7 +333,10 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
                 .axis_desc_style(("sans-serif", 19))
                 .label_style(("sans-serif", 15))
                 .y_label_formatter(&|v| {
-                    if *v == 0.0 || v.abs() >= 1e-2 {
+                    // a tick at rounding distance from zero is zero
+                    if v.abs() <= 1e-9 * py0.abs().max(py1.abs()) {
+                        "0".to_string()
+                    } else if v.abs() >= 1e-2 {
                         format!("{v:.3}")
                     } else {
                         format!("{v:.1e}")
@@ -754,7 +760,7 @@ pub fn write_all(
     for ((ls0, stroke), per) in starts.iter().zip(&flattening) {
         for ((h, color), c) in hyps.iter().zip(per) {
             series.push(Series {
-                label: format!("{} flattening from λs* = {ls0}", h.label()),
+                label: format!("{} flattening from λs* = {ls0:.1}", h.label()),
                 points: c.iter().map(|s| (s.lambda_s, s.w)).collect(),
                 color: *color,
                 stroke: *stroke,
@@ -842,7 +848,7 @@ pub fn write_all(
                 // draw the GPS curve from the run's own λs* (the error panel's reference)
                 label = format!("{label} (λs* = {run_ls0:.4})");
                 notes.push(format!(
-                    "{}: the run's λs* = {run_ls0:.4} differs from the curves' {ls0}; thin line: GPS from {run_ls0:.4}",
+                    "{}: the run's λs* = {run_ls0:.4} differs from the curves' {ls0:.1}; thin dashed line: GPS from {run_ls0:.4}",
                     run.label
                 ));
                 if let Ok(c) = flattening_curve(law, Hypothesis::Gps, run_ls0, 0.5 * run_ls0, 201) {
@@ -881,7 +887,7 @@ pub fn write_all(
         });
         written.extend(save(
             &Figure {
-                title: format!("Fig. {num} — flattening from λs* = {ls0} ({name})"),
+                title: format!("Fig. {num} — flattening from λs* = {ls0:.1} ({name})"),
                 x_label: "reduced displacement λs* − ρ".into(),
                 y_label: "reduced force ϖχ = pc/(πμH)".into(),
                 series,
@@ -907,7 +913,7 @@ pub fn write_all(
     }];
     for ((ls0, stroke), per) in starts.iter().zip(&flattening) {
         series.push(Series {
-            label: format!("GPS flattening from λs* = {ls0}"),
+            label: format!("GPS flattening from λs* = {ls0:.1}"),
             points: per[0].iter().map(|s| (s.lambda_s, s.lambda_z)).collect(),
             color: RGBColor(20, 150, 90),
             stroke: *stroke,
