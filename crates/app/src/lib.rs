@@ -26,6 +26,7 @@ pub mod main_job;
 pub mod output;
 pub mod report;
 pub mod run;
+pub mod verify;
 
 use std::path::PathBuf;
 use thiserror::Error;

@@ -78,7 +78,8 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
     v
 }
 
-fn format_row(r: &StepRecord) -> String {
+/// One steps.csv line of a step (integers as integers, empty fields for what it lacks).
+pub fn format_row(r: &StepRecord) -> String {
     let fields: Vec<String> = step_row(r)
         .into_iter()
         .enumerate()

@@ -5,6 +5,7 @@
 pub mod console;
 pub mod gps_cmd;
 pub mod material_args;
+pub mod verify_cmd;
 
 /// Write one line to standard output. A closed or full standard output (`> /dev/full`, a pipe
 /// whose reader has gone) is an error that the caller reports, never a panic.

@@ -58,6 +58,10 @@ enum Command {
         #[arg(long)]
         log: Option<PathBuf>,
     },
+    /// Run verification checks (suite files, or the study of one case) and write results.json,
+    /// report.md, report.html and junit.xml. Exit code 0: all passed; 1: a check failed; 2: a
+    /// usage or setup error.
+    Verify(tubemem_cli::verify_cmd::VerifyArgs),
     /// Write SVG/PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure,
     /// for any law, with FE runs overlaid (their points also as CSV, and an FE − GPS panel under
     /// Figs. 6–7).
@@ -197,6 +201,7 @@ fn run_case(
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => main_job(),
+        Some(Command::Verify(_)) => anyhow::bail!("internal: `verify` is dispatched in main"),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Run {
             case,
@@ -236,6 +241,9 @@ fn run(cli: Cli) -> Result<()> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(Command::Verify(a)) = cli.command {
+        return ExitCode::from(tubemem_cli::verify_cmd::run(a));
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e)

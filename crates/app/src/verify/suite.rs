@@ -1,0 +1,356 @@
+//! The suite file: `[[check]]` tables, each with a case, a kind and sourced tolerances.
+//!
+//! ```toml
+//! [suite]
+//! name = "ci"
+//!
+//! [[check]]
+//! name = "inflate-1.3"
+//! case = "../cases/inflate_abb30_ls1.3.toml"   # relative to this file, or an inline table
+//! kind = "closed-form"
+//! tolerance.w = { value = 1.5e-3, source = "64-gon factor 1/cos(π/64) − 1 = 1.2e-3" }
+//! ```
+
+use super::stats::EndLaw;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A tolerance and where its number comes from.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tol {
+    pub value: f64,
+    /// a paper equation, a measured refinement study or a fitted law
+    pub source: String,
+}
+
+/// An expected value with its admissible distance and source (e.g. an observed order).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expect {
+    pub value: f64,
+    pub within: f64,
+    pub source: String,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum CheckKind {
+    ClosedForm,
+    Reference,
+    Convergence,
+    EndEffect,
+    Invariance,
+    Gold,
+}
+
+impl CheckKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            CheckKind::ClosedForm => "closed-form",
+            CheckKind::Reference => "reference",
+            CheckKind::Convergence => "convergence",
+            CheckKind::EndEffect => "end-effect",
+            CheckKind::Invariance => "invariance",
+            CheckKind::Gold => "gold",
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum CaseRef {
+    Path(String),
+    Inline(toml::Table),
+}
+
+/// One `[[check]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckSpec {
+    pub name: String,
+    pub case: CaseRef,
+    pub kind: CheckKind,
+    /// per-quantity tolerances (closed-form, reference, convergence: the distance of the
+    /// reference from the extrapolated value when it exceeds the GCI)
+    #[serde(default)]
+    pub tolerance: BTreeMap<String, Tol>,
+    // convergence
+    /// the mesh refinement ratio between members (around and along are multiplied by it)
+    pub refinement: Option<f64>,
+    /// number of meshes (at least 3)
+    pub meshes: Option<usize>,
+    /// the exponent of the first member's refinement relative to the case's mesh (e.g. −1:
+    /// one step coarser than the case); default 0
+    pub start: Option<i32>,
+    /// the quantities studied (default w, lambda_z; and force for a squeeze)
+    pub quantities: Option<Vec<String>>,
+    pub expected_order: Option<Expect>,
+    // end-effect
+    /// tube lengths L/R of the family
+    pub lengths: Option<Vec<f64>>,
+    pub law: Option<EndLaw>,
+    /// the quantity whose error against GPS is fitted (default w)
+    pub quantity: Option<String>,
+    /// end-effect and invariance tolerance ε (default 1e-3)
+    pub epsilon: Option<f64>,
+    pub decay_rate: Option<Expect>,
+    pub amplitude: Option<Expect>,
+    pub max_residual: Option<Tol>,
+    // invariance
+    pub min_core_fraction: Option<Tol>,
+    // gold
+    /// the gold folder, relative to the suite file (default gold/<name>)
+    pub gold: Option<String>,
+    pub rel_err: Option<f64>,
+    pub abs_zero: Option<f64>,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuiteMeta {
+    pub name: Option<String>,
+    pub description: Option<String>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuiteFile {
+    #[serde(default)]
+    pub suite: SuiteMeta,
+    #[serde(rename = "check", default)]
+    pub checks: Vec<CheckSpec>,
+}
+
+/// A check ready to run: its spec, its case text and the folder its paths are relative to.
+#[derive(Clone, Debug)]
+pub struct Check {
+    pub spec: CheckSpec,
+    pub suite: String,
+    pub case_text: String,
+    pub base_dir: PathBuf,
+    /// where gold files live
+    pub gold_dir: PathBuf,
+}
+
+/// A suite that cannot be used (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", path.display())]
+pub struct SuiteError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// The quantities a closed-form check can hold to a tolerance.
+pub const CLOSED_FORM_QUANTITIES: &[&str] = &[
+    "w",
+    "lambda_s",
+    "lambda_z",
+    "n_s",
+    "n_z",
+    "chi",
+    "force",
+    "local_lambda_s",
+    "local_lambda_z",
+    "local_chi",
+    "local_force",
+];
+/// The quantities of a reference check (FE against scikit-fem).
+pub const REFERENCE_QUANTITIES: &[&str] = &["profile", "w", "lambda_s", "lambda_z", "chi", "force"];
+/// Final mid-span quantities of a run (convergence, end-effect).
+pub const FINAL_QUANTITIES: &[&str] = &["w", "lambda_s", "lambda_z", "n_s", "n_z", "chi", "force"];
+
+fn tol_ok(path: &Path, name: &str, key: &str, t: &Tol) -> Result<(), SuiteError> {
+    if !(t.value.is_finite() && t.value >= 0.0) {
+        return Err(SuiteError {
+            path: path.to_path_buf(),
+            message: format!(
+                "check `{name}`: tolerance `{key}` = {} must be finite and ≥ 0",
+                t.value
+            ),
+        });
+    }
+    if t.source.trim().is_empty() {
+        return Err(SuiteError {
+            path: path.to_path_buf(),
+            message: format!(
+                "check `{name}`: tolerance `{key}` has no `source`: say where the number comes from (an equation, a refinement study, a fitted law)"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Validate a check's fields for its kind.
+pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
+    let err = |message: String| SuiteError {
+        path: path.to_path_buf(),
+        message: format!("check `{}`: {message}", c.name),
+    };
+    if c.name.trim().is_empty()
+        || !c
+            .name
+            .chars()
+            .all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch))
+    {
+        return Err(err(
+            "`name` must be non-empty ASCII letters, digits, '-', '_' or '.' (it names a folder)"
+                .into(),
+        ));
+    }
+    for (k, t) in &c.tolerance {
+        tol_ok(path, &c.name, k, t)?;
+    }
+    for (k, t) in [
+        ("max_residual", &c.max_residual),
+        ("min_core_fraction", &c.min_core_fraction),
+    ] {
+        if let Some(t) = t {
+            tol_ok(path, &c.name, k, t)?;
+        }
+    }
+    for (k, e) in [
+        ("expected_order", &c.expected_order),
+        ("decay_rate", &c.decay_rate),
+        ("amplitude", &c.amplitude),
+    ] {
+        if let Some(e) = e {
+            tol_ok(
+                path,
+                &c.name,
+                k,
+                &Tol {
+                    value: e.within,
+                    source: e.source.clone(),
+                },
+            )?;
+        }
+    }
+    let known = |list: &[&str], keys: &mut dyn Iterator<Item = &String>| {
+        for k in keys {
+            if !list.contains(&k.as_str()) {
+                return Err(err(format!(
+                    "unknown quantity `{k}` for a {} check (known: {})",
+                    c.kind.label(),
+                    list.join(", ")
+                )));
+            }
+        }
+        Ok(())
+    };
+    match c.kind {
+        CheckKind::ClosedForm => {
+            known(CLOSED_FORM_QUANTITIES, &mut c.tolerance.keys())?;
+            if c.tolerance.is_empty() {
+                return Err(err(
+                    "a closed-form check needs at least one `tolerance.<quantity>`".into(),
+                ));
+            }
+        }
+        CheckKind::Reference => known(REFERENCE_QUANTITIES, &mut c.tolerance.keys())?,
+        CheckKind::Convergence => {
+            known(FINAL_QUANTITIES, &mut c.tolerance.keys())?;
+            if let Some(q) = &c.quantities {
+                known(FINAL_QUANTITIES, &mut q.iter())?;
+            }
+            let r = c.refinement.unwrap_or(2.0);
+            if !(r.is_finite() && r > 1.0 && r <= 4.0) {
+                return Err(err(format!("`refinement` = {r} must be in (1, 4]")));
+            }
+            if c.meshes.unwrap_or(3) < 3 {
+                return Err(err("`meshes` must be at least 3".into()));
+            }
+        }
+        CheckKind::EndEffect => {
+            let l = c.lengths.as_deref().unwrap_or(&[]);
+            if l.len() < 3 || l.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+                return Err(err(
+                    "an end-effect check needs `lengths` = at least three L/R > 0".into(),
+                ));
+            }
+            if c.law.is_none() {
+                return Err(err(
+                    "an end-effect check needs `law` = \"exponential\" (open inflation) or \"inverse\" (gas-closed squeeze)"
+                        .into(),
+                ));
+            }
+            if let Some(q) = &c.quantity {
+                known(FINAL_QUANTITIES, &mut std::iter::once(q))?;
+            }
+        }
+        CheckKind::Invariance => {
+            if c.min_core_fraction.is_none() {
+                return Err(err("an invariance check needs `min_core_fraction`".into()));
+            }
+        }
+        CheckKind::Gold => {}
+    }
+    if let Some(e) = c.epsilon {
+        if !(e.is_finite() && e > 0.0) {
+            return Err(err(format!("`epsilon` = {e} must be > 0")));
+        }
+    }
+    Ok(())
+}
+
+/// Read a suite file into checks (each case read, relative to the suite's folder).
+pub fn read_suite(path: &Path) -> Result<(String, Vec<Check>), SuiteError> {
+    let err = |message: String| SuiteError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| err(format!("cannot read it: {e}")))?;
+    let file: SuiteFile = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let suite = file.suite.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default()
+    });
+    if file.checks.is_empty() {
+        return Err(err("no [[check]] in the suite".into()));
+    }
+    let mut out = vec![];
+    let mut names = std::collections::HashSet::new();
+    for spec in file.checks {
+        validate(path, &spec)?;
+        if !names.insert(spec.name.clone()) {
+            return Err(err(format!("two checks are named `{}`", spec.name)));
+        }
+        let (case_text, base_dir) = match &spec.case {
+            CaseRef::Path(p) => {
+                let cp = dir.join(p);
+                let t = std::fs::read_to_string(&cp).map_err(|e| {
+                    err(format!("check `{}`: case {}: {e}", spec.name, cp.display()))
+                })?;
+                (t, cp.parent().map(Path::to_path_buf).unwrap_or_default())
+            }
+            CaseRef::Inline(t) => (
+                toml::to_string(t).map_err(|e| err(e.to_string()))?,
+                dir.clone(),
+            ),
+        };
+        // the case must be valid before anything runs
+        crate::case::Case::parse(&case_text).map_err(|e| {
+            err(format!(
+                "check `{}`: its case: {}",
+                spec.name,
+                crate::error_chain(&e)
+            ))
+        })?;
+        let gold_dir = dir.join(
+            spec.gold
+                .clone()
+                .unwrap_or_else(|| format!("gold/{}", spec.name)),
+        );
+        out.push(Check {
+            spec,
+            suite: suite.clone(),
+            case_text,
+            base_dir,
+            gold_dir,
+        });
+    }
+    Ok((suite, out))
+}

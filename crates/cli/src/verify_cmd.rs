@@ -1,0 +1,140 @@
+//! `tubemem verify`: runs suites of checks (or the study of one case) and writes results.json,
+//! report.md, report.html and junit.xml. Exit codes: 0 every check passed (or was skipped with
+//! its reason), 1 a check failed or could not run, 2 a usage or setup error (a bad suite file,
+//! a case that does not parse, an output folder that cannot be written).
+
+use std::io::Write;
+use std::path::PathBuf;
+use tubemem_app::verify::{self, report::Results, Event, VerifyOptions};
+
+#[derive(clap::Args, Debug)]
+pub struct VerifyArgs {
+    /// Suite files (TOML; see the README's "tubemem verify" section).
+    pub suites: Vec<PathBuf>,
+    /// Instead of suites: the study of this case (closed form, three-mesh convergence with GCI,
+    /// end effect at L/2, L, 2L, invariance core, references).
+    #[arg(long, conflicts_with = "suites")]
+    pub case: Option<PathBuf>,
+    /// With --case: a cheaper family (the meshes coarser than the case's, lengths up to L).
+    #[arg(long, requires = "case")]
+    pub quick: bool,
+    /// Output folder: a folder per check, results.json, report.md, report.html, junit.xml.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Checks run at once (default: the number of cores).
+    #[arg(long, default_value_t = 0)]
+    pub jobs: usize,
+    /// Run only the checks whose name contains this text.
+    #[arg(long)]
+    pub filter: Option<String>,
+    /// Rewrite the gold files of `gold` checks from this run (on request only).
+    #[arg(long)]
+    pub update_gold: bool,
+    /// The Python interpreter with the scikit-fem references (default: $TUBEMEM_PYTHON, else
+    /// the .venv next to python_ref/, else python3).
+    #[arg(long)]
+    pub python: Option<PathBuf>,
+}
+
+/// Exit code 2: the verification could not be set up.
+fn setup(message: impl std::fmt::Display) -> u8 {
+    let _ = writeln!(std::io::stderr(), "error: {message}");
+    2
+}
+
+pub fn run(a: VerifyArgs) -> u8 {
+    let opts = VerifyOptions {
+        jobs: a.jobs,
+        filter: a.filter.clone(),
+        update_gold: a.update_gold,
+        python: a.python.clone(),
+        python_ref: None,
+    };
+    let progress = |e: Event| {
+        let mut err = std::io::stderr().lock();
+        let _ = match e {
+            Event::Started { .. } => Ok(()),
+            Event::Finished {
+                done,
+                total,
+                result: r,
+            } => writeln!(
+                err,
+                "[{done}/{total}] {:<7} {:<12} {} ({:.1} s): {}",
+                r.status.label(),
+                r.kind.label(),
+                r.name,
+                r.seconds,
+                r.message
+            ),
+        };
+    };
+    if let Err(e) = std::fs::create_dir_all(&a.out) {
+        return setup(format!("--out {}: {e}", a.out.display()));
+    }
+    let t0 = std::time::Instant::now();
+    let (names, results, verdict) = if let Some(case) = &a.case {
+        let _ = writeln!(
+            std::io::stderr(),
+            "study of {}: convergence, end effect, invariance, reference, then the closed form",
+            case.display()
+        );
+        match verify::study::run_study(case, &a.out, a.quick, &opts, &progress) {
+            Ok(s) => (
+                vec![format!("study of {}", case.display())],
+                s.results,
+                Some(s.verdict),
+            ),
+            Err(e) => return setup(e),
+        }
+    } else {
+        if a.suites.is_empty() {
+            return setup("give suite files (e.g. verify/ci.toml) or --case CASE.toml");
+        }
+        let mut checks = vec![];
+        let mut names = vec![];
+        for s in &a.suites {
+            match verify::suite::read_suite(s) {
+                Ok((name, c)) => {
+                    names.push(name);
+                    checks.extend(c);
+                }
+                Err(e) => return setup(e),
+            }
+        }
+        let n = checks
+            .iter()
+            .filter(|c| {
+                opts.filter
+                    .as_deref()
+                    .is_none_or(|f| c.spec.name.contains(f))
+            })
+            .count();
+        if n == 0 {
+            return setup(format!(
+                "no check matches --filter {:?}",
+                opts.filter.as_deref().unwrap_or("")
+            ));
+        }
+        let _ = writeln!(std::io::stderr(), "{n} checks from {}", names.join(", "));
+        match verify::run_checks(&checks, &a.out, &opts, &progress) {
+            Ok(r) => (names, r, None),
+            Err(e) => return setup(e.chain()),
+        }
+    };
+    let results = Results::new(names, t0.elapsed().as_secs_f64(), &results, verdict);
+    let written = match verify::report::write_all(&a.out, &results) {
+        Ok(w) => w,
+        Err(e) => return setup(e.chain()),
+    };
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{}", results.verdict);
+    for p in written {
+        let _ = writeln!(out, "wrote {}", p.display());
+    }
+    if results.ok() {
+        0
+    } else {
+        1
+    }
+}
