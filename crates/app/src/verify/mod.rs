@@ -431,11 +431,52 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let law = report.material_spec.build().map_err(|e| e.to_string())?;
     let steps: Vec<&StepRecord> = report.steps().collect();
     let mut series = vec![];
+    // the Maxwell plateau: the steps whose mid-span sits in the propagating bulge
+    let maxwell = if c.spec.tolerance.keys().any(|q| q.starts_with("maxwell_")) {
+        let m = tubemem_gps::limits::limit_points(law.as_ref(), Hypothesis::Gps)
+            .map_err(|e| e.to_string())?
+            .maxwell
+            .ok_or("the law has no Maxwell pressure (no pressure minimum)")?;
+        let around: toml::Table = toml::from_str(&c.case_text).map_err(|e| e.to_string())?;
+        let n = around
+            .get("mesh")
+            .and_then(|m| m.get("around"))
+            .and_then(|v| v.as_integer())
+            .ok_or("maxwell_*: the case needs a generated mesh (`around`) for its polygon factor")?;
+        let polygon = 1.0 / (std::f64::consts::PI / n as f64).cos();
+        Some((m, polygon))
+    } else {
+        None
+    };
     for (k, (q, tol)) in c.spec.tolerance.iter().enumerate() {
         let mut worst: Option<(f64, &StepRecord)> = None;
         let mut pts = vec![];
         for (i, s) in steps.iter().enumerate() {
-            if let Some((fe, cf)) = step_pair(s, q) {
+            let pair = match (q.as_str(), maxwell) {
+                // the plateau's level: the step of least pressure among those whose mid-span
+                // sits in the bulge (within 1 % of the upper coexisting stretch); a front near
+                // a cap or near its mirror front only raises the pressure
+                ("maxwell_w" | "maxwell_lambda_s", Some((m, polygon))) => {
+                    let plateau = steps
+                        .iter()
+                        .filter(|t| {
+                            t.contact.is_none()
+                                && (t.midspan.lambda_s / m.lambda_s_upper - 1.0).abs() <= 0.01
+                        })
+                        .min_by(|a, b| a.midspan.w.total_cmp(&b.midspan.w));
+                    match plateau {
+                        Some(t) if std::ptr::eq(*t, *s) => Some(if q == "maxwell_w" {
+                            (s.midspan.w, m.w * polygon)
+                        } else {
+                            (s.midspan.lambda_s, m.lambda_s_upper)
+                        }),
+                        _ => None,
+                    }
+                }
+                ("maxwell_w" | "maxwell_lambda_s", None) => None,
+                _ => step_pair(s, q),
+            };
+            if let Some((fe, cf)) = pair {
                 let e = rel(fe, cf);
                 pts.push(((i + 1) as f64, e));
                 if worst.is_none_or(|(w, _)| e.abs() > w.abs()) {
@@ -761,7 +802,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             Ok(g) => {
                 if let Some(exp) = &c.spec.expected_order {
                     r.measures.push(Measure {
-                        quantity: format!("{q} order"),
+                        quantity: format!("{q} |p − {}|", exp.value),
                         measured: (g.order - exp.value).abs(),
                         tolerance: Some(exp.within),
                         source: Some(exp.source.clone()),
@@ -890,7 +931,7 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     if let Some(e) = &c.spec.decay_rate {
         let d = (fit.k - e.value).abs();
         r.measures.push(Measure {
-            quantity: "decay rate k".into(),
+            quantity: format!("|k − {}|", e.value),
             measured: d,
             tolerance: Some(e.within),
             source: Some(e.source.clone()),
@@ -905,7 +946,7 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     if let Some(e) = &c.spec.amplitude {
         let d = (fit.a - e.value).abs();
         r.measures.push(Measure {
-            quantity: "amplitude A".into(),
+            quantity: format!("|A − {}|", e.value),
             measured: d,
             tolerance: Some(e.within),
             source: Some(e.source.clone()),

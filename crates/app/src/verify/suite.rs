@@ -155,6 +155,8 @@ pub const CLOSED_FORM_QUANTITIES: &[&str] = &[
     "local_lambda_z",
     "local_chi",
     "local_force",
+    "maxwell_w",
+    "maxwell_lambda_s",
 ];
 /// The quantities of a reference check (FE against scikit-fem).
 pub const REFERENCE_QUANTITIES: &[&str] = &["profile", "w", "lambda_s", "lambda_z", "chi", "force"];
