@@ -125,3 +125,14 @@ def sweep(
     row per case and converged step; failed members keep their `error` and lose no others."""
 
 def _sweep_one(index: int, text: str, out: Union[str, PathLike]) -> dict[str, Any]: ...
+
+def verify(
+    suites: Optional[list[Union[str, PathLike]]] = None,
+    out: Union[str, PathLike] = "tubemem-verify",
+    case: Optional[Union[str, PathLike]] = None,
+    quick: bool = False,
+    jobs: int = 0,
+    filter: Optional[str] = None,
+    update_gold: bool = False,
+) -> dict[str, Any]:
+    """Verification suites (or the study of one case): results.json's content as a dict."""

@@ -1013,6 +1013,71 @@ fn sweep<'py>(
     py.import("pandas")?.call_method1("DataFrame", (rows,))
 }
 
+/// Run verification suites (TOML files, as `tubemem verify`) or, with `case=`, the study of one
+/// case (closed form, three-mesh convergence with GCI, end effect, invariance core, references),
+/// into `out`; writes results.json, report.md, report.html and junit.xml there and returns the
+/// results as a dict (results.json's content: `verdict`, `passed`, `failed`, `checks` with each
+/// check's `status`, `message`, `measures` and `details`). Bad suites raise ValueError; failing
+/// checks do not raise (read `failed` and each check's `status`).
+#[pyfunction]
+#[pyo3(signature = (suites=None, out=PathBuf::from("tubemem-verify"), case=None, quick=false, jobs=0, filter=None, update_gold=false))]
+#[allow(clippy::too_many_arguments)]
+fn verify<'py>(
+    py: Python<'py>,
+    suites: Option<Vec<PathBuf>>,
+    out: PathBuf,
+    case: Option<PathBuf>,
+    quick: bool,
+    jobs: usize,
+    filter: Option<String>,
+    update_gold: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    use tubemem_app::verify::{self as v, report::Results, VerifyOptions};
+    let opts = VerifyOptions {
+        jobs,
+        filter,
+        update_gold,
+        python: None,
+        python_ref: None,
+    };
+    let t0 = std::time::Instant::now();
+    let quiet = |_: v::Event| {};
+    let (names, results, verdict) = match (case, suites) {
+        (Some(c), None) => {
+            let s = py
+                .detach(|| v::study::run_study(&c, &out, quick, &opts, &quiet))
+                .map_err(PyValueError::new_err)?;
+            (
+                vec![format!("study of {}", c.display())],
+                s.results,
+                Some(s.verdict),
+            )
+        }
+        (None, Some(list)) if !list.is_empty() => {
+            let mut checks = vec![];
+            let mut names = vec![];
+            for s in &list {
+                let (n, c) =
+                    v::suite::read_suite(s).map_err(|e| PyValueError::new_err(e.to_string()))?;
+                names.push(n);
+                checks.extend(c);
+            }
+            let r = py
+                .detach(|| v::run_checks(&checks, &out, &opts, &quiet))
+                .map_err(|e| TubememError::new_err(e.chain()))?;
+            (names, r, None)
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "give suites=[...] (suite files) or case=... (a case file), not both",
+            ))
+        }
+    };
+    let results = Results::new(names, t0.elapsed().as_secs_f64(), &results, verdict);
+    v::report::write_all(&out, &results).map_err(|e| TubememError::new_err(e.chain()))?;
+    to_py(py, &results)
+}
+
 /// The TOML text of a case given in any of `run`'s forms.
 fn case_text(py: Python<'_>, case: &Bound<'_, PyAny>) -> PyResult<String> {
     if let Ok(c) = case.cast::<PyCase>() {
@@ -1056,6 +1121,7 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TubememError", m.py().get_type::<TubememError>())?;
     m.add_function(wrap_pyfunction!(gps_inflate, m)?)?;
     m.add_class::<Table>()?;
+    m.add_function(wrap_pyfunction!(verify, m)?)?;
     m.add_function(wrap_pyfunction!(gps_inflation_curve, m)?)?;
     m.add_function(wrap_pyfunction!(gps_flatten, m)?)?;
     m.add_function(wrap_pyfunction!(gps_flattening_curve, m)?)?;

@@ -25,6 +25,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[3] / "python_ref
 from cases import SMALL, SQUEEZE  # noqa: E402
 
 SMALL_CASE = SMALL + SQUEEZE
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 
 def rel(a, b):
@@ -402,3 +403,55 @@ def test_progress_with_tqdm_or_a_clear_import_error(tmp_path, monkeypatch, capsy
     assert not (tmp_path / "nobar" / "steps.csv").exists()
     with pytest.raises(ValueError, match="a callable"):
         tubemem.run(SMALL_CASE, str(tmp_path / "nobar2"), progress="bar")
+
+
+def test_verify_returns_the_results_and_writes_a_junit_file_of_the_junit_structure(tmp_path):
+    """tubemem.verify runs a suite (here: a reference check that must pass now that the
+    scikit-fem references are installed, and a closed-form check that must fail), returns
+    results.json's content, and junit.xml has the JUnit structure (testsuites > testsuite >
+    testcase, with the attributes the JUnit schema requires, a <failure> with its message)."""
+    import xml.etree.ElementTree as ET
+
+    small = ROOT / "cases" / "small_abb30_ls1.2.toml"
+    suite = tmp_path / "suite.toml"
+    suite.write_text(f'''
+[[check]]
+name = "ref"
+case = "{small}"
+kind = "reference"
+tolerance.profile = {{ value = 2e-3, source = "regression bound: 3.5 x the 5.7e-4 measured" }}
+tolerance.w = {{ value = 2.1e-2, source = "16-gon factor 1.96e-2 + the end effect at L/R = 8" }}
+
+[[check]]
+name = "too-tight"
+case = "{small}"
+kind = "closed-form"
+tolerance.w = {{ value = 1e-6, source = "a tolerance the 16-gon cannot meet" }}
+''')
+    out = tmp_path / "out"
+    r = tubemem.verify([str(suite)], str(out))
+    assert r["passed"] == 1 and r["failed"] == 1
+    by = {c["name"]: c for c in r["checks"]}
+    assert by["ref"]["status"] == "pass", by["ref"]["message"]
+    prof = [m for m in by["ref"]["measures"] if m["quantity"] == "profile"][0]
+    assert 1e-4 < prof["measured"] < 2e-3 and prof["source"].startswith("regression bound")
+    assert by["too-tight"]["status"] == "fail" and "w: " in by["too-tight"]["message"]
+    root = ET.parse(out / "junit.xml").getroot()
+    assert root.tag == "testsuites"
+    for ts in root:
+        assert ts.tag == "testsuite"
+        for a in ["name", "tests", "failures", "errors", "skipped", "time"]:
+            assert a in ts.attrib, a
+        assert int(ts.attrib["tests"]) == len(ts) == 2 and int(ts.attrib["failures"]) == 1
+        for tc in ts:
+            assert tc.tag == "testcase" and {"name", "classname", "time"} <= set(tc.attrib)
+            float(tc.attrib["time"])
+            for child in tc:
+                assert child.tag in {"failure", "error", "skipped"}
+                assert "message" in child.attrib
+        fail = [tc for tc in ts if len(tc)][0]
+        assert fail.attrib["name"] == "too-tight" and "16-gon cannot meet" in fail[0].attrib["message"]
+    with pytest.raises(ValueError, match="has no `source`"):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(f'[[check]]\nname = "x"\ncase = "{small}"\nkind = "gold"\ntolerance.w = {{ value = 1.0, source = "" }}\n')
+        tubemem.verify([str(bad)], str(tmp_path / "bad"))

@@ -250,7 +250,10 @@ mod tests {
     #[test]
     fn end_laws_are_recovered_from_exact_data() {
         let l = [4.0, 6.0, 8.0, 10.0];
-        let e: Vec<f64> = l.iter().map(|x| 1.2e-3 + 0.5 * (-0.78f64 * x).exp()).collect();
+        let e: Vec<f64> = l
+            .iter()
+            .map(|x| 1.2e-3 + 0.5 * (-0.78f64 * x).exp())
+            .collect();
         let f = fit_end_law(EndLaw::Exponential, &l, &e).unwrap();
         assert!(
             (f.k - 0.78).abs() < 1e-6 && (f.c - 1.2e-3).abs() < 1e-9,
