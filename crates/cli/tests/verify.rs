@@ -286,3 +286,104 @@ fn bad_suites_exit_with_2_and_a_clear_message() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--case"));
 }
+
+/// The study of a user's case: below the limit point GPS describes the mid-span of a 16-around,
+/// L/R = 16 tube;
+/// a Mooney–Rivlin tube inflated past its pressure maximum (λs* = 2.0 > 1.708) is said not to
+/// be described, with the instability named; a case that does not parse is exit 2.
+#[test]
+fn the_case_study_says_whether_gps_describes_the_tube() {
+    let d = tmp("study");
+    let case = |name: &str, text: String| {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    // L/R = 16, 8 elements per R along: at L/R = 8 the caps' boundary layers (about 3 R each
+    // at ε = 1e-3) leave only a third of the tube invariant
+    let base = std::fs::read_to_string(SMALL)
+        .unwrap()
+        .replace("length = 8.0", "length = 16.0")
+        .replace("along = 24", "along = 128");
+    let good = case("good.toml", base.clone());
+    let o = tubemem(
+        &[
+            "verify",
+            "--case",
+            good.to_str().unwrap(),
+            "--out",
+            d.join("good").to_str().unwrap(),
+        ],
+        &[("TUBEMEM_PYTHON", "/nonexistent/python")],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        out.starts_with("GPS describes the mid-span of this tube"),
+        "{out}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("good/results.json")).unwrap())
+            .unwrap();
+    let names: Vec<&str> = r["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "end-effect",
+            "invariance",
+            "reference",
+            "convergence",
+            "closed-form"
+        ]
+    );
+    let bulged = case(
+        "bulged.toml",
+        base.replace(
+            "model = \"abb\"\nshear_modulus = 1.0\nkuhn = 30",
+            "model = \"mooney-rivlin\"\nshear_modulus = 1.0\nalpha = 0.1",
+        )
+        .replace("target_stretch = 1.2", "target_stretch = 2.0")
+        .replace("steps = 4", "steps = 10"),
+    );
+    let o = tubemem(
+        &[
+            "verify",
+            "--case",
+            bulged.to_str().unwrap(),
+            "--out",
+            d.join("bulged").to_str().unwrap(),
+            "--quick",
+        ],
+        &[("TUBEMEM_PYTHON", "/nonexistent/python")],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(
+        out.contains("GPS does NOT describe")
+            && out.contains("past the GPS pressure maximum")
+            && out.contains("1.708"),
+        "{out}"
+    );
+    let bad = case("bad.toml", "[geometry]\nradius = 1.0\n".into());
+    let o = tubemem(
+        &[
+            "verify",
+            "--case",
+            bad.to_str().unwrap(),
+            "--out",
+            d.join("bad").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -507,8 +507,7 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                 tol,
                 format!(
                     "max |FE/GPS − 1| over {compared} steps, {e:+.3e} at stage {} step {}",
-                    s.stage,
-                    s.step
+                    s.stage, s.step
                 ),
             )),
         }
