@@ -26,6 +26,8 @@ fi
 echo "== Python API: maturin develop (crates/py, release)"
 .venv/bin/python -m pip install --quiet "maturin>=1.16,<2"
 VIRTUAL_ENV="$PWD/.venv" .venv/bin/maturin develop --release --quiet -m crates/py/Cargo.toml
+echo "== tubemem verify verify/ci.toml (FE against closed form, references and gold files)"
+TUBEMEM_PYTHON="$PWD/.venv/bin/python" target/release/tubemem verify verify/ci.toml --out target/verify-ci
 echo "== pytest: python_ref/tests"
 TUBEMEM_BIN="$PWD/target/release/tubemem" .venv/bin/python -m pytest python_ref/tests -q
 echo "== the Python package installs with plain pip in a fresh venv (no maturin beforehand)"
