@@ -636,14 +636,15 @@ impl Mirror {
 }
 
 /// The columns of a stage-end profile (one row per ring).
-pub const PROFILE_HEADER: &str = "z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width";
+pub const PROFILE_HEADER: &str =
+    "z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width,contact_force";
 /// The columns of profiles.csv: the step's row in steps.csv, its stage and step, then
 /// [`PROFILE_HEADER`].
 pub const PROFILES_HEADER: &str =
-    "row,stage,step,z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width";
+    "row,stage,step,z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width,contact_force";
 
 /// The values of one ring, in [`PROFILE_HEADER`]'s order.
-pub fn ring_row(r: &RingValues) -> [f64; 9] {
+pub fn ring_row(r: &RingValues) -> [f64; 10] {
     let v = &r.values;
     [
         r.z_ref,
@@ -655,6 +656,7 @@ pub fn ring_row(r: &RingValues) -> [f64; 9] {
         v.n_z,
         v.n_sz,
         r.contact_width,
+        r.contact_force,
     ]
 }
 

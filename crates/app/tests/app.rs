@@ -80,9 +80,10 @@ fn the_files_are_the_report() {
         match &rec.contact {
             Some(c) => {
                 assert_eq!(mid.contact_width, c.values.chi_geometric);
+                assert_eq!(mid.contact_force, c.values.force);
                 assert!(mid.contact_width > 0.0);
             }
-            None => assert_eq!(mid.contact_width, 0.0),
+            None => assert_eq!((mid.contact_width, mid.contact_force), (0.0, 0.0)),
         }
     }
     assert!(lines.next().is_none() && rows > 0);
@@ -118,6 +119,10 @@ fn profiles_at_stage_ends_only() {
     assert_eq!(
         mid.contact_width,
         last.contact.as_ref().unwrap().values.chi_geometric
+    );
+    assert_eq!(
+        mid.contact_force,
+        last.contact.as_ref().unwrap().values.force
     );
 }
 

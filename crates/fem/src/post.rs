@@ -288,6 +288,10 @@ pub struct RingValues {
     /// ([`ContactValues::chi_geometric`], c/(πR) over all symmetry copies); 0 without plates
     #[serde(default)]
     pub contact_width: f64,
+    /// the plate force per unit current length at the ring over πμH, as at mid-span
+    /// ([`ContactValues::force`]); 0 without plates
+    #[serde(default)]
+    pub contact_force: f64,
 }
 
 /// Profiles along the cylinder: one entry per ring of nodes at the reference radius (the
@@ -348,6 +352,17 @@ pub fn ring_profile(
             .collect::<Result<Vec<_>, _>>()?
     };
     let volume = model.total_volume(&state.x);
+    let forces: Vec<f64> = match (contact, half_gap) {
+        (Some(c), Some(h)) => {
+            use rayon::prelude::*;
+            model
+                .elements()
+                .par_iter()
+                .map(|el| element_contact_force(el, &el.gather(&state.x), c, h))
+                .collect()
+        }
+        _ => vec![],
+    };
     heights
         .iter()
         .zip(nodes)
@@ -373,6 +388,11 @@ pub fn ring_profile(
                     / n,
                 values: ring_state_of(model, state, &ring, touching, |_, e| projected[e], volume)?,
                 contact_width: half_gap.map_or(0.0, |h| contact_width(model, state, &ring, h)),
+                contact_force: if forces.is_empty() {
+                    0.0
+                } else {
+                    ring_force(model, state, &ring, touching.iter().copied(), |e| forces[e])
+                },
             })
         })
         .collect()
@@ -401,6 +421,78 @@ fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64) -> f64 {
         1.0
     };
     x_copies * c / std::f64::consts::PI
+}
+
+/// The plate force per unit current length at `ring` over πμH (all copies across x = 0), from
+/// the contact forces `fe(e)` of the elements that touch it (ascending): each side's row force
+/// over the row's mean axial extent (the meridian edges with one end on the ring), averaged over
+/// the sides that have one.
+fn ring_force(
+    model: &Model,
+    state: &State,
+    ring: &Ring,
+    touching: impl Iterator<Item = usize>,
+    fe: impl Fn(usize) -> f64,
+) -> f64 {
+    let mesh = model.mesh();
+    let on_ring = ring.contains_set();
+    let z_ring = ring.nodes.first().map_or(0.0, |&i| mesh.nodes[i][2]);
+    let mut side_force = [0.0; 2];
+    let mut side_extent = [(0.0, 0usize); 2];
+    for e in touching {
+        let el = &model.elements()[e];
+        let zc = el.nodes.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0;
+        let side = usize::from(zc < z_ring);
+        side_force[side] += fe(e);
+        // axial extent: mean |Δz| of the element's meridian edges (one end on the ring)
+        let mut ext = 0.0;
+        let mut m = 0;
+        for k in 0..4 {
+            let (a, b) = (el.nodes[k], el.nodes[(k + 1) % 4]);
+            if on_ring.contains(&a) != on_ring.contains(&b) {
+                ext += (state.x[a][2] - state.x[b][2]).abs();
+                m += 1;
+            }
+        }
+        if m > 0 {
+            side_extent[side].0 += ext / m as f64;
+            side_extent[side].1 += 1;
+        }
+    }
+    // per unit length: the row's force over its axial extent (the mean extent of its elements)
+    let mut f_per_len = 0.0;
+    let mut sides = 0.0;
+    for s in 0..2 {
+        if side_extent[s].1 > 0 && side_extent[s].0 > 0.0 {
+            f_per_len += side_force[s] / (side_extent[s].0 / side_extent[s].1 as f64);
+            sides += 1.0;
+        }
+    }
+    let f_per_len = if sides > 0.0 { f_per_len / sides } else { 0.0 };
+    let x_copies = if mesh.symmetry.planes().contains(&0) {
+        2.0
+    } else {
+        1.0
+    };
+    x_copies * f_per_len / std::f64::consts::PI
+}
+
+/// The contact force of one element against the plate y = h: Σ_g w_g t(gap_g) over its Gauss
+/// points in contact.
+fn element_contact_force(
+    el: &crate::geometry::RefElement,
+    xe: &[Vec3; 4],
+    contact: &Contact,
+    h: f64,
+) -> f64 {
+    let mut fe = 0.0;
+    for g in 0..4 {
+        let gp_gap = h - el.position(g, xe)[1];
+        if gp_gap < 0.0 {
+            fe += el.gauss[g].w * contact.traction(gp_gap);
+        }
+    }
+    fe
 }
 
 /// Mid-span contact values of a squeeze, dimensionless.
@@ -438,16 +530,13 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
     let ring = Ring::midspan(model);
     let chi_geometric = contact_width(model, state, &ring, h);
     let on_ring = ring.contains_set();
-    // force per unit length from the element rows next to the ring, side by side
-    let mut side_force = [0.0; 2];
-    let mut side_extent = [(0.0, 0usize); 2];
     let (mut pc_sum, mut pc_n) = (0.0, 0usize);
     let (mut total, mut penetration) = (0.0, 0.0_f64);
-    for el in model.elements() {
+    let mut forces = vec![0.0; model.elements().len()];
+    let mut touching = vec![];
+    for (e, el) in model.elements().iter().enumerate() {
         let xe = el.gather(&state.x);
         let touches = el.nodes.iter().any(|i| on_ring.contains(i));
-        let zc = el.nodes.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0;
-        let side = usize::from(zc < 0.0);
         let mut fe = 0.0;
         for g in 0..4 {
             let gp_gap = gap(el.position(g, &xe).into());
@@ -462,44 +551,18 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             }
         }
         total += fe;
+        forces[e] = fe;
         if touches {
-            side_force[side] += fe;
-            // axial extent: mean |Δz| of the element's meridian edges (one end on the ring)
-            let mut ext = 0.0;
-            let mut m = 0;
-            for k in 0..4 {
-                let (a, b) = (el.nodes[k], el.nodes[(k + 1) % 4]);
-                if on_ring.contains(&a) != on_ring.contains(&b) {
-                    ext += (state.x[a][2] - state.x[b][2]).abs();
-                    m += 1;
-                }
-            }
-            if m > 0 {
-                side_extent[side].0 += ext / m as f64;
-                side_extent[side].1 += 1;
-            }
+            touching.push(e);
         }
     }
-    // per unit length: the row's force over its axial extent (the mean extent of its elements)
-    let mut f_per_len = 0.0;
-    let mut sides = 0.0;
-    for s in 0..2 {
-        if side_extent[s].1 > 0 && side_extent[s].0 > 0.0 {
-            f_per_len += side_force[s] / (side_extent[s].0 / side_extent[s].1 as f64);
-            sides += 1.0;
-        }
-    }
-    let f_per_len = if sides > 0.0 { f_per_len / sides } else { 0.0 };
-    let pi = std::f64::consts::PI;
+    // force per unit length from the element rows next to the ring, side by side
+    let force = ring_force(model, state, &ring, touching.into_iter(), |e| forces[e]);
     Some(ContactValues {
         rho: h,
-        chi: if state.p > 0.0 {
-            x_copies * f_per_len / (pi * state.p)
-        } else {
-            0.0
-        },
+        chi: if state.p > 0.0 { force / state.p } else { 0.0 },
         chi_geometric,
-        force: x_copies * f_per_len / pi,
+        force,
         contact_pressure: if pc_n > 0 { pc_sum / pc_n as f64 } else { 0.0 },
         penetration,
         total_force: x_copies * z_copies * total,

@@ -587,8 +587,12 @@ fn the_one_pass_profile_is_the_per_ring_extraction() {
     let mid = rings.iter().find(|r| r.z_ref == 0.0).unwrap();
     let mc = midspan_contact(&m, &st, &contact).unwrap();
     assert_eq!(mid.contact_width, mc.chi_geometric);
-    assert!(mid.contact_width > 0.0);
+    assert_eq!(mid.contact_force, mc.force);
+    assert!(mid.contact_width > 0.0 && mid.contact_force > 0.0);
     // the highest ring (a cap equator) is below the plate: no contact there
     let top = rings.last().unwrap();
-    assert!(top.z_ref > 2.9 && top.contact_width == 0.0, "{top:?}");
+    assert!(
+        top.z_ref > 2.9 && top.contact_width == 0.0 && top.contact_force == 0.0,
+        "{top:?}"
+    );
 }

@@ -303,6 +303,7 @@ def test_run_returns_arrays_equal_to_steps_csv_and_takes_cases_as_dicts(tmp_path
     np.testing.assert_array_equal(mid["lambda_s"].to_numpy(), a.steps["lambda_s"])
     sq = a.steps["rho"] == a.steps["rho"]  # squeeze rows (rho is NaN for inflation)
     np.testing.assert_array_equal(mid["contact_width"].to_numpy()[sq], a.steps["chi_geometric"][sq])
+    np.testing.assert_array_equal(mid["contact_force"].to_numpy()[sq], a.steps["force"][sq])
     assert (mid["contact_width"].to_numpy()[sq] > 0).all() and (mid["contact_width"].to_numpy()[~sq] == 0).all()
     # a bad dict names its key
     bad = dict(as_dict, material={"model": "abb", "shear_modulus": 1.0, "kuhm": 3})

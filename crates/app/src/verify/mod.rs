@@ -1063,6 +1063,9 @@ fn core(rings: &[tubemem_fem::post::RingValues], eps: f64) -> Option<(f64, Optio
         if mid.contact_width > 0.0 && (r.contact_width / mid.contact_width - 1.0).abs() > eps {
             return Some("contact_width");
         }
+        if mid.contact_force > 0.0 && (r.contact_force / mid.contact_force - 1.0).abs() > eps {
+            return Some("contact_force");
+        }
         None
     };
     let side = |sign: f64| -> Option<(f64, String)> {
