@@ -151,7 +151,7 @@ case = { geometry = { radius = 1.0, length = 3.0 }, material = { model = "abb", 
     );
     let (s, m) = status(&r, "end-fail");
     assert!(
-        s == "fail" && m.contains("fitted k = 0.") && m.contains("expected 3"),
+        s == "fail" && m.contains("fitted decay rate per R 0.") && m.contains("expected 3"),
         "{m}"
     );
     let (s, m) = status(&r, "inv-short");

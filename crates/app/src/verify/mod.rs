@@ -88,6 +88,31 @@ impl Measure {
             at_least: false,
         }
     }
+    /// A quantity that has a tolerance but nothing was measured for it: a failure that says why.
+    fn missing(quantity: &str, tol: &Tol, why: &str) -> Self {
+        Measure {
+            quantity: quantity.into(),
+            measured: f64::NAN,
+            tolerance: Some(tol.value),
+            source: Some(tol.source.clone()),
+            pass: false,
+            note: why.into(),
+            at_least: false,
+        }
+    }
+    /// A fitted or observed value against an expectation `value ± within`.
+    fn expected(label: &str, symbol: &str, found: f64, e: &suite::Expect, note: &str) -> Self {
+        let d = (found - e.value).abs();
+        Measure {
+            quantity: format!("{label}|{symbol} − {}|", e.value),
+            measured: d,
+            tolerance: Some(e.within),
+            source: Some(e.source.clone()),
+            pass: d <= e.within,
+            note: format!("{note} {found:.4}, expected {} ± {}", e.value, e.within),
+            at_least: false,
+        }
+    }
     fn reported(quantity: &str, measured: f64, note: String) -> Self {
         Measure {
             quantity: quantity.into(),
@@ -492,15 +517,11 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             }
         }
         match worst {
-            None => r.measures.push(Measure {
-                quantity: q.clone(),
-                measured: f64::NAN,
-                tolerance: Some(tol.value),
-                source: Some(tol.source.clone()),
-                pass: false,
-                note: "no step of this run has this comparison".into(),
-                at_least: false,
-            }),
+            None => r.measures.push(Measure::missing(
+                q,
+                tol,
+                "no step of this run has this comparison",
+            )),
             Some((e, s)) => r.measures.push(Measure::held(
                 q,
                 e.abs(),
@@ -701,15 +722,11 @@ fn reference(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -
         }
         match worst {
             Some((v, note)) => r.measures.push(Measure::held(q, v, tol, note)),
-            None => r.measures.push(Measure {
-                quantity: q.clone(),
-                measured: f64::NAN,
-                tolerance: Some(tol.value),
-                source: Some(tol.source.clone()),
-                pass: false,
-                note: "the references gave no such comparison for this run".into(),
-                at_least: false,
-            }),
+            None => r.measures.push(Measure::missing(
+                q,
+                tol,
+                "the references gave no such comparison for this run",
+            )),
         }
     }
     r.details = serde_json::json!({ "rows": rows, "material": report.material });
@@ -814,18 +831,13 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             }
             Ok(g) => {
                 if let Some(exp) = &c.spec.expected_order {
-                    r.measures.push(Measure {
-                        quantity: format!("{q} |p − {}|", exp.value),
-                        measured: (g.order - exp.value).abs(),
-                        tolerance: Some(exp.within),
-                        source: Some(exp.source.clone()),
-                        pass: (g.order - exp.value).abs() <= exp.within,
-                        note: format!(
-                            "observed order {:.3}, expected {} ± {}",
-                            g.order, exp.value, exp.within
-                        ),
-                        at_least: false,
-                    });
+                    r.measures.push(Measure::expected(
+                        &format!("{q} "),
+                        "p",
+                        g.order,
+                        exp,
+                        "observed order",
+                    ));
                 }
                 if let Some(reference) = reference {
                     // the reference within the extrapolated value ± GCI (+ a stated tolerance)
@@ -942,34 +954,17 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let fit =
         stats::fit_end_law(law, &lengths, &errors).ok_or("the end-effect law cannot be fitted")?;
     if let Some(e) = &c.spec.decay_rate {
-        let d = (fit.k - e.value).abs();
-        r.measures.push(Measure {
-            quantity: format!("|k − {}|", e.value),
-            measured: d,
-            tolerance: Some(e.within),
-            source: Some(e.source.clone()),
-            pass: d <= e.within,
-            note: format!(
-                "fitted k = {:.4} per R, expected {} ± {}",
-                fit.k, e.value, e.within
-            ),
-            at_least: false,
-        });
+        r.measures.push(Measure::expected(
+            "",
+            "k",
+            fit.k,
+            e,
+            "fitted decay rate per R",
+        ));
     }
     if let Some(e) = &c.spec.amplitude {
-        let d = (fit.a - e.value).abs();
-        r.measures.push(Measure {
-            quantity: format!("|A − {}|", e.value),
-            measured: d,
-            tolerance: Some(e.within),
-            source: Some(e.source.clone()),
-            pass: d <= e.within,
-            note: format!(
-                "fitted A = {:.4e}, expected {} ± {}",
-                fit.a, e.value, e.within
-            ),
-            at_least: false,
-        });
+        r.measures
+            .push(Measure::expected("", "A", fit.a, e, "fitted amplitude"));
     }
     if let Some(t) = &c.spec.max_residual {
         r.measures.push(Measure::held(
