@@ -70,7 +70,7 @@ def compare(run_dir, out_dir, plot=True):
                 rows.append((idx, "inflate", k, fe, sk, cf, rel(fe, sk), rel(fe, cf), rel(sk, cf)))
             # summary.json names the profile relative to the run folder
             prof = read_profile(pathlib.Path(run_dir) / st["profile"])
-            z_ax, ls_ax, _, s_ax = tube.profile(q)
+            z_ax, ls_ax, lz_ax, s_ax = tube.profile(q)
             cyl = s_ax >= np.pi / 2 - 1e-12
             z_ref_ax = length / 2 - (s_ax[cyl] - np.pi / 2)
             order = np.argsort(z_ref_ax)
@@ -79,6 +79,14 @@ def compare(run_dir, out_dir, plot=True):
             diff = prof["lambda_s"][sel] - ls_interp
             imax = int(np.argmax(np.abs(diff)))
             rows.append((idx, "inflate", "profile max |Δλs|", float(np.abs(diff).max()), float(prof["z_ref"][sel][imax]),
+                         np.nan, np.nan, np.nan, np.nan))
+            # λz(Z): the axisymmetric meridian stretch (finite differences at the P2 vertices)
+            # against the FE's mean meridian edge stretch at each ring; both are O(h) at the
+            # cap junction, where the meridian curvature jumps
+            lz_interp = np.interp(prof["z_ref"][sel], z_ref_ax[order], lz_ax[cyl][order])
+            dlz = prof["lambda_z"][sel] - lz_interp
+            jmax = int(np.argmax(np.abs(dlz)))
+            rows.append((idx, "inflate", "profile max |Δλz|", float(np.abs(dlz).max()), float(prof["z_ref"][sel][jmax]),
                          np.nan, np.nan, np.nan, np.nan))
             if plot:
                 import matplotlib

@@ -34,6 +34,9 @@ def test_compare_a_run_folder(tmp_path, tubemem_exe):
         assert abs(table[(2, k)][8]) < 1e-4, (k, table[(2, k)])
     # FE profile against the axisymmetric reference
     assert table[(1, "profile max |Δλs|")][3] < 2e-3, table[(1, "profile max |Δλs|")]
+    # λz(Z): 1.6e-3 measured next to the cap junction (3 elements per R along; O(h) there, where
+    # the meridian curvature jumps); the same 3.5x regression bound
+    assert table[(1, "profile max |Δλz|")][3] < 5.5e-3, table[(1, "profile max |Δλz|")]
     assert (tmp_path / "cmp" / "compare.csv").exists() and (tmp_path / "cmp" / "profile_stage1.png").exists()
 
 

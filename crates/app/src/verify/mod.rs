@@ -696,11 +696,16 @@ fn reference(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -
         let mut worst: Option<(f64, String)> = None;
         for row in &rows {
             let (stage, quantity) = (num(&row[0]), row[2].as_str().unwrap_or(""));
-            let (value, note) = if q == "profile" && quantity.starts_with("profile") {
+            let profile_row = match q.as_str() {
+                "profile" => Some("profile max |Δλs|"),
+                "profile_lambda_z" => Some("profile max |Δλz|"),
+                _ => None,
+            };
+            let (value, note) = if profile_row.is_some_and(|p| quantity == p) {
                 (
                     num(&row[3]),
                     format!(
-                        "stage {stage}: max |Δλs| along the tube, at Z = {:.3}",
+                        "stage {stage}: {quantity} along the tube, at Z = {:.3}",
                         num(&row[4])
                     ),
                 )

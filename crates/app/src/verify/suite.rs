@@ -159,7 +159,15 @@ pub const CLOSED_FORM_QUANTITIES: &[&str] = &[
     "maxwell_lambda_s",
 ];
 /// The quantities of a reference check (FE against scikit-fem).
-pub const REFERENCE_QUANTITIES: &[&str] = &["profile", "w", "lambda_s", "lambda_z", "chi", "force"];
+pub const REFERENCE_QUANTITIES: &[&str] = &[
+    "profile",
+    "profile_lambda_z",
+    "w",
+    "lambda_s",
+    "lambda_z",
+    "chi",
+    "force",
+];
 /// Final mid-span quantities of a run (convergence, end-effect).
 pub const FINAL_QUANTITIES: &[&str] = &["w", "lambda_s", "lambda_z", "n_s", "n_z", "chi", "force"];
 
