@@ -20,6 +20,9 @@ pub enum GpsError {
         #[source]
         source: MaterialError,
     },
+    /// A set of walls that cannot hold the section (open, empty, too short a perimeter).
+    #[error("{message}")]
+    Walls { message: String },
     /// Newton did not converge, even after step cut-back.
     #[error(
         "{stage} did not converge at {at}: residual {residual:.3e} after {iterations} iterations"

@@ -31,6 +31,7 @@
 //! assert!((f.lambda_s - f.rho - f.chi).abs() < 1e-12); // eq. (77)₁
 //! ```
 
+pub mod confine;
 mod error;
 pub mod limits;
 pub mod linear;

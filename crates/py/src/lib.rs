@@ -36,7 +36,7 @@ const DEFAULT_MATERIAL: MaterialSpec = MaterialSpec::Abb {
 fn gps_err(e: GpsError) -> PyErr {
     let msg = tubemem_app::error_chain(&e);
     match e {
-        GpsError::InvalidInput { .. } => PyValueError::new_err(msg),
+        GpsError::InvalidInput { .. } | GpsError::Walls { .. } => PyValueError::new_err(msg),
         // a material parameter out of range, or a stretch asked for beyond the locking limit,
         // is bad input
         GpsError::Material {
