@@ -43,6 +43,185 @@ pub enum GpsCommand {
     Flatten(FlattenArgs),
     /// Pressure maximum and minimum of the inflation curve and the Maxwell pressure.
     Limits(LimitsArgs),
+    /// Confinement by any convex set of planes parallel to the axis (eqs. 55–60): the gas
+    /// closed in at --initial-stretch and the walls moved in from first contact, or a given
+    /// --pressure. One state (--json), a path into --csv, a figure of the section (--figure).
+    Confine(ConfineArgs),
+}
+
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct ConfineArgs {
+    #[command(flatten)]
+    material: MaterialArgs,
+    #[arg(long, value_enum, default_value = "gps")]
+    hypothesis: Hyp,
+    /// A wall {x : n·x = d} as nx,ny,d, the membrane on the side n·x ≤ d (n need not be unit
+    /// length; the axis must be inside: d > 0). Repeat for each wall.
+    #[arg(
+        long = "plane",
+        value_name = "NX,NY,D",
+        required = true,
+        allow_hyphen_values = true
+    )]
+    planes: Vec<String>,
+    /// The inflated hoop stretch λs* at which the gas is closed in (the walls then move in
+    /// from first contact to their offsets d).
+    #[arg(long, conflicts_with = "pressure")]
+    initial_stretch: Option<f64>,
+    /// A given reduced pressure ϖ instead (no gas law).
+    #[arg(long)]
+    pressure: Option<f64>,
+    /// With --initial-stretch: the path's number of states (≥ 2), written to --csv.
+    #[arg(long, requires = "csv")]
+    points: Option<usize>,
+    /// Write the path (the walls' offsets scaled from first contact to d) to this CSV file.
+    #[arg(long, requires = "initial_stretch")]
+    csv: Option<PathBuf>,
+    /// Draw the final section and the walls to this figure (.png or .svg).
+    #[arg(long)]
+    figure: Option<PathBuf>,
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_plane(text: &str) -> Result<tubemem_gps::confine::Wall> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| anyhow::anyhow!("--plane {text:?}: expected three numbers nx,ny,d"))?;
+    let [nx, ny, d] = v[..] else {
+        bail!(
+            "--plane {text:?}: expected three numbers nx,ny,d, got {}",
+            v.len()
+        );
+    };
+    Ok(tubemem_gps::confine::Wall::new(nx, ny, d)?)
+}
+
+fn confine_json(s: &tubemem_gps::confine::ConfineState) -> Result<serde_json::Value> {
+    let mut nums = vec![s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z, s.r, s.area];
+    nums.extend(s.walls.iter().flat_map(|w| [w.contact_length, w.force]));
+    ensure_finite(&nums)?;
+    Ok(serde_json::to_value(s)?)
+}
+
+fn run_confine(a: ConfineArgs) -> Result<()> {
+    use tubemem_gps::confine::{confine_at_pressure, confine_path, section_outline};
+    let law = a.material.build()?;
+    let hyp: Hypothesis = a.hypothesis.into();
+    let walls = a
+        .planes
+        .iter()
+        .map(|p| parse_plane(p))
+        .collect::<Result<Vec<_>>>()?;
+    let path = match (a.initial_stretch, a.pressure) {
+        (Some(ls0), None) => confine_path(law.as_ref(), hyp, &walls, ls0, a.points.unwrap_or(2))?,
+        (None, Some(w)) => vec![confine_at_pressure(law.as_ref(), hyp, &walls, w)?],
+        _ => bail!("give --initial-stretch λs* (the gas closed in) or --pressure ϖ"),
+    };
+    let last = path.last().expect("a path has a state");
+    if let Some(csv) = &a.csv {
+        let mut header = "scale,w,lambda_s,lambda_z,n_s,n_z,r,area,regime".to_string();
+        for k in 0..walls.len() {
+            header.push_str(&format!(",contact_{k},force_{k}"));
+        }
+        let mut text = header + "\n";
+        for s in &path {
+            confine_json(s)?;
+            let mut row = [
+                s.scale, s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z, s.r, s.area,
+            ]
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>();
+            row.push(format!("{:?}", s.regime).to_lowercase());
+            for w in &s.walls {
+                row.push(w.contact_length.to_string());
+                row.push(w.force.to_string());
+            }
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        std::fs::write(csv, text).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        crate::say!("wrote {} states to {}", path.len(), csv.display())?;
+    }
+    if let Some(fig) = &a.figure {
+        draw_section(fig, &walls, last, &section_outline(&walls, last, 720))?;
+        crate::say!("wrote {}", fig.display())?;
+    }
+    let v = confine_json(last)?;
+    if a.json {
+        crate::say!("{v}")?;
+    } else if a.csv.is_none() {
+        print_state(last, false)?;
+    }
+    Ok(())
+}
+
+/// The section (closed outline) and the walls (segments across the picture).
+fn draw_section(
+    path: &std::path::Path,
+    walls: &[tubemem_gps::confine::Wall],
+    state: &tubemem_gps::confine::ConfineState,
+    outline: &[[f64; 2]],
+) -> Result<()> {
+    use tubemem_app::figures::{Figure, FigureOptions, Series, Stroke};
+    let extent = outline
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()))
+        * 1.3;
+    let mut series = vec![Series {
+        label: format!(
+            "section: ϖ = {:.4}, λs = {:.4}, λz = {:.4}, r = {:.4}",
+            state.w, state.lambda_s, state.lambda_z, state.r
+        ),
+        points: outline
+            .iter()
+            .chain(outline.first())
+            .map(|p| (p[0], p[1]))
+            .collect(),
+        color: plotters::style::RGBColor(31, 90, 180),
+        stroke: Stroke::Solid,
+        width: 3,
+    }];
+    for (k, w) in walls.iter().enumerate() {
+        let d = w.offset * state.scale;
+        let (n, t) = (w.normal, [-w.normal[1], w.normal[0]]);
+        let p0 = [n[0] * d, n[1] * d];
+        series.push(Series {
+            label: format!(
+                "wall {k}: contact {:.4} R, force {:.4}",
+                state.walls[k].contact_length, state.walls[k].force
+            ),
+            points: vec![
+                (p0[0] - extent * t[0], p0[1] - extent * t[1]),
+                (p0[0] + extent * t[0], p0[1] + extent * t[1]),
+            ],
+            color: plotters::style::RGBColor(90, 90, 90),
+            stroke: Stroke::Dashed,
+            width: 2,
+        });
+    }
+    let fig = Figure {
+        title: "Confined cross-section (GPS closed form, eqs. 55–60)".into(),
+        x_label: "x/R".into(),
+        y_label: "y/R".into(),
+        series,
+        markers: vec![],
+        panel: None,
+        notes: vec![],
+    };
+    let stem = path.with_extension("");
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("png");
+    let opts = FigureOptions {
+        png: ext == "png",
+        svg: ext == "svg",
+        ..FigureOptions::default()
+    };
+    tubemem_app::figures::save(&fig, &stem, &opts).map_err(|e| anyhow::anyhow!(e.chain()))?;
+    Ok(())
 }
 
 #[derive(Args, Debug)]
@@ -175,6 +354,7 @@ pub fn run(cmd: GpsCommand) -> Result<()> {
                 _ => bail!("give either --rho ρ (one state) or --to, --points and --csv (a curve)"),
             }
         }
+        GpsCommand::Confine(a) => run_confine(a),
         GpsCommand::Limits(a) => {
             let law = a.material.build()?;
             let l = limit_points(law.as_ref(), a.hypothesis.into())?;

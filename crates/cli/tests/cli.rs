@@ -1425,3 +1425,95 @@ fn run_log_has_a_line_per_step() {
         assert!((w / steps.num(row, "w") - 1.0).abs() < 1e-8, "{line}");
     }
 }
+
+/// `tubemem gps confine`: the issue's square channel in its own syntax (a plane with a leading
+/// minus), the JSON keys, a path CSV with the walls' columns and the regime, a figure of the
+/// section; an open set of planes and a malformed plane are clear errors.
+#[test]
+fn gps_confine_by_any_planes() {
+    let d = tmp("confine");
+    let square = [
+        "--plane", "1,0,1.1", "--plane", "-1,0,1.1", "--plane", "0,1,1.1", "--plane", "0,-1,1.1",
+    ];
+    let mut args = vec![
+        "gps",
+        "confine",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--hypothesis",
+        "gps",
+        "--initial-stretch",
+        "1.3",
+    ];
+    args.extend(square);
+    let csv = d.join("path.csv");
+    let fig = d.join("section.png");
+    args.extend([
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--points",
+        "6",
+        "--figure",
+        fig.to_str().unwrap(),
+    ]);
+    let o = tubemem(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let v: Value = serde_json::from_str(out.lines().last().unwrap()).unwrap();
+    for k in ["w", "lambda_s", "lambda_z", "n_s", "n_z", "r", "walls"] {
+        assert!(v.get(k).is_some(), "{k} in {v}");
+    }
+    let walls = v["walls"].as_array().unwrap();
+    assert_eq!(walls.len(), 4);
+    assert!(
+        walls
+            .iter()
+            .all(|w| w["contact_length"].as_f64().unwrap() > 0.0
+                && w["force"].as_f64().unwrap() > 0.0)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("scale,w,lambda_s,lambda_z,n_s,n_z,r,area,regime,contact_0,force_0"));
+    assert_eq!(text.lines().count(), 7);
+    assert!(
+        text.lines().nth(1).unwrap().contains(",free,")
+            && text.lines().last().unwrap().contains(",polygon,")
+    );
+    assert!(std::fs::read(&fig).unwrap().starts_with(b"\x89PNG"));
+    assert_clean_failure(
+        &[
+            "gps",
+            "confine",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--initial-stretch",
+            "1.3",
+            "--plane",
+            "1,0,1.1",
+            "--plane",
+            "0,1,1.1",
+            "--plane",
+            "0,-1,1.1",
+        ],
+        "do not confine the section: it is free to move along (-1.000, 0.000)",
+    );
+    assert_clean_failure(
+        &[
+            "gps",
+            "confine",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--initial-stretch",
+            "1.3",
+            "--plane",
+            "1,0",
+        ],
+        "expected three numbers nx,ny,d",
+    );
+}

@@ -381,16 +381,31 @@ impl Walls<'_> {
 /// Confinement with the gas closed in: the tube inflated to mid-span `initial_stretch` under
 /// `hyp`, then held by `walls` (offsets at scale `s`, e.g. 1). GPS solves eqs. (55)–(60) for
 /// (λs, λz); PS fixes λz = 1 and drops N_z (Sec. 3.7). `guess` = (λs, λz) of a nearby state.
+/// What holds the section's pressure.
+#[derive(Clone, Copy, Debug)]
+enum Load<'a> {
+    /// the gas closed in at the inflated state (Boyle, eq. 60)
+    Gas(&'a crate::InflationState),
+    /// a given pressure ϖ
+    Pressure(f64),
+}
+
 fn solve_at(
     law: &dyn MembraneLaw,
     hyp: Hypothesis,
     ws: &Walls,
     s: f64,
-    initial: &crate::InflationState,
+    load: Load,
     guess: [f64; 2],
 ) -> Result<ConfineState, GpsError> {
-    let at = format!("scale {s} of the wall offsets (λs* = {})", initial.lambda_s);
-    let gas = initial.lambda_z * initial.w * PI * initial.lambda_s.powi(2);
+    let (at, gas, scale_ns) = match load {
+        Load::Gas(initial) => (
+            format!("scale {s} of the wall offsets (λs* = {})", initial.lambda_s),
+            initial.lambda_z * initial.w * PI * initial.lambda_s.powi(2),
+            initial.n_s,
+        ),
+        Load::Pressure(w) => (format!("ϖ = {w}"), f64::NAN, w),
+    };
     let residual = |x: [f64; 2]| -> Result<[f64; 2], tubemem_material::MaterialError> {
         let [ls, lz] = x;
         // a trial λs the walls cannot hold is rejected like a state the law rejects: the
@@ -403,15 +418,26 @@ fn solve_at(
                 requirement: "the membrane must fit the walls' perimeter",
             })?;
         let res = resultants(law, ls, lz)?;
-        let w = res.ns / sec.r;
         let l = 2.0 * PI * ls;
-        match hyp {
-            Hypothesis::Gps => Ok([
-                (res.nz - w * sec.area / l) / initial.n_s,
-                lz * w * sec.area / gas - 1.0,
-            ]),
-            // λz = 1: the second unknown is pinned (residual lz − 1)
-            Hypothesis::Ps => Ok([w * sec.area / gas - 1.0, lz - 1.0]),
+        match load {
+            Load::Gas(_) => {
+                let w = res.ns / sec.r;
+                match hyp {
+                    Hypothesis::Gps => Ok([
+                        (res.nz - w * sec.area / l) / scale_ns,
+                        lz * w * sec.area / gas - 1.0,
+                    ]),
+                    // λz = 1: the second unknown is pinned (residual lz − 1)
+                    Hypothesis::Ps => Ok([w * sec.area / gas - 1.0, lz - 1.0]),
+                }
+            }
+            Load::Pressure(w) => match hyp {
+                Hypothesis::Gps => Ok([
+                    (res.ns - w * sec.r) / (w * sec.r),
+                    (res.nz - w * sec.area / l) / (w * sec.r),
+                ]),
+                Hypothesis::Ps => Ok([(res.ns - w * sec.r) / (w * sec.r), lz - 1.0]),
+            },
         }
     };
     let f = |x: [f64; 2]| {
@@ -553,7 +579,14 @@ pub fn confine_path(
             } else {
                 cur.scale + step
             };
-            match solve_at(law, hyp, &ws, s, &initial, [cur.lambda_s, cur.lambda_z]) {
+            match solve_at(
+                law,
+                hyp,
+                &ws,
+                s,
+                Load::Gas(&initial),
+                [cur.lambda_s, cur.lambda_z],
+            ) {
                 Ok(st) => cur = st,
                 Err(e) => {
                     cuts += 1;
@@ -590,6 +623,104 @@ pub fn confine(
 ) -> Result<ConfineState, GpsError> {
     let path = confine_path(law, hyp, walls, initial_stretch, 2)?;
     Ok(path.last().cloned().expect("a path has at least one state"))
+}
+
+/// The state under a given pressure `w` in `walls` at their offsets (no gas law): the free
+/// inflation at ϖ if the circle fits (on the rising branch, λs below the pressure maximum),
+/// else continued in ϖ from the pressure at first contact.
+pub fn confine_at_pressure(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    walls: &[Wall],
+    w: f64,
+) -> Result<ConfineState, GpsError> {
+    if walls.is_empty() {
+        return Err(GpsError::Walls {
+            message: "no planes given".into(),
+        });
+    }
+    if !(w.is_finite() && w > 0.0) {
+        return Err(crate::invalid(
+            "pressure",
+            w,
+            "the pressure ϖ must be positive",
+        ));
+    }
+    let hold = classify(walls)?;
+    let ws = Walls { walls, hold };
+    let r_in = ws.inradius(1.0);
+    if r_in.is_nan() || r_in <= 0.0 || walls.iter().any(|x| x.offset <= 0.0) {
+        return Err(GpsError::Walls {
+            message: "every plane must have the origin (the tube's axis) on the membrane's side: all offsets d > 0".into(),
+        });
+    }
+    let contact = inflate(law, hyp, r_in.max(1.0))?;
+    let free = |st: crate::InflationState| ConfineState {
+        w: st.w,
+        lambda_s: st.lambda_s,
+        lambda_z: st.lambda_z,
+        n_s: st.n_s,
+        n_z: st.n_z,
+        r: st.lambda_s,
+        area: PI * st.lambda_s.powi(2),
+        regime: Regime::Free,
+        walls: vec![
+            WallContact {
+                contact_length: 0.0,
+                force: 0.0
+            };
+            walls.len()
+        ],
+        scale: 1.0,
+    };
+    if r_in <= 1.0 || w <= contact.w {
+        // the free circle at ϖ: λs on the rising branch up to the contact radius
+        let (mut lo, mut hi) = (1.0, r_in.max(1.0));
+        if w > contact.w {
+            return Err(crate::invalid(
+                "pressure",
+                w,
+                "the walls touch the unstretched tube; give a pressure reached before contact",
+            ));
+        }
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if inflate(law, hyp, mid)?.w < w {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            if hi - lo <= 1e-15 * hi {
+                break;
+            }
+        }
+        return Ok(free(inflate(law, hyp, 0.5 * (lo + hi))?));
+    }
+    // continuation in ϖ from first contact
+    let mut cur = free(contact);
+    let mut step = 0.02 * (w - contact.w).max(1e-3 * w);
+    let mut cuts = 0;
+    while cur.w < w {
+        let target = (cur.w + step).min(w);
+        match solve_at(
+            law,
+            hyp,
+            &ws,
+            1.0,
+            Load::Pressure(target),
+            [cur.lambda_s * (1.0 + 1e-6), cur.lambda_z],
+        ) {
+            Ok(st) => cur = ConfineState { w: target, ..st },
+            Err(e) => {
+                cuts += 1;
+                if cuts > 30 {
+                    return Err(e);
+                }
+                step *= 0.5;
+            }
+        }
+    }
+    Ok(cur)
 }
 
 /// The outline of the section P ⊕ B(r) of `state` in `walls` (offsets at the state's scale):
@@ -856,6 +987,33 @@ mod tests {
         let typical = jumps[first_polygon + 1];
         assert!(at < 3.0 * typical, "jump {at} against {typical}");
         assert!(path.windows(2).all(|p| p[1].w >= p[0].w - 1e-12));
+    }
+
+    /// Pressure control: two plates give the GPS section at that pressure (eq. 76 without the
+    /// gas law, `section_at_pressure`), and below the contact pressure the free inflation.
+    #[test]
+    fn pressure_control_matches_the_section_at_pressure() {
+        let law = abb();
+        let rho = 1.1;
+        let walls = [
+            Wall::new(0.0, 1.0, rho).unwrap(),
+            Wall::new(0.0, -1.0, rho).unwrap(),
+        ];
+        let contact = inflate(&law, Hypothesis::Gps, rho).unwrap().w;
+        let w = 0.8;
+        assert!(w > contact);
+        let c = confine_at_pressure(&law, Hypothesis::Gps, &walls, w).unwrap();
+        let f = crate::section_at_pressure(&law, rho, w, [c.lambda_s, c.lambda_z]).unwrap();
+        assert_eq!(c.regime, Regime::Stadium);
+        assert!(
+            rel(c.lambda_s, f.lambda_s) < 1e-10 && rel(c.lambda_z, f.lambda_z) < 1e-10,
+            "{c:?} {f:?}"
+        );
+        assert!(rel(c.walls[0].force, f.force) < 1e-9);
+        let low = confine_at_pressure(&law, Hypothesis::Gps, &walls, 0.3).unwrap();
+        let g = inflate(&law, Hypothesis::Gps, low.lambda_s).unwrap();
+        assert_eq!(low.regime, Regime::Free);
+        assert!(0.3 < contact && rel(g.w, 0.3) < 1e-12);
     }
 
     #[test]
