@@ -138,8 +138,10 @@ pub struct Figure {
     pub series: Vec<Series>,
     pub markers: Vec<Markers>,
     pub panel: Option<Panel>,
-    /// lines of text printed in the plot's lower right corner
+    /// lines of text printed under the title
     pub notes: Vec<String>,
+    /// one unit of x as long as one unit of y (a cross-section), without a panel
+    pub equal_aspect: bool,
 }
 
 fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
@@ -261,8 +263,22 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
                 .flat_map(|s| s.points.iter())
                 .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
         };
-        let (x0, x1) = range(all().map(|p| p.0), false);
-        let (y0, y1) = range(all().map(|p| p.1), true);
+        let (mut x0, mut x1) = range(all().map(|p| p.0), false);
+        let (mut y0, mut y1) = range(all().map(|p| p.1), !fig.equal_aspect);
+        if fig.equal_aspect {
+            // the plot area's shape: the canvas less the label areas and margins
+            let (w, h) = top.dim_in_pixel();
+            let ratio =
+                (w as f64 - 86.0 - 28.0) / (h as f64 - 58.0 - 28.0 - 20.0 * fig.notes.len() as f64);
+            let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            let (mut hx, mut hy) = (0.5 * (x1 - x0), 0.5 * (y1 - y0));
+            if hx / hy < ratio {
+                hx = hy * ratio;
+            } else {
+                hy = hx / ratio;
+            }
+            (x0, x1, y0, y1) = (cx - hx, cx + hx, cy - hy, cy + hy);
+        }
         // the notes go under the title, above the plot, where no curve can be under them
         let (w, _) = top.dim_in_pixel();
         for (k, note) in fig.notes.iter().enumerate() {
@@ -812,6 +828,7 @@ pub fn write_all(
             markers,
             panel: None,
             notes: vec![],
+            equal_aspect: false,
         },
         &dir.join("fig5_pressure_stretch"),
         opts,
@@ -894,6 +911,7 @@ pub fn write_all(
                 markers,
                 panel,
                 notes,
+                equal_aspect: false,
             },
             &dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}")),
             opts,
@@ -936,6 +954,7 @@ pub fn write_all(
             markers: vec![],
             panel: None,
             notes: vec![],
+            equal_aspect: false,
         },
         &dir.join("fig_lambda_z"),
         opts,

@@ -212,6 +212,7 @@ fn draw_section(
         markers: vec![],
         panel: None,
         notes: vec![],
+        equal_aspect: true,
     };
     let stem = path.with_extension("");
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("png");

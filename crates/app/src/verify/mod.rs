@@ -592,6 +592,7 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             markers: vec![],
             panel: None,
             notes: vec![],
+            equal_aspect: false,
         },
         r,
     );
@@ -911,6 +912,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             markers: vec![],
             panel: None,
             notes: vec![format!("elements around: {arounds:?}")],
+            equal_aspect: false,
         },
         r,
     );
@@ -1031,6 +1033,7 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             }],
             panel: None,
             notes: vec![],
+            equal_aspect: false,
         },
         r,
     );
@@ -1167,6 +1170,7 @@ fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             markers: vec![],
             panel: None,
             notes: vec![],
+            equal_aspect: false,
         },
         r,
     );
