@@ -108,6 +108,7 @@ pub enum Stroke {
 }
 
 /// One curve of a figure.
+#[derive(Clone)]
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64)>,
@@ -117,6 +118,7 @@ pub struct Series {
 }
 
 /// Isolated markers with a legend entry; hollow markers leave the curves under them visible.
+#[derive(Clone)]
 pub struct Markers {
     pub label: String,
     pub points: Vec<(f64, f64)>,
@@ -142,6 +144,8 @@ pub struct Figure {
     pub notes: Vec<String>,
     /// one unit of x as long as one unit of y (a cross-section), without a panel
     pub equal_aspect: bool,
+    /// the y axis starts at 0 (or below)
+    pub y_from_zero: bool,
 }
 
 fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
@@ -264,7 +268,7 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
                 .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
         };
         let (mut x0, mut x1) = range(all().map(|p| p.0), false);
-        let (mut y0, mut y1) = range(all().map(|p| p.1), !fig.equal_aspect);
+        let (mut y0, mut y1) = range(all().map(|p| p.1), fig.y_from_zero);
         if fig.equal_aspect {
             // the plot area's shape: the canvas less the label areas and margins
             let (w, h) = top.dim_in_pixel();
@@ -819,6 +823,36 @@ pub fn write_all(
             });
         }
     }
+    // the λs* = 1.3 branches are short on the whole curve: a zoom on them (every series and
+    // marker clipped to the window around the branches)
+    let (zx0, zx1, zy0, zy1) = {
+        let pts = flattening[0].iter().flatten();
+        let (mut x0, mut x1, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for p in pts {
+            x0 = x0.min(p.lambda_s);
+            x1 = x1.max(p.lambda_s);
+            y1 = y1.max(p.w);
+        }
+        let pad = 0.15 * (x1 - x0).max(1e-3);
+        (x0 - pad, x1 + pad, 0.0, y1 * 1.05)
+    };
+    let inside = |p: &(f64, f64)| p.0 >= zx0 && p.0 <= zx1 && p.1 >= zy0 && p.1 <= zy1;
+    let zoom_series: Vec<Series> = series
+        .iter()
+        .map(|s| Series {
+            points: s.points.iter().copied().filter(inside).collect(),
+            ..s.clone()
+        })
+        .filter(|s| s.points.len() >= 2)
+        .collect();
+    let zoom_markers: Vec<Markers> = markers
+        .iter()
+        .map(|m| Markers {
+            points: m.points.iter().copied().filter(inside).collect(),
+            ..m.clone()
+        })
+        .filter(|m| !m.points.is_empty())
+        .collect();
     written.extend(save(
         &Figure {
             title: format!("Fig. 5 — reduced pressure vs hoop stretch ({name})"),
@@ -829,8 +863,24 @@ pub fn write_all(
             panel: None,
             notes: vec![],
             equal_aspect: false,
+            y_from_zero: true,
         },
         &dir.join("fig5_pressure_stretch"),
+        opts,
+    )?);
+    written.extend(save(
+        &Figure {
+            title: format!("Fig. 5, zoom on the flattening from λs* = 1.3 ({name})"),
+            x_label: "hoop stretch λs".into(),
+            y_label: "reduced pressure ϖ = pR/(μH)".into(),
+            series: zoom_series,
+            markers: zoom_markers,
+            panel: None,
+            notes: vec![],
+            equal_aspect: false,
+            y_from_zero: false,
+        },
+        &dir.join("fig5_zoom_ls1.3"),
         opts,
     )?);
 
@@ -912,6 +962,7 @@ pub fn write_all(
                 panel,
                 notes,
                 equal_aspect: false,
+                y_from_zero: true,
             },
             &dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}")),
             opts,
@@ -955,6 +1006,7 @@ pub fn write_all(
             panel: None,
             notes: vec![],
             equal_aspect: false,
+            y_from_zero: true,
         },
         &dir.join("fig_lambda_z"),
         opts,

@@ -213,6 +213,7 @@ fn draw_section(
         panel: None,
         notes: vec![],
         equal_aspect: true,
+        y_from_zero: false,
     };
     let stem = path.with_extension("");
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("png");

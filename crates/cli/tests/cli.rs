@@ -413,6 +413,7 @@ fn figures_writes_pngs_and_csvs() {
     );
     for f in [
         "fig5_pressure_stretch.png",
+        "fig5_zoom_ls1.3.png",
         "fig6_force_displacement_ls1.3.png",
         "fig7_force_displacement_ls6.0.png",
         "fig_lambda_z.png",

@@ -593,6 +593,7 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             panel: None,
             notes: vec![],
             equal_aspect: false,
+            y_from_zero: true,
         },
         r,
     );
@@ -913,6 +914,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             panel: None,
             notes: vec![format!("elements around: {arounds:?}")],
             equal_aspect: false,
+            y_from_zero: true,
         },
         r,
     );
@@ -1034,6 +1036,7 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             panel: None,
             notes: vec![],
             equal_aspect: false,
+            y_from_zero: true,
         },
         r,
     );
@@ -1171,6 +1174,7 @@ fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             panel: None,
             notes: vec![],
             equal_aspect: false,
+            y_from_zero: true,
         },
         r,
     );
