@@ -258,6 +258,30 @@ pub struct MeshSpec {
 pub enum Kind {
     Inflate,
     Squeeze,
+    /// planes moved in together with the gas closed (paper Sec. 3.6 for any walls)
+    Confine,
+}
+
+/// One `[[stage.plane]]` of a confine stage: the wall {x : n·x = d} in the cross-section, the
+/// membrane on n·x ≤ d; `offset` is d at the start of the stage and `target` at its end (moved
+/// linearly in the stage's load parameter, 0 → 1).
+#[derive(Debug, Deserialize, Serialize, Clone, Copy, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSpec {
+    pub normal: [f64; 2],
+    pub offset: f64,
+    pub target: f64,
+}
+
+impl PlaneSpec {
+    /// The wall at load parameter `t` ∈ [0, 1] (the closed form's convention, unit normal).
+    pub fn wall_at(&self, t: f64) -> Result<tubemem_gps::confine::Wall, tubemem_gps::GpsError> {
+        tubemem_gps::confine::Wall::new(
+            self.normal[0],
+            self.normal[1],
+            self.offset + t * (self.target - self.offset),
+        )
+    }
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -282,6 +306,9 @@ pub struct StageSpec {
     pub target_pressure: Option<f64>,
     pub target_stretch: Option<f64>,
     pub target_volume_ratio: Option<f64>,
+    /// confine only: the planes
+    #[serde(default)]
+    pub plane: Vec<PlaneSpec>,
     #[serde(default = "default_steps")]
     pub steps: usize,
 }
@@ -302,6 +329,8 @@ pub enum Target {
     VolumeRatio(f64),
     /// squeeze between plates y = ±ρR with the gas closed in
     Rho(f64),
+    /// the stage's planes (their number) moved from `offset` to `target` with the gas closed
+    Confine(usize),
 }
 
 impl Target {
@@ -312,6 +341,7 @@ impl Target {
             Target::Stretch(s) => format!("inflate, mid-span stretch control to λs = {s}"),
             Target::VolumeRatio(r) => format!("inflate, volume control to V/V0 = {r}"),
             Target::Rho(r) => format!("squeeze, closed gas, plates to ρ = {r}"),
+            Target::Confine(n) => format!("confine, closed gas, {n} planes to their targets"),
         }
     }
 }
@@ -346,8 +376,8 @@ impl StageSpec {
     pub fn plan(&self, i: usize) -> Result<StagePlan, CaseError> {
         let target = self.target(i)?;
         let penalty = match (self.kind, self.penalty, self.penetration_tolerance) {
-            (Kind::Squeeze, Some(k), _) => Some(PenaltySpec::Value(k)),
-            (Kind::Squeeze, None, t) => Some(PenaltySpec::Tolerance(
+            (Kind::Squeeze | Kind::Confine, Some(k), _) => Some(PenaltySpec::Value(k)),
+            (Kind::Squeeze | Kind::Confine, None, t) => Some(PenaltySpec::Tolerance(
                 t.unwrap_or(DEFAULT_PENETRATION_TOLERANCE),
             )),
             _ => None,
@@ -385,12 +415,57 @@ impl StageSpec {
             ),
             (Kind::Squeeze, None, (None, None, None, Some(r))) => Target::Rho(r),
             (Kind::Squeeze, None, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
+            (Kind::Confine, Some(_), _) => invalid!(
+                "[[stage]] {}: a confine stage keeps the gas closed (Boyle); it takes no `control`",
+                i + 1
+            ),
+            (Kind::Confine, None, (None, None, None, None)) => Target::Confine(self.plane.len()),
+            (Kind::Confine, None, _) => invalid!(
+                "[[stage]] {}: kind = \"confine\" moves its [[stage.plane]]s to their `target`s; it takes no target_pressure, target_stretch, target_volume_ratio or target_rho",
+                i + 1
+            ),
         };
+        if self.kind != Kind::Confine && !self.plane.is_empty() {
+            invalid!(
+                "[[stage]] {}: [[stage.plane]] belongs to kind = \"confine\" stages",
+                i + 1
+            );
+        }
+        if let Target::Confine(_) = t {
+            if self.plane.is_empty() {
+                invalid!(
+                    "[[stage]] {}: kind = \"confine\" needs at least one [[stage.plane]] (normal = [nx, ny], offset, target)",
+                    i + 1
+                );
+            }
+            for (k, p) in self.plane.iter().enumerate() {
+                let finite = p.normal.iter().all(|v| v.is_finite())
+                    && p.offset.is_finite()
+                    && p.target.is_finite();
+                if !finite || p.normal[0].hypot(p.normal[1]) == 0.0 {
+                    invalid!(
+                        "[[stage]] {}, plane {}: `normal` must be a finite non-zero [nx, ny] and `offset`, `target` finite",
+                        i + 1,
+                        k + 1
+                    );
+                }
+            }
+            let walls = self
+                .plane
+                .iter()
+                .map(|p| p.wall_at(1.0))
+                .collect::<Result<Vec<_>, _>>()
+                .and_then(|w| tubemem_gps::confine::check_walls(&w).map(|_| w));
+            if let Err(e) = walls {
+                invalid!("[[stage]] {}: the planes at their targets: {e}", i + 1);
+            }
+        }
         let (name, v, ok) = match t {
             Target::Pressure(p) => ("target_pressure", p, p.is_finite() && p >= 0.0),
             Target::Stretch(s) => ("target_stretch", s, s.is_finite() && s >= 1.0),
             Target::VolumeRatio(r) => ("target_volume_ratio", r, r.is_finite() && r >= 1.0),
             Target::Rho(r) => ("target_rho", r, r.is_finite() && r > 0.0),
+            Target::Confine(n) => ("plane", n as f64, n >= 1),
         };
         if !ok {
             invalid!(
@@ -508,9 +583,9 @@ impl Case {
         let mut plan = Vec::with_capacity(self.stages.len());
         for (i, s) in self.stages.iter().enumerate() {
             plan.push(s.plan(i)?);
-            if s.kind == Kind::Squeeze && i == 0 {
+            if matches!(s.kind, Kind::Squeeze | Kind::Confine) && i == 0 {
                 invalid!(
-                    "[[stage]] 1: a squeeze needs an inflated tube: put an inflate stage before it"
+                    "[[stage]] 1: a squeeze or confine stage needs an inflated tube: put an inflate stage before it"
                 );
             }
         }

@@ -4,6 +4,7 @@
 //! * `vtu/step_NNNNN.vtu` + `tube.pvd`: a frame per step (frame 0 is the reference state); the
 //!   PVD timestep is the load path: stage − 1 + the fraction of the stage done;
 //! * `profiles/stageN_final.csv`: the profile along the tube at each stage end;
+//! * `walls.csv`: confine stages, each wall at every step ([`WALLS_HEADER`]);
 //! * `profiles/profiles.csv`: the profile at every converged step ([`PROFILES_HEADER`]; `row`
 //!   is the step's row in steps.csv), unless `[output] profiles = "stage-end"`;
 //! * `summary.json`: [`RunReport::summary`], rewritten (atomically: write, then rename) after
@@ -103,9 +104,10 @@ pub enum FolderMode {
 }
 
 /// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
-pub const RUN_ENTRIES: [&str; 9] = [
+pub const RUN_ENTRIES: [&str; 10] = [
     "checkpoints",
     "steps.csv",
+    "walls.csv",
     "summary.json",
     "run.json",
     "tube.pvd",
@@ -158,6 +160,7 @@ pub struct RunWriter {
     dir: PathBuf,
     steps: Option<BufWriter<File>>,
     profiles: Option<BufWriter<File>>,
+    walls: Option<BufWriter<File>>,
     pvd: Vec<(f64, String)>,
     frames: usize,
     rows: usize,
@@ -323,6 +326,24 @@ impl RunWriter {
             .open(&path)
             .map_err(|e| AppError::io(&path, e))?;
         w.steps = Some(BufWriter::new(steps));
+        // walls.csv: the rows of the kept steps (appended to from here on)
+        let walls_path = dir.join("walls.csv");
+        if let Ok(text) = std::fs::read_to_string(&walls_path) {
+            let kept: Vec<&str> = text
+                .lines()
+                .enumerate()
+                .filter(|(k, l)| {
+                    *k == 0
+                        || l.split(',')
+                            .next()
+                            .and_then(|r| r.parse::<usize>().ok())
+                            .is_some_and(|r| r <= ck.rows)
+                })
+                .map(|(_, l)| l)
+                .collect();
+            std::fs::write(&walls_path, format!("{}\n", kept.join("\n")))
+                .map_err(|e| AppError::io(&walls_path, e))?;
+        }
         // profiles.csv: the rows of the kept steps
         let path = dir.join("profiles").join("profiles.csv");
         if let Ok(text) = std::fs::read_to_string(&path) {
@@ -387,6 +408,7 @@ impl RunWriter {
             dir: dir.to_path_buf(),
             steps: None,
             profiles: None,
+            walls: None,
             pvd: vec![],
             frames: 0,
             rows: 0,
@@ -640,6 +662,10 @@ pub const PROFILE_HEADER: &str =
     "z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width,contact_force";
 /// The columns of profiles.csv: the step's row in steps.csv, its stage and step, then
 /// [`PROFILE_HEADER`].
+/// The columns of walls.csv (confine stages): the step's row in steps.csv, stage, step, the
+/// wall (1-based, the case's order), the FE's mid-span contact length, force per length over π
+/// and penetration, then GPS for the same walls and GPS under the FE's pressure.
+pub const WALLS_HEADER: &str = "row,stage,step,wall,contact_length,force,penetration,gps_contact_length,gps_force,local_contact_length,local_force";
 pub const PROFILES_HEADER: &str =
     "row,stage,step,z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width,contact_force";
 
@@ -711,6 +737,59 @@ impl Observer for RunWriter {
             writeln!(steps, "{}", format_row(view.record))?;
             steps.flush()?;
             self.rows += 1;
+        }
+        if !view.record.walls.is_empty() {
+            if self.walls.is_none() {
+                let path = self.dir.join("walls.csv");
+                let fresh = !path.exists();
+                let f = std::fs::OpenOptions::new()
+                    .create(true)
+                    .append(true)
+                    .open(&path)
+                    .map_err(|e| AppError::io(&path, e))?;
+                let mut w = BufWriter::new(f);
+                if fresh {
+                    writeln!(w, "{WALLS_HEADER}")?;
+                }
+                self.walls = Some(w);
+            }
+            if let Some(out) = &mut self.walls {
+                let r = view.record;
+                let cf = |c: &Option<tubemem_gps::confine::ConfineState>, k: usize| {
+                    c.as_ref()
+                        .and_then(|c| c.walls.get(k))
+                        .map_or([f64::NAN; 2], |w| [w.contact_length, w.force])
+                };
+                for (k, w) in r.walls.iter().enumerate() {
+                    let g = cf(&r.closed_form.gps_confine, k);
+                    let l = cf(&r.closed_form.local_confine, k);
+                    let vals = [
+                        self.rows as f64,
+                        r.stage as f64,
+                        r.step as f64,
+                        (k + 1) as f64,
+                        w.contact_length,
+                        w.force,
+                        w.penetration,
+                        g[0],
+                        g[1],
+                        l[0],
+                        l[1],
+                    ];
+                    let fields: Vec<String> = vals
+                        .iter()
+                        .map(|v| {
+                            if v.is_finite() {
+                                v.to_string()
+                            } else {
+                                String::new()
+                            }
+                        })
+                        .collect();
+                    writeln!(out, "{}", fields.join(","))?;
+                }
+                out.flush()?;
+            }
         }
         if let Some(profiles) = &mut self.profiles {
             let r = view.record;

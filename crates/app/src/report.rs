@@ -4,7 +4,9 @@
 
 use crate::case::{StagePlan, Target};
 use serde::{Deserialize, Serialize};
+use tubemem_fem::post::WallValues;
 use tubemem_fem::post::{ContactValues, MidSpan, RingValues};
+use tubemem_gps::confine::ConfineState;
 use tubemem_gps::{FlatteningState, InflationState, SectionState};
 use tubemem_material::MaterialSpec;
 
@@ -36,6 +38,12 @@ pub struct StepClosedForm {
     pub gps_flattening: Option<FlatteningState>,
     /// `None` for inflation steps or when the GPS flattening itself failed
     pub local: Option<Result<SectionState, String>>,
+    /// a confine step: GPS for the same walls from the run's λs* (eqs. 55–60)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gps_confine: Option<ConfineState>,
+    /// a confine step: the section in the same walls under the FE's own pressure
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_confine: Option<ConfineState>,
 }
 
 /// Contact values of a squeeze step (mid-span, [`ContactValues`]) with the displacement λs* − ρ.
@@ -64,6 +72,9 @@ pub struct StepRecord {
     /// the Newton residual history of the step
     pub residuals: Vec<f64>,
     pub contact: Option<ContactRecord>,
+    /// a confine step: each wall's mid-span contact, for the whole tube, in the case's order
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<WallValues>,
     pub closed_form: StepClosedForm,
     /// the profile along the tube at this step (`[output] profiles = "every"`, the default;
     /// empty otherwise)
@@ -122,6 +133,7 @@ pub struct RelativeErrors {
 #[serde(untagged)]
 pub enum ClosedFormState {
     // (untagged: deserialization tries the variants in order, so the larger one comes first)
+    Confine(Box<ConfineState>),
     Flattening(FlatteningState),
     Inflation(InflationState),
 }
@@ -171,6 +183,21 @@ pub struct StageSummary {
     pub gps_at_fe_pressure: Option<LocalSection>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relative_error_vs_gps_at_fe_pressure: Option<RelativeErrors>,
+    /// a confine stage: each wall at the end, FE against GPS and the section at the FE's
+    /// pressure
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<WallSummary>,
+}
+
+/// One wall at the end of a confine stage.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct WallSummary {
+    pub fe: WallValues,
+    pub gps: Option<tubemem_gps::confine::WallContact>,
+    pub local: Option<tubemem_gps::confine::WallContact>,
+    /// FE/GPS − 1 of the force per unit length
+    pub force_error_vs_gps: Option<f64>,
+    pub force_error_vs_gps_at_fe_pressure: Option<f64>,
 }
 
 /// A stage that failed: its error and the last converged mid-span state.

@@ -124,6 +124,8 @@ fn step_closed_form(
             gps_inflation: inflate(law, Hypothesis::Gps, ms.lambda_s).ok(),
             gps_flattening: None,
             local: None,
+            gps_confine: None,
+            local_confine: None,
         },
         Some((c, ls0)) => {
             let g = flatten(law, Hypothesis::Gps, ls0, c.rho).ok();
@@ -135,6 +137,8 @@ fn step_closed_form(
                 gps_inflation: None,
                 gps_flattening: g,
                 local,
+                gps_confine: None,
+                local_confine: None,
             }
         }
     }
@@ -367,6 +371,7 @@ pub struct RunOptions {
 #[allow(clippy::too_many_arguments)]
 fn setup_stage(
     plan: &StagePlan,
+    planes: &[crate::case::PlaneSpec],
     stages: usize,
     model: &mut Model,
     state: &mut State,
@@ -423,7 +428,8 @@ fn setup_stage(
         Target::VolumeRatio(_) => Some(model.total_volume(&state.x)),
         _ => None,
     };
-    if state.p == 0.0 && !matches!(plan.target, Target::Rho(_)) {
+    let closed_gas = matches!(plan.target, Target::Rho(_) | Target::Confine(_));
+    if state.p == 0.0 && !closed_gas {
         let estimate = match plan.target {
             Target::Pressure(p) => Some(p),
             Target::Stretch(s) => inflate(closed_form_law, Hypothesis::Gps, s)
@@ -432,7 +438,7 @@ fn setup_stage(
             Target::VolumeRatio(r) => inflate(closed_form_law, Hypothesis::Gps, r.cbrt())
                 .ok()
                 .map(|g| g.w),
-            Target::Rho(_) => None,
+            Target::Rho(_) | Target::Confine(_) => None,
         };
         let mut pre = settings;
         let target_pressure = matches!(plan.target, Target::Pressure(_));
@@ -536,6 +542,69 @@ fn setup_stage(
             };
             (h0, rho, penalty)
         }
+        Target::Confine(_) => {
+            if state.p.is_nan() || state.p <= 0.0 {
+                return Err(fail_input(
+                    report,
+                    format!(
+                        "the tube holds no gas pressure to confine (ϖ = {})",
+                        state.p
+                    ),
+                ));
+            }
+            // no plane may start inside the tube
+            for (k, p) in planes.iter().enumerate() {
+                let len = p.normal[0].hypot(p.normal[1]);
+                let reach = state
+                    .x
+                    .iter()
+                    .map(|x| (p.normal[0] * x[0] + p.normal[1] * x[1]) / len)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                if reach > p.offset / len {
+                    return Err(fail_input(report, format!(
+                        "plane {}: `offset` = {} cuts the tube, which reaches n·x = {reach:.6} along its normal: start it further out",
+                        k + 1,
+                        p.offset
+                    )));
+                }
+            }
+            // the planes must have the model's symmetry
+            let sym = model.mesh().symmetry.planes();
+            for (axis, name) in [(0usize, "x = 0"), (1usize, "y = 0")] {
+                if !sym.contains(&axis) {
+                    continue;
+                }
+                for (k, p) in planes.iter().enumerate() {
+                    let mut m = p.normal;
+                    m[axis] = -m[axis];
+                    let mirrored = planes.iter().any(|q| {
+                        (q.normal[0] - m[0]).abs() <= 1e-12 * (1.0 + m[0].abs())
+                            && (q.normal[1] - m[1]).abs() <= 1e-12 * (1.0 + m[1].abs())
+                            && (q.offset - p.offset).abs() <= 1e-12 * (1.0 + p.offset.abs())
+                            && (q.target - p.target).abs() <= 1e-12 * (1.0 + p.target.abs())
+                    });
+                    if !mirrored {
+                        return Err(fail_input(report, format!(
+                            "plane {} has no mirror image across {name}, a symmetry plane of the model (symmetry = {:?}): give its mirror plane too, or use a model without that symmetry",
+                            k + 1,
+                            model.mesh().symmetry
+                        )));
+                    }
+                }
+            }
+            let penalty = match plan.penalty {
+                Some(PenaltySpec::Value(k)) => k,
+                Some(PenaltySpec::Tolerance(t)) => {
+                    penalty_for(state.p, start.lambda_s * start.lambda_z, t)
+                }
+                None => penalty_for(
+                    state.p,
+                    start.lambda_s * start.lambda_z,
+                    crate::case::DEFAULT_PENETRATION_TOLERANCE,
+                ),
+            };
+            (0.0, 1.0, penalty)
+        }
     };
     match (prestressed_from, from_before) {
         (Some(f), _) | (None, Some(f)) => from = f,
@@ -545,15 +614,30 @@ fn setup_stage(
         stage: i,
         from,
         to,
-        pv: if matches!(plan.target, Target::Rho(_)) {
-            pv
-        } else {
-            0.0
-        },
+        pv: if closed_gas { pv } else { 0.0 },
         penalty,
         // a squeeze that continues a squeeze compares with the flattening from the same λs*
         start_lambda_s: previous_squeeze.map_or(start.lambda_s, |c| c.initial_stretch),
     })
+}
+
+/// The FE contact of a confine stage at load parameter `t`: each wall n·x ≤ d as the kernel's
+/// plane with gap −n·x + d ≥ 0 (unit normal, in the cross-section plane).
+pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Contact {
+    Contact {
+        planes: planes
+            .iter()
+            .map(|p| {
+                let len = p.normal[0].hypot(p.normal[1]);
+                let d = p.offset + t * (p.target - p.offset);
+                tubemem_fem::contact::Plane {
+                    normal: [-p.normal[0] / len, -p.normal[1] / len, 0.0],
+                    offset: -d / len,
+                }
+            })
+            .collect(),
+        penalty,
+    }
 }
 
 /// Run a validated case; `label` names it in the report. Observers see every converged step as
@@ -694,6 +778,7 @@ fn run_inner(
             None => {
                 let ctx = setup_stage(
                     plan,
+                    &case.stages[i - 1].plane,
                     stages,
                     &mut model,
                     &mut state,
@@ -724,6 +809,12 @@ fn run_inner(
             Target::Rho(_) => Box::new(move |h| {
                 Load::with_contact(Loading::Gas { pv }, Contact::plates(h, penalty))
             }),
+            Target::Confine(_) => {
+                let planes = case.stages[i - 1].plane.clone();
+                Box::new(move |t| {
+                    Load::with_contact(Loading::Gas { pv }, fe_planes(&planes, t, penalty))
+                })
+            }
         };
         let stage = Stage {
             index: i,
@@ -733,6 +824,8 @@ fn run_inner(
         };
         let mut steps: Vec<StepRecord> = restored;
         let every_profile = case.output.profiles == crate::case::ProfileFrames::Every;
+        let confine_planes =
+            matches!(plan.target, Target::Confine(_)).then(|| case.stages[i - 1].plane.clone());
         let finished: &RunReport = report;
         let result = run_stage_from(
             &mut model,
@@ -742,7 +835,12 @@ fn run_inner(
             &load,
             |m, st, info| {
                 let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
-                let contact = info.load.contact.as_ref().and_then(|c| {
+                let plates = if confine_planes.is_some() {
+                    None
+                } else {
+                    info.load.contact.as_ref()
+                };
+                let contact = plates.and_then(|c| {
                     midspan_contact(m, st, c).map(|values| ContactRecord {
                         values,
                         displacement: start_lambda_s - values.rho,
@@ -783,11 +881,58 @@ fn run_inner(
                         values: vals,
                     }) as BoxError);
                 }
-                let closed_form = step_closed_form(
+                let mut closed_form = step_closed_form(
                     closed_form_law.as_ref(),
                     &ms,
                     contact.as_ref().map(|c| (&c.values, start_lambda_s)),
                 );
+                // a confine stage: each wall, and the closed form for the same walls
+                let walls = match (&confine_planes, info.load.contact.as_ref()) {
+                    (Some(planes), Some(c)) => {
+                        let w = tubemem_fem::post::midspan_walls(m, st, c);
+                        let d_min = planes
+                            .iter()
+                            .map(|p| {
+                                (p.offset + info.value * (p.target - p.offset)).abs()
+                                    / p.normal[0].hypot(p.normal[1])
+                            })
+                            .fold(f64::INFINITY, f64::min);
+                        let pen = w.iter().map(|v| v.penetration).fold(0.0, f64::max);
+                        if pen.is_nan() || pen > MAX_PENETRATION_FRACTION * d_min {
+                            return Err(Box::new(AppError::ContactUnresolved {
+                                stage: i,
+                                step: info.step,
+                                penetration: pen,
+                                rho: d_min,
+                                penalty: c.penalty,
+                            }) as BoxError);
+                        }
+                        if let Ok(gw) = planes
+                            .iter()
+                            .map(|p| p.wall_at(info.value))
+                            .collect::<Result<Vec<_>, _>>()
+                        {
+                            let law = closed_form_law.as_ref();
+                            closed_form.gps_inflation = None;
+                            closed_form.gps_confine = tubemem_gps::confine::confine(
+                                law,
+                                Hypothesis::Gps,
+                                &gw,
+                                start_lambda_s,
+                            )
+                            .ok();
+                            closed_form.local_confine = tubemem_gps::confine::confine_at_pressure(
+                                law,
+                                Hypothesis::Gps,
+                                &gw,
+                                ms.w,
+                            )
+                            .ok();
+                        }
+                        w
+                    }
+                    _ => vec![],
+                };
                 let profile = if every_profile {
                     ring_profile(m, st, info.load.contact.as_ref())
                         .map_err(|e| Box::new(e) as BoxError)?
@@ -803,6 +948,7 @@ fn run_inner(
                     negative_pivots: info.newton.inertia.negative_pivots,
                     residuals: info.newton.history.clone(),
                     contact,
+                    walls,
                     closed_form,
                     profile,
                 };
@@ -886,15 +1032,69 @@ fn run_inner(
         };
         let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
         let wrinkling = wrinkle_report(&model, &state, i)?;
-        let ([(gps, gps_err), (ps, ps_err)], local_section, local_err) = stage_closed_form(
-            closed_form_law.as_ref(),
-            &ms,
-            contact.as_ref(),
-            last_cf.as_ref(),
-        )?;
+        let ([(mut gps, mut gps_err), (mut ps, mut ps_err)], local_section, mut local_err) =
+            stage_closed_form(
+                closed_form_law.as_ref(),
+                &ms,
+                contact.as_ref(),
+                last_cf.as_ref(),
+            )?;
+        // a confine stage: the closed form for the same walls, GPS and PS, and each wall
+        let mut wall_summary = vec![];
+        if let (Some(planes), Some(last)) = (&confine_planes, steps.last()) {
+            let law = closed_form_law.as_ref();
+            let walls = planes
+                .iter()
+                .map(|p| p.wall_at(last.load))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| AppError::gps("the confine stage's planes", e))?;
+            let errors = |c: &tubemem_gps::confine::ConfineState| RelativeErrors {
+                w: Some(rel(ms.w, c.w)),
+                lambda_s: Some(rel(ms.lambda_s, c.lambda_s)),
+                lambda_z: Some(rel(ms.lambda_z, c.lambda_z)),
+                ..Default::default()
+            };
+            let g = match &last.closed_form.gps_confine {
+                Some(g) => g.clone(),
+                None => tubemem_gps::confine::confine(law, Hypothesis::Gps, &walls, start_lambda_s)
+                    .map_err(|e| AppError::gps("GPS for the confine stage's walls", e))?,
+            };
+            let p = tubemem_gps::confine::confine(law, Hypothesis::Ps, &walls, start_lambda_s)
+                .map_err(|e| AppError::gps("PS for the confine stage's walls", e))?;
+            gps_err = errors(&g);
+            ps_err = errors(&p);
+            let local = last.closed_form.local_confine.clone();
+            local_err = local.as_ref().map(|l| RelativeErrors {
+                w: None,
+                ..errors(l)
+            });
+            wall_summary = last
+                .walls
+                .iter()
+                .enumerate()
+                .map(|(k, fe)| {
+                    let gk = g.walls.get(k).copied();
+                    let lk = local.as_ref().and_then(|l| l.walls.get(k).copied());
+                    let err = |c: Option<tubemem_gps::confine::WallContact>| {
+                        c.filter(|c| c.force > 0.0).map(|c| rel(fe.force, c.force))
+                    };
+                    crate::report::WallSummary {
+                        fe: *fe,
+                        gps: gk,
+                        local: lk,
+                        force_error_vs_gps: err(gk),
+                        force_error_vs_gps_at_fe_pressure: err(lk),
+                    }
+                })
+                .collect();
+            gps = ClosedFormState::Confine(Box::new(g));
+            ps = ClosedFormState::Confine(Box::new(p));
+        }
         let summary = StageSummary {
             index: i,
-            kind: if contact.is_some() {
+            kind: if confine_planes.is_some() {
+                "confine".into()
+            } else if contact.is_some() {
                 "squeeze".into()
             } else {
                 "inflate".into()
@@ -928,6 +1128,7 @@ fn run_inner(
             relative_error_vs_ps: ps_err,
             gps_at_fe_pressure: local_section,
             relative_error_vs_gps_at_fe_pressure: local_err,
+            walls: wall_summary,
         };
         report.stages.push(StageReport {
             plan: *plan,

@@ -216,3 +216,87 @@ fn a_squeeze_after_a_squeeze_ends_where_one_squeeze_ends() {
         ) < 1e-6
     );
 }
+
+/// A confine stage with two plates y = ±ρ is the squeeze: started from just outside the tube,
+/// it ends in the squeeze's state (ϖ, λs, λz to 1e-7: both stop Newton at 1e-9 of the residual
+/// and the penalty is the same), and its top wall carries the squeeze's force per length; its
+/// closed form is the flattening's. Walls the model's symmetry cannot hold, walls that start
+/// inside the tube and planes on the wrong stage are refused with their stage and plane.
+#[test]
+fn a_confine_stage_with_two_plates_is_the_squeeze() {
+    let squeeze = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
+    let rs = run(&squeeze, "squeeze", &mut []).into_result().unwrap();
+    let plates = "\n[[stage]]\nkind = \"confine\"\nsteps = 4\n[[stage.plane]]\nnormal = [0, 1]\noffset = 1.21\ntarget = 1.0\n[[stage.plane]]\nnormal = [0, -1]\noffset = 1.21\ntarget = 1.0\n";
+    let confine = Case::parse(&format!("{SMALL}{plates}")).unwrap();
+    let rc = run(&confine, "confine", &mut []).into_result().unwrap();
+    let (a, b) = (rs.steps().last().unwrap(), rc.steps().last().unwrap());
+    let rel = |x: f64, y: f64| (x / y - 1.0).abs();
+    assert!(
+        rel(b.midspan.w, a.midspan.w) < 1e-7,
+        "{} {}",
+        b.midspan.w,
+        a.midspan.w
+    );
+    assert!(rel(b.midspan.lambda_s, a.midspan.lambda_s) < 1e-7);
+    assert!(rel(b.midspan.lambda_z, a.midspan.lambda_z) < 1e-7);
+    assert_eq!(b.walls.len(), 2);
+    let force = a.contact.as_ref().unwrap().values.force;
+    assert!(
+        rel(b.walls[0].force, force) < 1e-6,
+        "{} {force}",
+        b.walls[0].force
+    );
+    assert_eq!(b.walls[1].force, b.walls[0].force);
+    let g = b.closed_form.gps_confine.as_ref().unwrap();
+    let f = a.closed_form.gps_flattening.as_ref().unwrap();
+    assert!(rel(g.w, f.w) < 1e-9 && rel(g.walls[0].force, f.force) < 1e-9);
+    match &rc.stages[1].outcome {
+        StageOutcome::Finished(s) => {
+            assert_eq!(s.kind, "confine");
+            assert_eq!(s.walls.len(), 2);
+        }
+        o => panic!("{o:?}"),
+    }
+    // refused: walls without their mirror in the eighth model, a wall inside the tube, planes on
+    // an inflate stage, no planes, walls open at their targets
+    let one_side = plates.replace(
+        "normal = [0, -1]\noffset = 1.21",
+        "normal = [0, -1]\noffset = 1.5",
+    );
+    let err = run(
+        &Case::parse(&format!("{SMALL}{one_side}")).unwrap(),
+        "x",
+        &mut [],
+    )
+    .into_result()
+    .unwrap_err()
+    .chain();
+    assert!(
+        err.contains("plane 1 has no mirror image across y = 0"),
+        "{err}"
+    );
+    let inside = plates.replace("offset = 1.21", "offset = 1.1");
+    let err = run(
+        &Case::parse(&format!("{SMALL}{inside}")).unwrap(),
+        "x",
+        &mut [],
+    )
+    .into_result()
+    .unwrap_err()
+    .chain();
+    assert!(
+        err.contains("[[stage]] 2") && err.contains("plane 1: `offset` = 1.1 cuts the tube"),
+        "{err}"
+    );
+    let wrong = format!("{SMALL}[[stage.plane]]\nnormal = [0, 1]\noffset = 1.2\ntarget = 1.0\n");
+    let err = Case::parse(&wrong).unwrap_err().to_string();
+    assert!(err.contains("belongs to kind = \"confine\""), "{err}");
+    let none = format!("{SMALL}\n[[stage]]\nkind = \"confine\"\n");
+    assert!(Case::parse(&none)
+        .unwrap_err()
+        .to_string()
+        .contains("at least one [[stage.plane]]"));
+    let open = format!("{SMALL}\n[[stage]]\nkind = \"confine\"\n[[stage.plane]]\nnormal = [0, 1]\noffset = 1.3\ntarget = 1.0\n");
+    let err = Case::parse(&open).unwrap_err().to_string();
+    assert!(err.contains("do not confine"), "{err}");
+}

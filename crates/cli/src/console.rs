@@ -158,6 +158,21 @@ impl Observer for Console {
                 )?;
             }
         }
+        for (k, w) in s.walls.iter().enumerate() {
+            let gps = w.gps.map_or(f64::NAN, |g| g.force);
+            let local = w.local.map_or(f64::NAN, |g| g.force);
+            say!(
+                "         wall {}: contact {:.5} R, force {:.5} (GPS {:.5}, {:+.2}%; GPS at the FE's pressure {:.5}, {:+.2}%), penetration {:.1e}",
+                k + 1,
+                w.fe.contact_length,
+                w.fe.force,
+                gps,
+                100.0 * w.force_error_vs_gps.unwrap_or(f64::NAN),
+                local,
+                100.0 * w.force_error_vs_gps_at_fe_pressure.unwrap_or(f64::NAN),
+                w.fe.penetration
+            )?;
+        }
         if let Some(d) = s.cap_boundary_layer {
             say!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)")?;
         }
@@ -189,5 +204,6 @@ fn values(c: &ClosedFormState) -> (f64, f64, f64, f64, f64) {
     match c {
         ClosedFormState::Inflation(g) => (g.w, g.lambda_s, g.lambda_z, f64::NAN, f64::NAN),
         ClosedFormState::Flattening(g) => (g.w, g.lambda_s, g.lambda_z, g.chi, g.force),
+        ClosedFormState::Confine(g) => (g.w, g.lambda_s, g.lambda_z, f64::NAN, f64::NAN),
     }
 }

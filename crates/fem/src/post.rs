@@ -434,6 +434,22 @@ fn ring_force(
     touching: impl Iterator<Item = usize>,
     fe: impl Fn(usize) -> f64,
 ) -> f64 {
+    let x_copies = if model.mesh().symmetry.planes().contains(&0) {
+        2.0
+    } else {
+        1.0
+    };
+    x_copies * ring_force_per_length(model, state, ring, touching, fe) / std::f64::consts::PI
+}
+
+/// The force per unit current length at `ring` of the modelled part (no copies, not over π).
+fn ring_force_per_length(
+    model: &Model,
+    state: &State,
+    ring: &Ring,
+    touching: impl Iterator<Item = usize>,
+    fe: impl Fn(usize) -> f64,
+) -> f64 {
     let mesh = model.mesh();
     let on_ring = ring.contains_set();
     let z_ring = ring.nodes.first().map_or(0.0, |&i| mesh.nodes[i][2]);
@@ -468,13 +484,115 @@ fn ring_force(
             sides += 1.0;
         }
     }
-    let f_per_len = if sides > 0.0 { f_per_len / sides } else { 0.0 };
-    let x_copies = if mesh.symmetry.planes().contains(&0) {
-        2.0
+    if sides > 0.0 {
+        f_per_len / sides
     } else {
-        1.0
-    };
-    x_copies * f_per_len / std::f64::consts::PI
+        0.0
+    }
+}
+
+/// Mid-span contact of one wall of the whole tube.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WallValues {
+    /// flat contact length on the wall (zero crossings of the nodal gap, O(h)), per R
+    pub contact_length: f64,
+    /// force per unit current length on the wall over πμH (as the closed form's ϖc/π)
+    pub force: f64,
+    /// largest penetration of the wall anywhere
+    pub penetration: f64,
+}
+
+/// Mid-span contact values of each plane of `contact`, for the whole tube: each wall's values
+/// are summed over the symmetry copies of the modelled part (the copy mirrored across x = 0
+/// and/or y = 0 meets the mirror image of the wall, which the plane set must contain; a wall
+/// without its mirror gets only the modelled part's share).
+pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<WallValues> {
+    let mesh = model.mesh();
+    let ring = Ring::midspan(model);
+    let on_ring = ring.contains_set();
+    let touching: Vec<usize> = (0..model.elements().len())
+        .filter(|&e| {
+            model.elements()[e]
+                .nodes
+                .iter()
+                .any(|i| on_ring.contains(i))
+        })
+        .collect();
+    // the modelled part's values against each plane
+    let own: Vec<(f64, f64, f64)> = contact
+        .planes
+        .iter()
+        .map(|plane| {
+            let mut c = 0.0;
+            for (ia, ib) in ring.segments() {
+                let (a, b) = (state.x[ia], state.x[ib]);
+                let (ga, gb) = (plane.gap(a), plane.gap(b));
+                let len = dist(a, b);
+                c += match (ga < 0.0, gb < 0.0) {
+                    (true, true) => len,
+                    (true, false) => len * ga / (ga - gb),
+                    (false, true) => len * gb / (gb - ga),
+                    _ => 0.0,
+                };
+            }
+            let mut penetration = 0.0f64;
+            let forces: Vec<f64> = model
+                .elements()
+                .iter()
+                .map(|el| {
+                    let xe = el.gather(&state.x);
+                    let mut fe = 0.0;
+                    for g in 0..4 {
+                        let gap = plane.gap(el.position(g, &xe).into());
+                        if gap < 0.0 {
+                            fe += el.gauss[g].w * contact.traction(gap);
+                            penetration = penetration.max(-gap);
+                        }
+                    }
+                    fe
+                })
+                .collect();
+            let f =
+                ring_force_per_length(model, state, &ring, touching.iter().copied(), |e| forces[e]);
+            (c, f, penetration)
+        })
+        .collect();
+    // the reflections of the modelled part, as sign pairs on (x, y)
+    let planes = mesh.symmetry.planes();
+    let mut signs = vec![[1.0, 1.0]];
+    if planes.contains(&0) {
+        signs.push([-1.0, 1.0]);
+    }
+    if planes.contains(&1) {
+        let n = signs.len();
+        for k in 0..n {
+            signs.push([signs[k][0], -1.0]);
+        }
+    }
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
+    contact
+        .planes
+        .iter()
+        .map(|p| {
+            let mut v = WallValues {
+                contact_length: 0.0,
+                force: 0.0,
+                penetration: 0.0,
+            };
+            for sg in &signs {
+                // the copy mirrored by `sg` meets wall p where the model meets p's mirror
+                let m = [sg[0] * p.normal[0], sg[1] * p.normal[1], p.normal[2]];
+                if let Some(k) = contact.planes.iter().position(|q| {
+                    same(q.normal[0], m[0]) && same(q.normal[1], m[1]) && same(q.offset, p.offset)
+                }) {
+                    v.contact_length += own[k].0;
+                    v.force += own[k].1 / std::f64::consts::PI;
+                    v.penetration = v.penetration.max(own[k].2);
+                }
+            }
+            v
+        })
+        .collect()
 }
 
 /// The contact force of one element against the plate y = h: Σ_g w_g t(gap_g) over its Gauss

@@ -27,7 +27,7 @@
 use crate::newton;
 use crate::resultants::resultants;
 use crate::{inflate, GpsError, Hypothesis};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use tubemem_material::MembraneLaw;
 
@@ -57,7 +57,7 @@ impl Wall {
 }
 
 /// What a wall carries in a state.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WallContact {
     /// flat contact length on the wall, per R
     pub contact_length: f64,
@@ -66,7 +66,7 @@ pub struct WallContact {
 }
 
 /// Which regime the section is in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Regime {
     Free,
@@ -75,7 +75,7 @@ pub enum Regime {
 }
 
 /// A confined state (dimensionless, R = μH = 1).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ConfineState {
     pub w: f64,
     pub lambda_s: f64,
@@ -487,6 +487,17 @@ fn solve_at(
             .collect(),
         scale: s,
     })
+}
+
+/// Whether `walls` can hold a section: a bounded set, or two parallel plates (else the error
+/// that says which direction is open).
+pub fn check_walls(walls: &[Wall]) -> Result<(), GpsError> {
+    if walls.is_empty() {
+        return Err(GpsError::Walls {
+            message: "no planes given".into(),
+        });
+    }
+    classify(walls).map(|_| ())
 }
 
 fn check(walls: &[Wall], initial_stretch: f64) -> Result<Hold, GpsError> {
