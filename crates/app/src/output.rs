@@ -738,6 +738,34 @@ impl Observer for RunWriter {
             steps.flush()?;
             self.rows += 1;
         }
+        if !view.record.walls.is_empty() && view.fraction >= 1.0 {
+            // the mid-span ring of a confine stage's end, whole (symmetry copies), for plots
+            // against the closed-form section (`tubemem gps confine --figure … --ring …`)
+            let path = self
+                .dir
+                .join("profiles")
+                .join(format!("stage{}_midspan_ring.csv", view.plan.index));
+            let ring = tubemem_fem::post::Ring::midspan(view.model);
+            let planes = view.model.mesh().symmetry.planes();
+            let mut signs = vec![[1.0, 1.0]];
+            if planes.contains(&0) {
+                signs.push([-1.0, 1.0]);
+            }
+            if planes.contains(&1) {
+                let n = signs.len();
+                for k in 0..n {
+                    signs.push([signs[k][0], -1.0]);
+                }
+            }
+            let mut text = String::from("x,y\n");
+            for sg in &signs {
+                for &i in &ring.nodes {
+                    let x = view.state.x[i];
+                    text.push_str(&format!("{},{}\n", sg[0] * x[0], sg[1] * x[1]));
+                }
+            }
+            std::fs::write(&path, text).map_err(|e| AppError::io(&path, e))?;
+        }
         if !view.record.walls.is_empty() {
             if self.walls.is_none() {
                 let path = self.dir.join("walls.csv");

@@ -158,6 +158,14 @@ impl Observer for Console {
                 )?;
             }
         }
+        if let (false, Some(e)) = (s.walls.is_empty(), &s.relative_error_vs_gps_at_fe_pressure) {
+            say!(
+                "         GPS in the same walls at the FE's pressure ϖ = {:.6}: λs {:+.3}%, λz {:+.3}%",
+                ms.w,
+                100.0 * e.lambda_s.unwrap_or(f64::NAN),
+                100.0 * e.lambda_z.unwrap_or(f64::NAN)
+            )?;
+        }
         for (k, w) in s.walls.iter().enumerate() {
             let gps = w.gps.map_or(f64::NAN, |g| g.force);
             let local = w.local.map_or(f64::NAN, |g| g.force);

@@ -81,6 +81,10 @@ pub struct ConfineArgs {
     /// Draw the final section and the walls to this figure (.png or .svg).
     #[arg(long)]
     figure: Option<PathBuf>,
+    /// With --figure: also draw these FE mid-span ring points (x,y CSV, e.g. a run's
+    /// profiles/stage2_midspan_ring.csv).
+    #[arg(long, requires = "figure")]
+    ring: Option<PathBuf>,
     #[arg(long)]
     json: bool,
 }
@@ -148,7 +152,36 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
         crate::say!("wrote {} states to {}", path.len(), csv.display())?;
     }
     if let Some(fig) = &a.figure {
-        draw_section(fig, &walls, last, &section_outline(&walls, last, 720))?;
+        let ring = match &a.ring {
+            None => vec![],
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .map_err(|e| anyhow::anyhow!("--ring {}: {e}", p.display()))?;
+                text.lines()
+                    .skip(1)
+                    .enumerate()
+                    .map(|(k, l)| {
+                        let v: Vec<f64> =
+                            l.split(',').filter_map(|t| t.trim().parse().ok()).collect();
+                        match v[..] {
+                            [x, y] if x.is_finite() && y.is_finite() => Ok((x, y)),
+                            _ => Err(anyhow::anyhow!(
+                                "--ring {} line {}: expected x,y",
+                                p.display(),
+                                k + 2
+                            )),
+                        }
+                    })
+                    .collect::<Result<Vec<_>>>()?
+            }
+        };
+        draw_section(
+            fig,
+            &walls,
+            last,
+            &section_outline(&walls, last, 720),
+            &ring,
+        )?;
         crate::say!("wrote {}", fig.display())?;
     }
     let v = confine_json(last)?;
@@ -166,8 +199,9 @@ fn draw_section(
     walls: &[tubemem_gps::confine::Wall],
     state: &tubemem_gps::confine::ConfineState,
     outline: &[[f64; 2]],
+    ring: &[(f64, f64)],
 ) -> Result<()> {
-    use tubemem_app::figures::{Figure, FigureOptions, Series, Stroke};
+    use tubemem_app::figures::{Figure, FigureOptions, Markers, Series, Stroke};
     let extent = outline
         .iter()
         .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()))
@@ -192,8 +226,10 @@ fn draw_section(
         let p0 = [n[0] * d, n[1] * d];
         series.push(Series {
             label: format!(
-                "wall {k}: contact {:.4} R, force {:.4}",
-                state.walls[k].contact_length, state.walls[k].force
+                "wall {}: contact {:.4} R, force {:.4}",
+                k + 1,
+                state.walls[k].contact_length,
+                state.walls[k].force
             ),
             points: vec![
                 (p0[0] - extent * t[0], p0[1] - extent * t[1]),
@@ -209,7 +245,16 @@ fn draw_section(
         x_label: "x/R".into(),
         y_label: "y/R".into(),
         series,
-        markers: vec![],
+        markers: if ring.is_empty() {
+            vec![]
+        } else {
+            vec![Markers {
+                label: "FE mid-span ring (nodes)".into(),
+                points: ring.to_vec(),
+                color: plotters::style::RGBColor(20, 140, 60),
+                hollow: true,
+            }]
+        },
         panel: None,
         notes: vec![],
         equal_aspect: true,

@@ -380,6 +380,29 @@ fn member(c: &Check, text: &str, dir: &Path, r: &mut CheckResult) -> Result<RunR
 pub fn step_pair(s: &StepRecord, q: &str) -> Option<(f64, f64)> {
     let m = &s.midspan;
     let cf = &s.closed_form;
+    if let Some(g) = &cf.gps_confine {
+        // a confine step: the walls' forces compared wall by wall, the worst one kept
+        let worst_wall = |c: &tubemem_gps::confine::ConfineState| {
+            s.walls
+                .iter()
+                .zip(&c.walls)
+                .filter(|(_, w)| w.force > 0.0)
+                .map(|(fe, w)| (fe.force, w.force))
+                .max_by(|a, b| (a.0 / a.1 - 1.0).abs().total_cmp(&(b.0 / b.1 - 1.0).abs()))
+        };
+        return match q {
+            "w" => Some((m.w, g.w)),
+            "lambda_s" => Some((m.lambda_s, g.lambda_s)),
+            "lambda_z" => Some((m.lambda_z, g.lambda_z)),
+            "n_s" => Some((m.n_s, g.n_s)),
+            "n_z" => Some((m.n_z, g.n_z)),
+            "wall_force" => worst_wall(g),
+            "local_lambda_s" => cf.local_confine.as_ref().map(|l| (m.lambda_s, l.lambda_s)),
+            "local_lambda_z" => cf.local_confine.as_ref().map(|l| (m.lambda_z, l.lambda_z)),
+            "local_wall_force" => cf.local_confine.as_ref().and_then(worst_wall),
+            _ => None,
+        };
+    }
     if let Some(g) = &cf.gps_inflation {
         return match q {
             "w" => Some((m.w, g.w)),

@@ -157,6 +157,8 @@ pub const CLOSED_FORM_QUANTITIES: &[&str] = &[
     "local_force",
     "maxwell_w",
     "maxwell_lambda_s",
+    "wall_force",
+    "local_wall_force",
 ];
 /// The quantities of a reference check (FE against scikit-fem).
 pub const REFERENCE_QUANTITIES: &[&str] = &[
