@@ -9,7 +9,10 @@ and the relative differences.
   λs, and GPS (eq. 66); it also plots the end-cap profile λs(Z), FE against axisymmetric, as
   profile_stageN.png and reports the largest difference along the tube;
 - squeeze stage: the scikit-fem GPS cross-section with contact at the FE's λs* and ρ, and GPS
-  flattening (eqs. 76-77).
+  flattening (eqs. 76-77);
+- confine stage: the scikit-fem periodic GPS ring (gps_ring, any planes) with the gas closed in
+  at the FE's λs* and the stage's planes moved from their offsets to their targets, and the
+  Rust closed form of summary.json (`gps`): ϖ, λs, λz and each wall's force.
 The law is read from summary.json's material_spec: Anssari-Benam--Bucchi, Mooney--Rivlin or
 neo-Hookean, in every reference.
 """
@@ -104,6 +107,45 @@ def compare(run_dir, out_dir, plot=True):
                 fig.savefig(out_dir / f"profile_stage{idx}.png", dpi=110)
                 plt.close(fig)
             ls_star = ls
+        elif st["kind"] == "confine":
+            from tubemem_ref import gps_ring
+            ls0 = ls_star if ls_star is not None else fin["lambda_s"]
+            planes = st["planes"]
+
+            def walls(t):
+                # tubemem's n.x <= d as python_ref's (nx, ny, d) with nx x + ny y >= d
+                out = []
+                for p in planes:
+                    n = np.hypot(*p["normal"])
+                    d = p["offset"] + t * (p["target"] - p["offset"])
+                    out.append((-p["normal"][0] / n, -p["normal"][1] / n, -d / n))
+                return out
+
+            # the rigid modes: all pinned until every wall touches (a wall alone pushes the free
+            # ring away), then only those the walls cannot hold: the rotation, and a translation
+            # along which the plane set is symmetric (its multiplier then carries no load)
+            def symmetric(axis):
+                ws = walls(1.0)
+                flip = [(-a, b, d) if axis == 0 else (a, -b, d) for a, b, d in ws]
+                return all(any(np.allclose(f, w, atol=1e-12) for w in ws) for f in flip)
+
+            pins = tuple(k for k in (0, 1) if symmetric(k)) + (2,)
+            held = gps_ring.GpsRing(elements=128, penalty=1e5, rigid=(0, 1, 2), law=law)
+            ring = gps_ring.GpsRing(elements=128, penalty=1e5, rigid=pins, law=law)
+            w0, lz0 = closed_form.gps_inflation(ls0, law=law)
+            m = w0 * lz0 * np.pi * ls0**2
+            q, lz = held.circle(ls0), lz0
+            t_all = max(0.0, max((p["offset"] - ls0 * np.hypot(*p["normal"])) / (p["offset"] - p["target"])
+                                 for p in planes if p["offset"] != p["target"]))
+            for t in np.linspace(0.0, 1.0, 101)[1:]:
+                q, lz, _ = (held if t <= t_all + 0.02 else ring).solve(q, lz, walls(t), m)
+            o = ring.outputs(q, lz, walls(1.0), m)
+            cf = st["gps"]
+            for k in ["w", "lambda_s", "lambda_z"]:
+                rows.append((idx, "confine", k, fin[k], o[k], cf[k], rel(fin[k], o[k]), rel(fin[k], cf[k]), rel(o[k], cf[k])))
+            for j, wall in enumerate(st["walls"]):
+                fe, sk, c = wall["fe"]["force"], o["forces"][j], cf["walls"][j]["force"]
+                rows.append((idx, "confine", f"force wall {j + 1}", fe, sk, c, rel(fe, sk), rel(fe, c), rel(sk, c)))
         elif st["kind"] == "squeeze":
             ls0, rho = fin["initial_stretch"], fin["rho"]
             sec = gps_section.squeeze(ls0, [rho], elements=64, penalty=1e5, law=law)[0]

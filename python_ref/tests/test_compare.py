@@ -65,3 +65,23 @@ def test_compare_a_mooney_rivlin_run(tmp_path, tubemem_exe):
     w_mr, _ = cf.gps_inflation(ls, law=("mooney-rivlin", 0.1))
     w_abb, _ = cf.gps_inflation(ls, 30.0)
     assert table[(1, "w")][5] == w_mr and abs(w_mr / w_abb - 1) > 1e-2
+
+
+def test_compare_a_confine_run(tmp_path, tubemem_exe):
+    """compare.py on cases/vgroove_abb30_ls1.3.toml (the FE run's confine stage): the scikit-fem
+    periodic ring for the same planes against the Rust closed form in summary.json: 1e-4 for
+    w, lambda_s, lambda_z and 5e-3 for the wall forces (the bounds of test_gps_ring.py: the
+    ring's penalty error at kappa = 1e5 and its flats two elements wide). The FE is below both by
+    its end effect (the gas the ends keep), as for the squeeze: between 0 and -2 % in w."""
+    case = pathlib.Path(__file__).resolve().parents[2] / "cases" / "vgroove_abb30_ls1.3.toml"
+    out = subprocess.run([tubemem_exe, "run", str(case), "--out", str(tmp_path / "run")], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    rows = compare.compare(tmp_path / "run", tmp_path / "cmp", plot=False)
+    conf = {r[2]: r for r in rows if r[1] == "confine"}
+    for k in ["w", "lambda_s", "lambda_z"]:
+        assert abs(conf[k][8]) < 1e-4, (k, conf[k])
+    forces = [r for k, r in conf.items() if k.startswith("force wall")]
+    assert len(forces) == 3
+    for r in forces:
+        assert abs(r[8]) < 5e-3, r
+    assert -2e-2 < conf["w"][6] < 0.0, conf["w"]

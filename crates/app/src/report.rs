@@ -187,6 +187,9 @@ pub struct StageSummary {
     /// pressure
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub walls: Vec<WallSummary>,
+    /// a confine stage: its planes as the case gave them
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub planes: Vec<crate::case::PlaneSpec>,
 }
 
 /// One wall at the end of a confine stage.

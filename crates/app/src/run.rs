@@ -1129,6 +1129,7 @@ fn run_inner(
             gps_at_fe_pressure: local_section,
             relative_error_vs_gps_at_fe_pressure: local_err,
             walls: wall_summary,
+            planes: confine_planes.clone().unwrap_or_default(),
         };
         report.stages.push(StageReport {
             plan: *plan,
