@@ -327,40 +327,10 @@ impl RunWriter {
             .map_err(|e| AppError::io(&path, e))?;
         w.steps = Some(BufWriter::new(steps));
         // walls.csv: the rows of the kept steps (appended to from here on)
-        let walls_path = dir.join("walls.csv");
-        if let Ok(text) = std::fs::read_to_string(&walls_path) {
-            let kept: Vec<&str> = text
-                .lines()
-                .enumerate()
-                .filter(|(k, l)| {
-                    *k == 0
-                        || l.split(',')
-                            .next()
-                            .and_then(|r| r.parse::<usize>().ok())
-                            .is_some_and(|r| r <= ck.rows)
-                })
-                .map(|(_, l)| l)
-                .collect();
-            std::fs::write(&walls_path, format!("{}\n", kept.join("\n")))
-                .map_err(|e| AppError::io(&walls_path, e))?;
-        }
+        trim_rows(&dir.join("walls.csv"), ck.rows)?;
         // profiles.csv: the rows of the kept steps
         let path = dir.join("profiles").join("profiles.csv");
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            let kept: Vec<&str> = text
-                .lines()
-                .enumerate()
-                .filter(|(k, l)| {
-                    *k == 0
-                        || l.split(',')
-                            .next()
-                            .and_then(|r| r.parse::<usize>().ok())
-                            .is_some_and(|r| r <= ck.rows)
-                })
-                .map(|(_, l)| l)
-                .collect();
-            std::fs::write(&path, format!("{}\n", kept.join("\n")))
-                .map_err(|e| AppError::io(&path, e))?;
+        if trim_rows(&path, ck.rows)? {
             let f = std::fs::OpenOptions::new()
                 .append(true)
                 .open(&path)
@@ -694,6 +664,28 @@ fn join(values: &[f64]) -> String {
         .join(",")
 }
 
+/// Keep the header and the rows whose first field (the steps.csv row) is at most `rows`;
+/// whether the file was there.
+fn trim_rows(path: &Path, rows: usize) -> Result<bool> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(false);
+    };
+    let kept: Vec<&str> = text
+        .lines()
+        .enumerate()
+        .filter(|(k, l)| {
+            *k == 0
+                || l.split(',')
+                    .next()
+                    .and_then(|r| r.parse::<usize>().ok())
+                    .is_some_and(|r| r <= rows)
+        })
+        .map(|(_, l)| l)
+        .collect();
+    std::fs::write(path, format!("{}\n", kept.join("\n"))).map_err(|e| AppError::io(path, e))?;
+    Ok(true)
+}
+
 /// Write a profile (one row per ring) as CSV.
 pub fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
     let mut text = format!("{PROFILE_HEADER}\n");
@@ -746,17 +738,7 @@ impl Observer for RunWriter {
                 .join("profiles")
                 .join(format!("stage{}_midspan_ring.csv", view.plan.index));
             let ring = tubemem_fem::post::Ring::midspan(view.model);
-            let planes = view.model.mesh().symmetry.planes();
-            let mut signs = vec![[1.0, 1.0]];
-            if planes.contains(&0) {
-                signs.push([-1.0, 1.0]);
-            }
-            if planes.contains(&1) {
-                let n = signs.len();
-                for k in 0..n {
-                    signs.push([signs[k][0], -1.0]);
-                }
-            }
+            let signs = tubemem_fem::post::reflections(view.model);
             let mut text = String::from("x,y\n");
             for sg in &signs {
                 for &i in &ring.nodes {

@@ -300,3 +300,72 @@ fn a_confine_stage_with_two_plates_is_the_squeeze() {
     let err = Case::parse(&open).unwrap_err().to_string();
     assert!(err.contains("do not confine"), "{err}");
 }
+
+/// A confine run's files are its report: walls.csv holds every step's walls, field for field;
+/// the stage end's mid-span ring is written whole (four copies of the eighth model's quarter
+/// ring) and lies within the channel.
+#[test]
+fn a_confine_runs_walls_csv_is_the_report() {
+    let channel = "\n[[stage]]\nkind = \"confine\"\nsteps = 4\n[[stage.plane]]\nnormal = [1, 0]\noffset = 1.25\ntarget = 1.1\n[[stage.plane]]\nnormal = [-1, 0]\noffset = 1.25\ntarget = 1.1\n[[stage.plane]]\nnormal = [0, 1]\noffset = 1.25\ntarget = 1.1\n[[stage.plane]]\nnormal = [0, -1]\noffset = 1.25\ntarget = 1.1\n";
+    let case = Case::parse(&format!("{SMALL}{channel}")).unwrap();
+    let out = tmp("walls");
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let report = run(&case, "channel", &mut [&mut writer])
+        .into_result()
+        .unwrap();
+    let text = std::fs::read_to_string(out.join("walls.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(tubemem_app::output::WALLS_HEADER));
+    let mut n = 0;
+    for (k, rec) in report.steps().enumerate() {
+        for (j, w) in rec.walls.iter().enumerate() {
+            let v: Vec<f64> = lines
+                .next()
+                .unwrap()
+                .split(',')
+                .map(|f| f.parse().unwrap_or(f64::NAN))
+                .collect();
+            assert_eq!(
+                v[..4],
+                [
+                    (k + 1) as f64,
+                    rec.stage as f64,
+                    rec.step as f64,
+                    (j + 1) as f64
+                ]
+            );
+            assert_eq!(v[4..7], [w.contact_length, w.force, w.penetration]);
+            n += 1;
+        }
+    }
+    assert!(n >= 16 && lines.next().is_none());
+    let last = report.steps().last().unwrap();
+    // the four walls carry the same force (the square and the model are symmetric; the quarter
+    // ring's elements sit symmetrically about 45°, so to rounding)
+    let f0 = last.walls[0].force;
+    assert!(
+        f0 > 0.0 && last.walls.iter().all(|w| (w.force / f0 - 1.0).abs() < 1e-9),
+        "{:?}",
+        last.walls
+    );
+    let ring = std::fs::read_to_string(out.join("profiles/stage2_midspan_ring.csv")).unwrap();
+    let pts: Vec<(f64, f64)> = ring
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|f| f.parse().unwrap()).collect();
+            (v[0], v[1])
+        })
+        .collect();
+    assert_eq!(pts.len() % 4, 0);
+    // inside the channel up to what Gauss-point contact allows a node: the penalty acts at the
+    // Gauss points, and a node between them may pass the wall by up to the sagitta of an
+    // element's chord, h²/8r with h ≈ 2π·1.1/16 of arc and r ≥ 1 (measured: 1.05e-2)
+    let pen = last.walls.iter().map(|w| w.penetration).fold(0.0, f64::max);
+    let h = 2.0 * std::f64::consts::PI * 1.1 / 16.0;
+    let lim = 1.1 + pen + h * h / 8.0;
+    let worst = pts
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.0.abs()).max(p.1.abs()));
+    assert!(worst <= lim && worst > 1.1 - 1e-3, "{worst} against {lim}");
+}

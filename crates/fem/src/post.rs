@@ -74,6 +74,19 @@ impl Ring {
         (0..segs).map(move |k| (self.nodes[k], self.nodes[(k + 1) % n]))
     }
 
+    /// The elements with a node on the ring, in ascending order.
+    pub fn touching(&self, model: &Model) -> Vec<usize> {
+        let on_ring = self.contains_set();
+        (0..model.elements().len())
+            .filter(|&e| {
+                model.elements()[e]
+                    .nodes
+                    .iter()
+                    .any(|i| on_ring.contains(i))
+            })
+            .collect()
+    }
+
     fn contains_set(&self) -> std::collections::HashSet<usize> {
         self.nodes.iter().copied().collect()
     }
@@ -88,15 +101,7 @@ pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
 /// the edges leaving the ring, and resultants averaged over the Gauss points of the elements
 /// that touch it. `volume` is the total enclosed volume.
 pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, FemError> {
-    let on_ring = ring.contains_set();
-    let touching: Vec<usize> = (0..model.elements().len())
-        .filter(|&e| {
-            model.elements()[e]
-                .nodes
-                .iter()
-                .any(|i| on_ring.contains(i))
-        })
-        .collect();
+    let touching = ring.touching(model);
     let projected = touching
         .iter()
         .map(|&e| projected_resultants(model, state, e))
@@ -402,7 +407,17 @@ pub fn ring_profile(
 /// ring polygon (zero crossings of the nodal gap interpolated linearly, O(h) accurate), over π,
 /// for all copies across the x = 0 symmetry plane.
 fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64) -> f64 {
-    let gap = |p: [f64; 3]| h - p[1];
+    let c = penetrated_length(state, ring, |p| h - p[1]);
+    let x_copies = if model.mesh().symmetry.planes().contains(&0) {
+        2.0
+    } else {
+        1.0
+    };
+    x_copies * c / std::f64::consts::PI
+}
+
+/// The length of the ring polygon where `gap` < 0 (zero crossings interpolated linearly).
+fn penetrated_length(state: &State, ring: &Ring, gap: impl Fn([f64; 3]) -> f64) -> f64 {
     let mut c = 0.0;
     for (ia, ib) in ring.segments() {
         let (a, b) = (state.x[ia], state.x[ib]);
@@ -415,12 +430,24 @@ fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64) -> f64 {
             _ => 0.0,
         };
     }
-    let x_copies = if model.mesh().symmetry.planes().contains(&0) {
-        2.0
-    } else {
-        1.0
-    };
-    x_copies * c / std::f64::consts::PI
+    c
+}
+
+/// The reflections of the modelled part across the symmetry planes through the axis, as sign
+/// pairs on (x, y): the identity first.
+pub fn reflections(model: &Model) -> Vec<[f64; 2]> {
+    let planes = model.mesh().symmetry.planes();
+    let mut signs = vec![[1.0, 1.0]];
+    if planes.contains(&0) {
+        signs.push([-1.0, 1.0]);
+    }
+    if planes.contains(&1) {
+        let n = signs.len();
+        for k in 0..n {
+            signs.push([signs[k][0], -1.0]);
+        }
+    }
+    signs
 }
 
 /// The plate force per unit current length at `ring` over πμH (all copies across x = 0), from
@@ -507,34 +534,14 @@ pub struct WallValues {
 /// and/or y = 0 meets the mirror image of the wall, which the plane set must contain; a wall
 /// without its mirror gets only the modelled part's share).
 pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<WallValues> {
-    let mesh = model.mesh();
     let ring = Ring::midspan(model);
-    let on_ring = ring.contains_set();
-    let touching: Vec<usize> = (0..model.elements().len())
-        .filter(|&e| {
-            model.elements()[e]
-                .nodes
-                .iter()
-                .any(|i| on_ring.contains(i))
-        })
-        .collect();
+    let touching = ring.touching(model);
     // the modelled part's values against each plane
     let own: Vec<(f64, f64, f64)> = contact
         .planes
         .iter()
         .map(|plane| {
-            let mut c = 0.0;
-            for (ia, ib) in ring.segments() {
-                let (a, b) = (state.x[ia], state.x[ib]);
-                let (ga, gb) = (plane.gap(a), plane.gap(b));
-                let len = dist(a, b);
-                c += match (ga < 0.0, gb < 0.0) {
-                    (true, true) => len,
-                    (true, false) => len * ga / (ga - gb),
-                    (false, true) => len * gb / (gb - ga),
-                    _ => 0.0,
-                };
-            }
+            let c = penetrated_length(state, &ring, |p| plane.gap(p));
             let mut penetration = 0.0f64;
             let forces: Vec<f64> = model
                 .elements()
@@ -557,18 +564,7 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
             (c, f, penetration)
         })
         .collect();
-    // the reflections of the modelled part, as sign pairs on (x, y)
-    let planes = mesh.symmetry.planes();
-    let mut signs = vec![[1.0, 1.0]];
-    if planes.contains(&0) {
-        signs.push([-1.0, 1.0]);
-    }
-    if planes.contains(&1) {
-        let n = signs.len();
-        for k in 0..n {
-            signs.push([signs[k][0], -1.0]);
-        }
-    }
+    let signs = reflections(model);
     let same = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
     contact
         .planes

@@ -500,6 +500,28 @@ pub fn check_walls(walls: &[Wall]) -> Result<(), GpsError> {
     classify(walls).map(|_| ())
 }
 
+/// The free circle of an inflated state, touching none of `n` walls.
+fn free_state(st: &crate::InflationState, n: usize, scale: f64) -> ConfineState {
+    ConfineState {
+        w: st.w,
+        lambda_s: st.lambda_s,
+        lambda_z: st.lambda_z,
+        n_s: st.n_s,
+        n_z: st.n_z,
+        r: st.lambda_s,
+        area: PI * st.lambda_s.powi(2),
+        regime: Regime::Free,
+        walls: vec![
+            WallContact {
+                contact_length: 0.0,
+                force: 0.0
+            };
+            n
+        ],
+        scale,
+    }
+}
+
 fn check(walls: &[Wall], initial_stretch: f64) -> Result<Hold, GpsError> {
     if walls.is_empty() {
         return Err(GpsError::Walls {
@@ -556,24 +578,7 @@ pub fn confine_path(
     let ws = Walls { walls, hold };
     let initial = inflate(law, hyp, initial_stretch)?;
     let s0 = first_contact(&ws, initial_stretch)?;
-    let free = |s: f64| ConfineState {
-        w: initial.w,
-        lambda_s: initial.lambda_s,
-        lambda_z: initial.lambda_z,
-        n_s: initial.n_s,
-        n_z: initial.n_z,
-        r: initial.lambda_s,
-        area: PI * initial.lambda_s.powi(2),
-        regime: Regime::Free,
-        walls: vec![
-            WallContact {
-                contact_length: 0.0,
-                force: 0.0
-            };
-            walls.len()
-        ],
-        scale: s,
-    };
+    let free = |s: f64| free_state(&initial, walls.len(), s);
     if s0 <= 1.0 {
         return Ok(vec![free(1.0)]);
     }
@@ -666,24 +671,7 @@ pub fn confine_at_pressure(
         });
     }
     let contact = inflate(law, hyp, r_in.max(1.0))?;
-    let free = |st: crate::InflationState| ConfineState {
-        w: st.w,
-        lambda_s: st.lambda_s,
-        lambda_z: st.lambda_z,
-        n_s: st.n_s,
-        n_z: st.n_z,
-        r: st.lambda_s,
-        area: PI * st.lambda_s.powi(2),
-        regime: Regime::Free,
-        walls: vec![
-            WallContact {
-                contact_length: 0.0,
-                force: 0.0
-            };
-            walls.len()
-        ],
-        scale: 1.0,
-    };
+    let free = |st: crate::InflationState| free_state(&st, walls.len(), 1.0);
     if r_in <= 1.0 || w <= contact.w {
         // the free circle at ϖ: λs on the rising branch up to the contact radius
         let (mut lo, mut hi) = (1.0, r_in.max(1.0));
