@@ -839,7 +839,10 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             .collect();
         // the reference: the closed form at the finest member's last step
         let last = reports[fine].steps().last();
-        let reference = last.and_then(|s| step_pair(s, q)).map(|p| p.1);
+        let reference = last
+            .and_then(|s| step_pair(s, q))
+            .map(|p| p.1)
+            .filter(|_| c.spec.compare_reference.unwrap_or(true));
         let phi = [vals[fine], vals[fine - 1], vals[fine - 2]];
         if phi.iter().any(|v| !v.is_finite()) {
             return Err(format!("`{q}` is not a value of these runs"));
