@@ -26,6 +26,22 @@ pub fn flattening_values(s: &FlatteningState) -> Vec<f64> {
     ]
 }
 
+/// One CSV line of numbers (shortest round-trip form), an empty field where a value does not
+/// apply (non-finite).
+pub fn csv_line(values: &[f64]) -> String {
+    values
+        .iter()
+        .map(|v| {
+            if v.is_finite() {
+                v.to_string()
+            } else {
+                String::new()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
 /// Write rows of numbers as CSV (shortest round-trip representation). A non-finite value is
 /// refused: it would be a silent wrong answer.
 pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<()> {

@@ -148,6 +148,28 @@ pub struct Figure {
     pub y_from_zero: bool,
 }
 
+impl Figure {
+    /// A plain figure of curves: no markers, panel or notes, the y axis from zero.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+        series: Vec<Series>,
+    ) -> Self {
+        Figure {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series,
+            markers: vec![],
+            panel: None,
+            notes: vec![],
+            equal_aspect: false,
+            y_from_zero: true,
+        }
+    }
+}
+
 fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values {
@@ -684,17 +706,7 @@ fn write_points(dir: &Path, k: usize, o: &Overlay) -> Result<PathBuf> {
         "squeeze,lambda_s,w,rho,displacement,force,initial_stretch,gps_force,force_minus_gps\n",
     );
     for r in rows {
-        let fields: Vec<String> = r
-            .iter()
-            .map(|v| {
-                if v.is_finite() {
-                    v.to_string()
-                } else {
-                    String::new()
-                }
-            })
-            .collect();
-        text.push_str(&fields.join(","));
+        text.push_str(&crate::curves::csv_line(&r));
         text.push('\n');
     }
     std::fs::write(&p, text).map_err(|e| AppError::io(&p, e))?;
@@ -855,30 +867,27 @@ pub fn write_all(
         .collect();
     written.extend(save(
         &Figure {
-            title: format!("Fig. 5 — reduced pressure vs hoop stretch ({name})"),
-            x_label: "hoop stretch λs".into(),
-            y_label: "reduced pressure ϖ = pR/(μH)".into(),
-            series,
             markers,
-            panel: None,
-            notes: vec![],
-            equal_aspect: false,
-            y_from_zero: true,
+            ..Figure::new(
+                format!("Fig. 5 — reduced pressure vs hoop stretch ({name})"),
+                "hoop stretch λs",
+                "reduced pressure ϖ = pR/(μH)",
+                series,
+            )
         },
         &dir.join("fig5_pressure_stretch"),
         opts,
     )?);
     written.extend(save(
         &Figure {
-            title: format!("Fig. 5, zoom on the flattening from λs* = 1.3 ({name})"),
-            x_label: "hoop stretch λs".into(),
-            y_label: "reduced pressure ϖ = pR/(μH)".into(),
-            series: zoom_series,
             markers: zoom_markers,
-            panel: None,
-            notes: vec![],
-            equal_aspect: false,
             y_from_zero: false,
+            ..Figure::new(
+                format!("Fig. 5, zoom on the flattening from λs* = 1.3 ({name})"),
+                "hoop stretch λs",
+                "reduced pressure ϖ = pR/(μH)",
+                zoom_series,
+            )
         },
         &dir.join("fig5_zoom_ls1.3"),
         opts,
@@ -954,15 +963,15 @@ pub fn write_all(
         });
         written.extend(save(
             &Figure {
-                title: format!("Fig. {num} — flattening from λs* = {ls0:.1} ({name})"),
-                x_label: "reduced displacement λs* − ρ".into(),
-                y_label: "reduced force ϖχ = pc/(πμH)".into(),
-                series,
                 markers,
                 panel,
                 notes,
-                equal_aspect: false,
-                y_from_zero: true,
+                ..Figure::new(
+                    format!("Fig. {num} — flattening from λs* = {ls0:.1} ({name})"),
+                    "reduced displacement λs* − ρ",
+                    "reduced force ϖχ = pc/(πμH)",
+                    series,
+                )
             },
             &dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}")),
             opts,
@@ -997,17 +1006,12 @@ pub fn write_all(
         width: 3,
     });
     written.extend(save(
-        &Figure {
-            title: format!("Axial stretch vs hoop stretch ({name})"),
-            x_label: "hoop stretch λs".into(),
-            y_label: "axial stretch λz".into(),
+        &Figure::new(
+            format!("Axial stretch vs hoop stretch ({name})"),
+            "hoop stretch λs",
+            "axial stretch λz",
             series,
-            markers: vec![],
-            panel: None,
-            notes: vec![],
-            equal_aspect: false,
-            y_from_zero: true,
-        },
+        ),
         &dir.join("fig_lambda_z"),
         opts,
     )?);

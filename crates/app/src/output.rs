@@ -217,11 +217,20 @@ fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
     if data.len() != n.checked_mul(24)?.checked_add(8)? {
         return None;
     }
-    let f = |k: usize| f64::from_le_bytes(data[8 * k..8 * k + 8].try_into().expect("8 bytes"));
-    ck.x = (0..n)
-        .map(|i| [f(3 * i), f(3 * i + 1), f(3 * i + 2)])
+    // the length is checked above: 3n coordinates and the pressure, 8 bytes each
+    let v: Vec<f64> = data
+        .chunks_exact(8)
+        .map(|c| {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(c);
+            f64::from_le_bytes(b)
+        })
         .collect();
-    ck.p = f(3 * n);
+    ck.x = v[..3 * n]
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    ck.p = v[3 * n];
     Some(ck)
 }
 
@@ -786,17 +795,7 @@ impl Observer for RunWriter {
                         l[0],
                         l[1],
                     ];
-                    let fields: Vec<String> = vals
-                        .iter()
-                        .map(|v| {
-                            if v.is_finite() {
-                                v.to_string()
-                            } else {
-                                String::new()
-                            }
-                        })
-                        .collect();
-                    writeln!(out, "{}", fields.join(","))?;
+                    writeln!(out, "{}", crate::curves::csv_line(&vals))?;
                 }
                 out.flush()?;
             }

@@ -125,7 +125,9 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
         (None, Some(w)) => vec![confine_at_pressure(law.as_ref(), hyp, &walls, w)?],
         _ => bail!("give --initial-stretch λs* (the gas closed in) or --pressure ϖ"),
     };
-    let last = path.last().expect("a path has a state");
+    let Some(last) = path.last() else {
+        bail!("internal error: an empty confinement path; please report this input");
+    };
     if let Some(csv) = &a.csv {
         let mut header = "scale,w,lambda_s,lambda_z,n_s,n_z,r,area,regime".to_string();
         for k in 0..walls.len() {
@@ -241,10 +243,6 @@ fn draw_section(
         });
     }
     let fig = Figure {
-        title: "Confined cross-section (GPS closed form, eqs. 55–60)".into(),
-        x_label: "x/R".into(),
-        y_label: "y/R".into(),
-        series,
         markers: if ring.is_empty() {
             vec![]
         } else {
@@ -255,10 +253,14 @@ fn draw_section(
                 hollow: true,
             }]
         },
-        panel: None,
-        notes: vec![],
         equal_aspect: true,
         y_from_zero: false,
+        ..Figure::new(
+            "Confined cross-section (GPS closed form, eqs. 55–60)",
+            "x/R",
+            "y/R",
+            series,
+        )
     };
     let stem = path.with_extension("");
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("png");

@@ -637,8 +637,11 @@ pub fn confine(
     walls: &[Wall],
     initial_stretch: f64,
 ) -> Result<ConfineState, GpsError> {
-    let path = confine_path(law, hyp, walls, initial_stretch, 2)?;
-    Ok(path.last().cloned().expect("a path has at least one state"))
+    confine_path(law, hyp, walls, initial_stretch, 2)?
+        .pop()
+        .ok_or_else(|| GpsError::Walls {
+            message: "internal error: an empty confinement path; please report this input".into(),
+        })
 }
 
 /// The state under a given pressure `w` in `walls` at their offsets (no gas law): the free

@@ -607,17 +607,12 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         width: 1,
     });
     plot(
-        &Figure {
-            title: format!("{}: FE against GPS at every step", c.spec.name),
-            x_label: "step (all stages)".into(),
-            y_label: "share of the tolerance used".into(),
+        &Figure::new(
+            format!("{}: FE against GPS at every step", c.spec.name),
+            "step (all stages)",
+            "share of the tolerance used",
             series,
-            markers: vec![],
-            panel: None,
-            notes: vec![],
-            equal_aspect: false,
-            y_from_zero: true,
-        },
+        ),
         r,
     );
     Ok(None)
@@ -932,15 +927,13 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         serde_json::json!({ "around": arounds, "r21": r21, "r32": r32, "quantities": table });
     plot(
         &Figure {
-            title: format!("{}: mesh convergence", c.spec.name),
-            x_label: "(h/h_finest)² (h ∝ 1/elements around)".into(),
-            y_label: "FE/GPS − 1".into(),
-            series,
-            markers: vec![],
-            panel: None,
             notes: vec![format!("elements around: {arounds:?}")],
-            equal_aspect: false,
-            y_from_zero: true,
+            ..Figure::new(
+                format!("{}: mesh convergence", c.spec.name),
+                "(h/h_finest)² (h ∝ 1/elements around)",
+                "FE/GPS − 1",
+                series,
+            )
         },
         r,
     );
@@ -1043,26 +1036,24 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         .collect();
     plot(
         &Figure {
-            title: format!("{}: end effect on {q}", c.spec.name),
-            x_label: "tube length L/R".into(),
-            y_label: "log10 |FE/GPS − 1 − c|".into(),
-            series: vec![Series {
-                label: format!("fitted law {law_text}"),
-                points: curve,
-                color: COLORS[0],
-                stroke: Stroke::Solid,
-                width: 2,
-            }],
             markers: vec![Markers {
                 label: "FE".into(),
                 points: fe_pts,
                 color: COLORS[2],
                 hollow: false,
             }],
-            panel: None,
-            notes: vec![],
-            equal_aspect: false,
-            y_from_zero: true,
+            ..Figure::new(
+                format!("{}: end effect on {q}", c.spec.name),
+                "tube length L/R",
+                "log10 |FE/GPS − 1 − c|",
+                vec![Series {
+                    label: format!("fitted law {law_text}"),
+                    points: curve,
+                    color: COLORS[0],
+                    stroke: Stroke::Solid,
+                    width: 2,
+                }],
+            )
         },
         r,
     );
@@ -1176,11 +1167,11 @@ fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     });
     r.details = serde_json::json!({ "epsilon": eps, "steps": per_step });
     plot(
-        &Figure {
-            title: format!("{}: translation-invariant core", c.spec.name),
-            x_label: "step (all stages)".into(),
-            y_label: "core length / L".into(),
-            series: vec![
+        &Figure::new(
+            format!("{}: translation-invariant core", c.spec.name),
+            "step (all stages)",
+            "core length / L",
+            vec![
                 Series {
                     label: format!("core within ε = {eps:e}"),
                     points: pts.clone(),
@@ -1196,12 +1187,7 @@ fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                     width: 2,
                 },
             ],
-            markers: vec![],
-            panel: None,
-            notes: vec![],
-            equal_aspect: false,
-            y_from_zero: true,
-        },
+        ),
         r,
     );
     Ok(None)
