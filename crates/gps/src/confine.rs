@@ -983,7 +983,10 @@ mod tests {
         for s in &path[first_polygon..] {
             assert!(s.walls[0].contact_length > 0.0);
         }
-        // continuity: the largest jump of ϖ between neighbours is of the size of the others
+        // continuity: the step of ϖ across the activation is of the size of its neighbours'
+        // (steps of 1/200 of the path); a discontinuous regime change would jump by the
+        // stadium-to-polygon difference instead. 3× a neighbour's step is the criterion: the
+        // step sizes vary by less than that along a smooth path (the path's curvature)
         let jumps: Vec<f64> = path.windows(2).map(|p| (p[1].w - p[0].w).abs()).collect();
         let at = jumps[first_polygon - 1];
         let typical = jumps[first_polygon + 1];
