@@ -6,6 +6,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# A clean run builds the workspace twice (debug for the tests, release for the binary and the
+# Python module) plus the wheel of the pip check: about 12 GiB. Say so up front rather than
+# let pip or the linker die of ENOSPC half-way.
+FREE_KIB=$(df -Pk . | awk 'NR==2 {print $4}')
+echo "== free disk here: $((FREE_KIB / 1048576)) GiB"
+if [ "$FREE_KIB" -lt $((12 * 1048576)) ]; then
+  echo "warning: less than 12 GiB free; a clean test run may fail with 'No space left on device'" >&2
+fi
+
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy (all targets, warnings are errors)"

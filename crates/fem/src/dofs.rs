@@ -120,6 +120,18 @@ impl DofMap {
         }
     }
 
+    /// x − x0 on the free dofs (a plug's shared axial equation takes any of its nodes' equal
+    /// differences).
+    pub fn difference(&self, x: &[[f64; 3]], x0: &[[f64; 3]]) -> Vec<f64> {
+        let mut d = vec![0.0; self.n_eq];
+        for (k, e) in self.eq.iter().enumerate() {
+            if let Some(e) = e {
+                d[*e] = x[k / 3][k % 3] - x0[k / 3][k % 3];
+            }
+        }
+        d
+    }
+
     /// The largest nodal displacement of an increment dx.
     pub fn max_nodal_norm(&self, dx: &[f64]) -> f64 {
         (0..self.eq.len() / 3)

@@ -25,6 +25,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod contact;
+pub mod continuation;
 pub mod dofs;
 pub mod element;
 pub mod geometry;

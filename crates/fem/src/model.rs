@@ -436,8 +436,92 @@ impl Model {
             state.p = p;
         }
         let settings = self.settings;
-        let mut problem = MembraneProblem { model: self, load };
+        let mut problem = MembraneProblem {
+            model: self,
+            load,
+            arc: None,
+        };
         newton::solve(&mut problem, state, &settings)
+    }
+
+    /// Newton iterations on equilibrium under the pressure `state.p` (a free unknown) together
+    /// with the arc-length constraint `arc` (see [`ArcConstraint`]); `state` is the predictor
+    /// and, on success, the converged point. `load.loading` must be a pressure (its value is
+    /// ignored: the pressure is the continuation parameter).
+    pub fn solve_arc(
+        &mut self,
+        state: &mut State,
+        load: &Load,
+        arc: &ArcConstraint<'_>,
+    ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
+        let settings = self.settings;
+        // the pressure is the continuation parameter: whatever the stage's own control, the
+        // corrector solves equilibrium under ϖ (an unknown) with the stage's planes
+        let load = &Load {
+            loading: Loading::Pressure(state.p),
+            contact: load.contact.clone(),
+        };
+        let mut problem = MembraneProblem {
+            model: self,
+            load,
+            arc: Some(arc),
+        };
+        newton::solve(&mut problem, state, &settings)
+    }
+
+    /// The path tangent under pressure as the load parameter at the equilibrium `state`:
+    /// b = K⁻¹ g (dx/dϖ on the free dofs, K = K_int − ϖ H the pressure-control stiffness) and
+    /// the number of negative pivots of K. Factorizes K at `state`.
+    pub fn pressure_tangent(
+        &mut self,
+        state: &State,
+        load: &Load,
+    ) -> Result<(Vec<f64>, usize), FemError> {
+        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
+        let (neg, _) = self.factorize(&a, state.p)?;
+        let mut b = a.g;
+        self.ldlt.solve(&mut b);
+        Ok((b, neg))
+    }
+
+    /// Inverse iteration with the factor of K = K_int − ϖ H at `state`: the eigenvector of K of
+    /// smallest |eigenvalue| (unit Euclidean norm on the free dofs) and its Rayleigh quotient.
+    /// `iterations` solves, from a start vector of ones.
+    pub fn smallest_mode(
+        &mut self,
+        state: &State,
+        load: &Load,
+        iterations: usize,
+    ) -> Result<(Vec<f64>, f64), FemError> {
+        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
+        self.factorize(&a, state.p)?;
+        let n = self.n_eq();
+        // a start vector with a component along every mode: ones plus a deterministic ramp
+        let mut v: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 / n as f64)).collect();
+        let mut mu = 0.0;
+        for _ in 0..iterations.max(1) {
+            let nv = norm(&v);
+            v.iter_mut().for_each(|x| *x /= nv);
+            let mut w = v.clone();
+            self.ldlt.solve(&mut w);
+            // Rayleigh quotient of K⁻¹: vᵀK⁻¹v, so μ(K) ≈ 1/(vᵀw)
+            let vw = dot(&v, &w);
+            mu = if vw != 0.0 { 1.0 / vw } else { 0.0 };
+            v = w;
+        }
+        let nv = norm(&v);
+        v.iter_mut().for_each(|x| *x /= nv);
+        Ok((v, mu))
+    }
+
+    /// x − x0 on the free dofs.
+    pub fn free_difference(&self, x: &[[f64; 3]], x0: &[[f64; 3]]) -> Vec<f64> {
+        self.dofs.difference(x, x0)
+    }
+
+    /// x0 + t·dx on the free dofs (into `x`).
+    pub fn free_update(&self, x: &mut [[f64; 3]], dx: &[f64], t: f64) {
+        self.dofs.apply(x, dx, t)
     }
 
     /// The residual R = f_int − p ∂V/∂x on the free dofs, with p = `p` or, for closed gas,
@@ -527,11 +611,32 @@ fn potential(loading: Loading, energy: f64, v_part: f64, p: f64) -> f64 {
     }
 }
 
+/// The arc-length (pseudo-arclength) constraint of one continuation step from the converged
+/// point (x₀, ϖ₀) along the unit tangent (t_x, t_ϖ):
+///
+/// ```text
+/// c(x, ϖ) = w t_xᵀ(x − x₀) + t_ϖ (ϖ − ϖ₀) − Δs = 0
+/// ```
+///
+/// with x − x₀ on the free dofs and `w` the weight of the displacements in the arc-length norm
+/// ‖(Δx, Δϖ)‖² = w ΔxᵀΔx + Δϖ².
+#[derive(Clone, Copy, Debug)]
+pub struct ArcConstraint<'a> {
+    pub x0: &'a [[f64; 3]],
+    pub p0: f64,
+    pub tx: &'a [f64],
+    pub tp: f64,
+    pub w: f64,
+    pub ds: f64,
+}
+
 /// The membrane equilibrium under one load, as a [`newton::Problem`]: the state is (x, p), the
-/// step (Δx on the free dofs, Δp).
+/// step (Δx on the free dofs, Δp). With `arc`, the pressure is an unknown and the arc-length
+/// constraint closes the system.
 struct MembraneProblem<'a> {
     model: &'a mut Model,
     load: &'a Load,
+    arc: Option<&'a ArcConstraint<'a>>,
 }
 
 impl MembraneProblem<'_> {
@@ -578,13 +683,28 @@ impl newton::Problem for MembraneProblem<'_> {
         state.p = self.pressure(state.p, a.volume);
         let p = state.p;
         let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
-        let (c, h): (f64, Option<Vec<f64>>) = match self.load.loading {
-            Loading::Volume(v) => (m * a.volume - v, Some(a.g.iter().map(|g| m * g).collect())),
-            Loading::Node {
-                node,
-                component,
-                target,
-            } => {
+        // the constraint c, its gradient h in x and its derivative cp in ϖ
+        let mut cp = 0.0;
+        let (c, h): (f64, Option<Vec<f64>>) = match (self.arc, self.load.loading) {
+            (Some(arc), _) => {
+                let d = self.model.dofs.difference(&state.x, arc.x0);
+                cp = arc.tp;
+                (
+                    arc.w * dot(arc.tx, &d) + arc.tp * (p - arc.p0) - arc.ds,
+                    Some(arc.tx.iter().map(|t| arc.w * t).collect()),
+                )
+            }
+            (None, Loading::Volume(v)) => {
+                (m * a.volume - v, Some(a.g.iter().map(|g| m * g).collect()))
+            }
+            (
+                None,
+                Loading::Node {
+                    node,
+                    component,
+                    target,
+                },
+            ) => {
                 let k = self
                     .model
                     .dofs
@@ -599,8 +719,9 @@ impl newton::Problem for MembraneProblem<'_> {
         let reference = force_scale(&a, p);
         let res = norm(&r) / reference;
         self.admissible(&a, p, res)?;
-        let cscale = match self.load.loading {
-            Loading::Volume(v) => v.abs().max(1e-300),
+        let cscale = match (self.arc, self.load.loading) {
+            (Some(arc), _) => arc.ds.abs().max(1e-300),
+            (None, Loading::Volume(v)) => v.abs().max(1e-300),
             _ => 1.0,
         };
         let merit = res + c.abs() / cscale;
@@ -612,7 +733,7 @@ impl newton::Problem for MembraneProblem<'_> {
         ldlt.solve(&mut dx);
         let mut dp = 0.0;
         let mut negative = neg;
-        if self.load.gas().is_some() {
+        if self.load.gas().is_some() && self.arc.is_none() {
             let cc = p / a.volume;
             let mut b = a.g.clone();
             ldlt.solve(&mut b);
@@ -628,9 +749,11 @@ impl newton::Problem for MembraneProblem<'_> {
         } else if let Some(h) = &h {
             let mut b = a.g.clone();
             ldlt.solve(&mut b);
-            let hb = dot(h, &b);
+            let hb = dot(h, &b) + cp;
             let ha = dot(h, &dx);
-            if hb < 0.0 {
+            // the bordered operator's inertia (volume or stretch control); an arc-length step
+            // reports the pressure-control stiffness K itself
+            if hb < 0.0 && self.arc.is_none() {
                 negative = negative.saturating_sub(1);
             }
             dp = (-c - ha) / hb;

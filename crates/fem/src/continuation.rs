@@ -1,0 +1,675 @@
+//! Arc-length continuation through limit points and snap-backs, with the critical points of
+//! the path located and classified. The driver knows nothing of membranes: a [`Path`] gives the
+//! equilibrium R(u, λ) = 0 of its own problem through a tangent and a corrector.
+//!
+//! # The method: pseudo-arclength (Keller) in (u, λ) with a scaled norm
+//!
+//! ```text
+//! ‖(Δu, Δλ)‖² = w ΔuᵀΔu + Δλ²                     (w: the Path's displacement weight)
+//! tangent:    b = K⁻¹ g  (g = −∂R/∂λ),  t = ±(b, 1)/‖(b, 1)‖
+//! predictor:  z = z_k + Δs t
+//! corrector:  R(u, λ) = 0  and  w t_uᵀ(u − u_k) + t_λ (λ − λ_k) = Δs    (bordered Newton)
+//! ```
+//!
+//! Why this one rather than Crisfield's spherical constraint: the linear constraint gives one
+//! bordered solve per iteration with no quadratic to choose a root from (Crisfield's root choice
+//! is exactly where its implementations reverse on snap-backs), and the hyperplane through the
+//! predictor cuts the path once for any Δs below the path's radius of curvature.
+//!
+//! The predictor's sign: t is oriented so that it points along the last converged secant,
+//! tᵀ(z_k − z_{k−1}) > 0 in the scaled norm. At a limit point t_λ changes sign while t_u does
+//! not, and in a snap-back the displacement-like quantities reverse while the path's secant does
+//! not: the rule follows the curve where a rule on sign(Δλ) or on det K would turn back. (A
+//! simple bifurcation also flips det K; the secant rule is blind to it, and the path goes on
+//! along the branch it was on.)
+//!
+//! Adaptive length: Δs ← Δs · clamp(√(N_d / N), ½, 2) after a step of N Newton iterations (N_d
+//! desired, Crisfield's rule), at most `max_ds`; a failed corrector halves Δs and tries again
+//! from the same converged point, so no converged step is ever lost.
+//!
+//! # Critical points
+//!
+//! Between two converged points k−1 and k:
+//! * t_λ changed sign: a **limit point** (λ has an extremum along the path). Located by the
+//!   Illinois variant of regula falsi on t_λ(σ), σ the arc length from k−1.
+//! * the negative-pivot count of K changed and t_λ did not: a **bifurcation** (an eigenvalue of
+//!   K crosses zero with its mode orthogonal to g). Located by bisection on the count.
+//!
+//! Both stop when the bracket on σ is at most `locate_tol` (1e-8 by default) long.
+//! A target (a monitored quantity of the state, e.g. the volume) reached between k−1 and k is
+//! located the same way, by Illinois on q(σ) − q*, and becomes the stage's last point.
+
+use std::fmt;
+
+/// An equilibrium path R(u, λ) = 0 the driver can follow.
+pub trait Path {
+    type State: Clone;
+    type Error: fmt::Display;
+    /// The load parameter λ of a state.
+    fn load(&self, s: &Self::State) -> f64;
+    /// The weight w of the displacements in the arc-length norm.
+    fn weight(&self) -> f64;
+    /// u(a) − u(b) on the free unknowns.
+    fn difference(&self, a: &Self::State, b: &Self::State) -> Vec<f64>;
+    /// base + ds (t_u, t_λ).
+    fn predict(&self, base: &Self::State, tu: &[f64], tl: f64, ds: f64) -> Self::State;
+    /// At an equilibrium: K⁻¹g (du/dλ under load control) and the number of negative pivots of
+    /// K.
+    fn tangent(&mut self, s: &Self::State) -> Result<(Vec<f64>, usize), Self::Error>;
+    /// Correct the predictor `s` onto the path under `arc`; the Newton iterations taken.
+    fn correct(
+        &mut self,
+        s: &mut Self::State,
+        arc: &Arc<'_, Self::State>,
+    ) -> Result<usize, Self::Error>;
+    /// Whether an error ends the stage at once (an interrupt) instead of cutting the step.
+    fn is_final(&self, _e: &Self::Error) -> bool {
+        false
+    }
+}
+
+/// The arc-length constraint of one corrector: w t_uᵀ(u − u_base) + t_λ(λ − λ_base) = ds.
+pub struct Arc<'a, S> {
+    pub base: &'a S,
+    pub tu: &'a [f64],
+    pub tl: f64,
+    pub w: f64,
+    pub ds: f64,
+}
+
+/// Every number the continuation uses, named.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArcSettings {
+    /// the first step goes 1/`initial_steps` of the way to the target (measured along the
+    /// tangent)
+    pub initial_steps: usize,
+    /// Newton iterations a step should take (Crisfield's rule)
+    pub desired_iterations: usize,
+    /// the longest step, as a multiple of the first
+    pub max_ds_factor: f64,
+    /// consecutive halvings of one step before the stage fails
+    pub max_cuts: usize,
+    /// a step shorter than this multiple of the first fails the stage (a path that can only be
+    /// crept along, e.g. towards a state the corrector can never pass)
+    pub min_ds_factor: f64,
+    /// converged steps allowed in one stage
+    pub max_steps: usize,
+    /// the bracket on σ to which critical points and the target are located
+    pub locate_tol: f64,
+    /// iterations of the locating loops
+    pub locate_iterations: usize,
+    /// the relative accuracy of a located target, |q − q*| ≤ target_rtol·max(|q*|, 1e-300)
+    pub target_rtol: f64,
+    /// the sign of dλ/ds at the start (+1: the load increases first)
+    pub first_direction: f64,
+}
+
+impl Default for ArcSettings {
+    fn default() -> Self {
+        Self {
+            initial_steps: 8,
+            desired_iterations: 5,
+            max_ds_factor: 4.0,
+            max_cuts: 12,
+            min_ds_factor: 1e-6,
+            max_steps: 2000,
+            locate_tol: 1e-8,
+            locate_iterations: 80,
+            target_rtol: 1e-10,
+            first_direction: 1.0,
+        }
+    }
+}
+
+/// What stops the stage: a monitored quantity reaching its value.
+pub struct Target<'a, S> {
+    pub name: &'a str,
+    pub monitor: &'a dyn Fn(&S) -> f64,
+    pub value: f64,
+}
+
+/// The kind of a critical point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CriticalKind {
+    /// a maximum of the load along the path
+    LimitMax,
+    /// a minimum of the load along the path
+    LimitMin,
+    /// an eigenvalue of K crossed zero with no turn of the load
+    Bifurcation,
+}
+
+impl fmt::Display for CriticalKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::LimitMax => "limit point (load maximum)",
+            Self::LimitMin => "limit point (load minimum)",
+            Self::Bifurcation => "bifurcation point",
+        })
+    }
+}
+
+/// A located critical point.
+#[derive(Clone, Debug)]
+pub struct Critical<S> {
+    pub kind: CriticalKind,
+    /// it lies between converged steps `step − 1` and `step`
+    pub step: usize,
+    /// the arc length from the path's start
+    pub s: f64,
+    /// the final bracket on σ
+    pub bracket: f64,
+    pub state: S,
+    pub load: f64,
+    /// negative pivots of K before and after
+    pub negative_before: usize,
+    pub negative_after: usize,
+}
+
+/// A converged step.
+pub struct ArcStep<'a, S> {
+    pub step: usize,
+    pub state: &'a S,
+    pub load: f64,
+    /// the arc length from the path's start
+    pub s: f64,
+    pub ds: f64,
+    pub iterations: usize,
+    /// dλ/ds of the unit tangent there
+    pub tl: f64,
+    pub negative_pivots: usize,
+    /// the monitored quantity
+    pub monitor: f64,
+    /// the step ends exactly at the target
+    pub at_target: bool,
+    pub cuts: usize,
+}
+
+/// What the driver reports as it goes.
+pub enum ArcEvent<'a, S> {
+    Step(ArcStep<'a, S>),
+    Critical(&'a Critical<S>),
+}
+
+/// Why a continuation stopped.
+#[derive(Debug)]
+pub enum ArcError<E, O> {
+    /// the tangent could not be computed at a converged point
+    Tangent { step: usize, source: E },
+    /// `cuts` halvings of step `step` did not converge
+    Stalled {
+        step: usize,
+        ds: f64,
+        cuts: usize,
+        load: f64,
+        source: E,
+    },
+    /// the step limit was reached before the target
+    StepLimit {
+        steps: usize,
+        load: f64,
+        monitor: f64,
+    },
+    /// the observer failed
+    Observer { step: usize, source: O },
+    /// the problem asked to stop (an interrupt)
+    Final { step: usize, source: E },
+}
+
+impl<E: fmt::Display, O: fmt::Display> fmt::Display for ArcError<E, O> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Tangent { step, source } => {
+                write!(f, "the path tangent at step {step} failed: {source}")
+            }
+            Self::Stalled {
+                step,
+                ds,
+                cuts,
+                load,
+                source,
+            } => write!(
+                f,
+                "arc-length step {step} from load {load:.9} did not converge after {cuts} halvings (Δs = {ds:.3e}): {source}"
+            ),
+            Self::StepLimit {
+                steps,
+                load,
+                monitor,
+            } => write!(
+                f,
+                "{steps} arc-length steps without reaching the target (load {load:.9}, monitored value {monitor:.9})"
+            ),
+            Self::Observer { step, source } => write!(f, "step {step}: {source}"),
+            Self::Final { step, source } => write!(f, "step {step}: {source}"),
+        }
+    }
+}
+
+/// The unit tangent at an equilibrium from b = K⁻¹g, oriented along `reference` (a secant, or
+/// `None` for the first step, then by `first_direction` on t_λ).
+fn unit_tangent(
+    b: Vec<f64>,
+    w: f64,
+    reference: Option<(&[f64], f64)>,
+    dir: f64,
+) -> (Vec<f64>, f64) {
+    let n = (w * b.iter().map(|v| v * v).sum::<f64>() + 1.0).sqrt();
+    let mut tu: Vec<f64> = b.into_iter().map(|v| v / n).collect();
+    let mut tl = 1.0 / n;
+    let sign = match reference {
+        Some((du, dl)) => w * tu.iter().zip(du).map(|(a, b)| a * b).sum::<f64>() + tl * dl,
+        None => tl * dir,
+    };
+    if sign < 0.0 {
+        tu.iter_mut().for_each(|v| *v = -*v);
+        tl = -tl;
+    }
+    (tu, tl)
+}
+
+/// A converged point of the path with its oriented tangent.
+struct Point<S> {
+    state: S,
+    tu: Vec<f64>,
+    tl: f64,
+    negative: usize,
+    s: f64,
+}
+
+/// The located critical points of a followed path, or why it stopped.
+pub type FollowResult<P, O> =
+    Result<Vec<Critical<<P as Path>::State>>, ArcError<<P as Path>::Error, O>>;
+
+/// Follow the path of `path` from the equilibrium `start` until `target` is reached (located to
+/// `target_rtol`). `on_event` gets every converged step and every located critical point, in
+/// path order. Returns the located critical points.
+pub fn follow<P: Path, O>(
+    path: &mut P,
+    start: P::State,
+    target: &Target<'_, P::State>,
+    settings: &ArcSettings,
+    mut on_event: impl FnMut(&mut P, ArcEvent<'_, P::State>) -> Result<(), O>,
+) -> FollowResult<P, O> {
+    let w = path.weight();
+    let (b, negative) = path
+        .tangent(&start)
+        .map_err(|source| ArcError::Tangent { step: 0, source })?;
+    let (tu, tl) = unit_tangent(b, w, None, settings.first_direction);
+    let mut point = Point {
+        state: start,
+        tu,
+        tl,
+        negative,
+        s: 0.0,
+    };
+    let q0 = (target.monitor)(&point.state);
+    // the first step: 1/initial_steps of the distance to the target along the tangent (dq/ds by
+    // a difference along the predictor: q is a function of the state alone)
+    let h = 1e-6;
+    let probe = path.predict(&point.state, &point.tu, point.tl, h);
+    let dqds = ((target.monitor)(&probe) - q0) / h;
+    let mut ds = if dqds.is_finite() && dqds.abs() > 0.0 {
+        ((target.value - q0) / dqds).abs() / settings.initial_steps.max(1) as f64
+    } else {
+        1e-2
+    };
+    if !(ds > 0.0 && ds.is_finite()) {
+        ds = 1e-2;
+    }
+    let max_ds = settings.max_ds_factor * ds;
+    let min_ds = settings.min_ds_factor * ds;
+    let mut criticals = Vec::new();
+    let mut step = 0usize;
+    let qtol = settings.target_rtol * target.value.abs().max(1e-300);
+    loop {
+        if step >= settings.max_steps {
+            return Err(ArcError::StepLimit {
+                steps: step,
+                load: path.load(&point.state),
+                monitor: (target.monitor)(&point.state),
+            });
+        }
+        // one converged step of length ds (halved on failure)
+        let mut cuts = 0;
+        let (next, iterations) = loop {
+            match corrector(path, &point, w, ds) {
+                Ok(r) => break r,
+                Err(e) => {
+                    if path.is_final(&e) {
+                        return Err(ArcError::Final {
+                            step: step + 1,
+                            source: e,
+                        });
+                    }
+                    cuts += 1;
+                    if cuts > settings.max_cuts || ds * 0.5 < min_ds {
+                        return Err(ArcError::Stalled {
+                            step: step + 1,
+                            ds,
+                            cuts: cuts - 1,
+                            load: path.load(&point.state),
+                            source: e,
+                        });
+                    }
+                    ds *= 0.5;
+                }
+            }
+        };
+        let secant = (
+            path.difference(&next, &point.state),
+            path.load(&next) - path.load(&point.state),
+        );
+        let (b, negative) = path.tangent(&next).map_err(|source| ArcError::Tangent {
+            step: step + 1,
+            source,
+        })?;
+        let (tu, tl) = unit_tangent(b, w, Some((&secant.0, secant.1)), 1.0);
+        let q_prev = (target.monitor)(&point.state);
+        let q_next = (target.monitor)(&next);
+        // critical points inside the step, in path order
+        if tl * point.tl < 0.0 {
+            let (tu0, tl0) = (point.tu.clone(), point.tl);
+            let c = locate(path, &point, w, ds, settings, |path, s| {
+                let (b, _) = path.tangent(s)?;
+                Ok(unit_tangent(b, w, Some((&tu0, tl0)), 1.0).1)
+            })
+            .map_err(|source| ArcError::Tangent {
+                step: step + 1,
+                source,
+            })?;
+            let kind = if point.tl > 0.0 {
+                CriticalKind::LimitMax
+            } else {
+                CriticalKind::LimitMin
+            };
+            let cp = Critical {
+                kind,
+                step: step + 1,
+                s: point.s + c.0,
+                bracket: c.1,
+                load: path.load(&c.2),
+                state: c.2,
+                negative_before: point.negative,
+                negative_after: negative,
+            };
+            on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
+                step: step + 1,
+                source,
+            })?;
+            criticals.push(cp);
+        } else if negative != point.negative {
+            let before = point.negative as f64;
+            let c = locate_count(path, &point, w, ds, settings, before).map_err(|source| {
+                ArcError::Tangent {
+                    step: step + 1,
+                    source,
+                }
+            })?;
+            let cp = Critical {
+                kind: CriticalKind::Bifurcation,
+                step: step + 1,
+                s: point.s + c.0,
+                bracket: c.1,
+                load: path.load(&c.2),
+                state: c.2,
+                negative_before: point.negative,
+                negative_after: negative,
+            };
+            on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
+                step: step + 1,
+                source,
+            })?;
+            criticals.push(cp);
+        }
+        step += 1;
+        // the target inside the step: locate it and end there
+        if (q_prev - target.value) * (q_next - target.value) <= 0.0 && q_prev != target.value {
+            let (sigma, end) = if (q_next - target.value).abs() <= qtol {
+                (ds, next)
+            } else {
+                let monitor = target.monitor;
+                let goal = target.value;
+                let (sigma, _, st) = locate_root(
+                    path,
+                    &point,
+                    w,
+                    (0.0, q_prev - goal),
+                    (ds, q_next - goal),
+                    settings,
+                    qtol,
+                    |_, s| Ok(monitor(s) - goal),
+                )
+                .map_err(|source| ArcError::Stalled {
+                    step,
+                    ds,
+                    cuts: 0,
+                    load: path.load(&point.state),
+                    source,
+                })?;
+                (sigma, st)
+            };
+            let (_, neg_end) = path
+                .tangent(&end)
+                .map_err(|source| ArcError::Tangent { step, source })?;
+            let info = ArcStep {
+                step,
+                load: path.load(&end),
+                state: &end,
+                s: point.s + sigma,
+                ds: sigma,
+                iterations,
+                tl: point.tl,
+                negative_pivots: neg_end,
+                monitor: (target.monitor)(&end),
+                at_target: true,
+                cuts,
+            };
+            on_event(path, ArcEvent::Step(info))
+                .map_err(|source| ArcError::Observer { step, source })?;
+            return Ok(criticals);
+        }
+        let info = ArcStep {
+            step,
+            load: path.load(&next),
+            state: &next,
+            s: point.s + ds,
+            ds,
+            iterations,
+            tl,
+            negative_pivots: negative,
+            monitor: q_next,
+            at_target: false,
+            cuts,
+        };
+        on_event(path, ArcEvent::Step(info))
+            .map_err(|source| ArcError::Observer { step, source })?;
+        point = Point {
+            state: next,
+            tu,
+            tl,
+            negative,
+            s: point.s + ds,
+        };
+        // Crisfield's rule for the next length
+        let f = (settings.desired_iterations.max(1) as f64 / iterations.max(1) as f64).sqrt();
+        ds = (ds * f.clamp(0.5, 2.0)).min(max_ds);
+    }
+}
+
+/// One corrector from `point` with arc length `ds`: the converged state and its iterations.
+fn corrector<P: Path>(
+    path: &mut P,
+    point: &Point<P::State>,
+    w: f64,
+    ds: f64,
+) -> Result<(P::State, usize), P::Error> {
+    let mut s = path.predict(&point.state, &point.tu, point.tl, ds);
+    let arc = Arc {
+        base: &point.state,
+        tu: &point.tu,
+        tl: point.tl,
+        w,
+        ds,
+    };
+    let it = path.correct(&mut s, &arc)?;
+    Ok((s, it))
+}
+
+/// Illinois regula falsi on f(σ) over the bracket (a, fa), (b, fb) with fa·fb < 0: stops when the
+/// bracket is at most `locate_tol` long or |f| ≤ `ftol`. Returns (σ, final bracket, state).
+#[allow(clippy::too_many_arguments)]
+fn locate_root<P: Path>(
+    path: &mut P,
+    point: &Point<P::State>,
+    w: f64,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    settings: &ArcSettings,
+    ftol: f64,
+    mut f: impl FnMut(&mut P, &P::State) -> Result<f64, P::Error>,
+) -> Result<(f64, f64, P::State), P::Error> {
+    let mut best: Option<(f64, f64, P::State)> = None;
+    for _ in 0..settings.locate_iterations {
+        let mut c = (a * fb - b * fa) / (fb - fa);
+        if !(c > a.min(b) && c < a.max(b)) {
+            c = 0.5 * (a + b);
+        }
+        let (s, _) = corrector(path, point, w, c)?;
+        let fc = f(path, &s)?;
+        if best.as_ref().is_none_or(|bb| fc.abs() < bb.1) {
+            best = Some((c, fc.abs(), s.clone()));
+        }
+        if fc == 0.0 || fc.abs() <= ftol {
+            return Ok((c, (b - a).abs(), s));
+        }
+        if fc * fb < 0.0 {
+            a = b;
+            fa = fb;
+        } else {
+            // the same end stays: halve its value (Illinois)
+            fa *= 0.5;
+        }
+        b = c;
+        fb = fc;
+        if (b - a).abs() <= settings.locate_tol {
+            return Ok((c, (b - a).abs(), s));
+        }
+    }
+    let (c, _, s) = best.expect("at least one iteration");
+    Ok((c, (b - a).abs(), s))
+}
+
+/// Locate a limit point: the zero of the oriented t_λ(σ) in (0, ds].
+fn locate<P: Path>(
+    path: &mut P,
+    point: &Point<P::State>,
+    w: f64,
+    ds: f64,
+    settings: &ArcSettings,
+    tl_at: impl FnMut(&mut P, &P::State) -> Result<f64, P::Error>,
+) -> Result<(f64, f64, P::State), P::Error> {
+    let mut tl_at = tl_at;
+    let (s_end, _) = corrector(path, point, w, ds)?;
+    let f_end = tl_at(path, &s_end)?;
+    locate_root(
+        path,
+        point,
+        w,
+        (0.0, point.tl),
+        (ds, f_end),
+        settings,
+        0.0,
+        tl_at,
+    )
+}
+
+/// Locate a bifurcation: bisection on σ ∈ (0, ds] for the change of the negative-pivot count
+/// from `before`. Returns the first point past the change.
+fn locate_count<P: Path>(
+    path: &mut P,
+    point: &Point<P::State>,
+    w: f64,
+    ds: f64,
+    settings: &ArcSettings,
+    before: f64,
+) -> Result<(f64, f64, P::State), P::Error> {
+    let (mut a, mut b) = (0.0, ds);
+    let (mut state_b, _) = corrector(path, point, w, ds)?;
+    for _ in 0..settings.locate_iterations {
+        if b - a <= settings.locate_tol {
+            break;
+        }
+        let c = 0.5 * (a + b);
+        let (s, _) = corrector(path, point, w, c)?;
+        let (_, neg) = path.tangent(&s)?;
+        if neg as f64 == before {
+            a = c;
+        } else {
+            b = c;
+            state_b = s;
+        }
+    }
+    Ok((b, b - a, state_b))
+}
+
+#[cfg(test)]
+mod tests;
+
+/// The membrane model as a [`Path`]: u the free dofs, λ the reduced pressure ϖ, under the
+/// planes of `load` (its own control is replaced by the arc-length constraint). The weight of
+/// the displacements is 1/n_eq, so that ‖Δu‖ is their root mean square (in R), of the same order
+/// as Δϖ.
+pub struct MembranePath<'a> {
+    pub model: &'a mut crate::model::Model,
+    pub load: crate::model::Load,
+}
+
+impl Path for MembranePath<'_> {
+    type State = crate::model::State;
+    type Error = crate::newton::NewtonError<crate::FemError>;
+    fn load(&self, s: &Self::State) -> f64 {
+        s.p
+    }
+    fn weight(&self) -> f64 {
+        1.0 / self.model.n_eq().max(1) as f64
+    }
+    fn difference(&self, a: &Self::State, b: &Self::State) -> Vec<f64> {
+        self.model.free_difference(&a.x, &b.x)
+    }
+    fn predict(&self, base: &Self::State, tu: &[f64], tl: f64, ds: f64) -> Self::State {
+        let mut s = base.clone();
+        self.model.free_update(&mut s.x, tu, ds);
+        s.p += ds * tl;
+        s
+    }
+    fn tangent(&mut self, s: &Self::State) -> Result<(Vec<f64>, usize), Self::Error> {
+        self.model
+            .pressure_tangent(s, &self.load)
+            .map_err(|source| crate::newton::NewtonError::Problem {
+                iteration: 0,
+                source,
+            })
+    }
+    fn correct(
+        &mut self,
+        s: &mut Self::State,
+        arc: &Arc<'_, Self::State>,
+    ) -> Result<usize, Self::Error> {
+        let c = crate::model::ArcConstraint {
+            x0: &arc.base.x,
+            p0: arc.base.p,
+            tx: arc.tu,
+            tp: arc.tl,
+            w: arc.w,
+            ds: arc.ds,
+        };
+        self.model
+            .solve_arc(s, &self.load, &c)
+            .map(|r| r.iterations)
+    }
+    fn is_final(&self, e: &Self::Error) -> bool {
+        matches!(e.cause(), Some(crate::FemError::Interrupted))
+    }
+}
