@@ -7,7 +7,9 @@ compare.csv) a side-by-side table of the mid-span values: FE (Rust), scikit-fem,
 and the relative differences.
 - inflation stage: the scikit-fem axisymmetric capped tube of the same L/R at the FE's mid-span
   λs, and GPS (eq. 66); it also plots the end-cap profile λs(Z), FE against axisymmetric, as
-  profile_stageN.png and reports the largest difference along the tube;
+  profile_stageN.png and reports the largest difference along the tube; an arc-length stage's
+  located pressure maximum (polygon factor taken out) against the axisymmetric tube's maximum
+  and the GPS limit point (limit_max_w, limit_max_lambda_s);
 - squeeze stage: the scikit-fem GPS cross-section with contact at the FE's λs* and ρ, and GPS
   flattening (eqs. 76-77);
 - confine stage: the scikit-fem periodic GPS ring (gps_ring, any planes) with the gas closed in
@@ -59,6 +61,22 @@ def compare(run_dir, out_dir, plot=True):
             continue
         fin, idx = st["final"], st["index"]
         if st["kind"] == "inflate":
+            # an arc-length stage's located pressure maximum against the axisymmetric tube's
+            # (same L/R and law; golden section on the stretch-controlled path) and GPS's: the FE
+            # value with the mesh's polygon factor 1/cos(pi/n) taken out
+            for c in st.get("critical_points", []):
+                if c["kind"] != "limit-max" or c.get("ripple") or "polygon_factor" not in c:
+                    continue
+                gps_max = closed_form.gps_pressure_maximum(law=law)
+                if gps_max is None:
+                    continue
+                ls_g, w_g, _ = gps_max
+                ls_ax, w_ax = axisym.pressure_maximum(length, ls_g - 0.05, ls_g + 0.1, law=law,
+                                                      cylinder_elements=int(8 * length))
+                fe_w = c["w"] / c["polygon_factor"]
+                rows.append((idx, "inflate", "limit_max_w", fe_w, w_ax, w_g, rel(fe_w, w_ax), rel(fe_w, w_g), rel(w_ax, w_g)))
+                rows.append((idx, "inflate", "limit_max_lambda_s", c["lambda_s"], ls_ax, ls_g,
+                             rel(c["lambda_s"], ls_ax), rel(c["lambda_s"], ls_g), rel(ls_ax, ls_g)))
             ls = fin["lambda_s"]
             try:
                 tube, q, p = axisym.inflate_to(length, ls, law=law, cylinder_elements=int(8 * length))

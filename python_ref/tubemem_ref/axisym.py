@@ -188,3 +188,29 @@ def inflate_volume(tube, q, p, v_target, dv, min_dv=1e-6, on_step=None):
         if it < 6:
             dv *= 1.5
     return q, p
+
+
+def pressure_maximum(length, lo, hi, law=None, tol=1e-7, **mesh):
+    """The pressure maximum of the capped tube's inflation, (lambda_s, p) at mid-span: golden
+    section on p(lambda_s) over [lo, hi] (which must bracket it), each p from a mid-span
+    stretch-controlled solve continued from the nearest solved state. The mid-span stretch grows
+    monotonically through the maximum, so the stretch-controlled path passes it."""
+    tube = AxisymmetricTube(length, law=law, **mesh)
+    q, p = tube.reference(), 0.0
+    for s in np.linspace(1.0, lo, 11)[1:]:
+        q, p, _ = tube.solve_stretch(q, p, s)
+    g = (np.sqrt(5.0) - 1.0) / 2.0
+    a, b = lo, hi
+    c, d = b - g * (b - a), a + g * (b - a)
+    qc, pc, _ = tube.solve_stretch(q, p, c)
+    qd, pd, _ = tube.solve_stretch(qc, pc, d)
+    while b - a > tol:
+        if pc > pd:
+            b, d, qd, pd = d, c, qc, pc
+            c = b - g * (b - a)
+            qc, pc, _ = tube.solve_stretch(qd, pd, c)
+        else:
+            a, c, qc, pc = c, d, qd, pd
+            d = a + g * (b - a)
+            qd, pd, _ = tube.solve_stretch(qc, pc, d)
+    return (c, pc) if pc > pd else (d, pd)

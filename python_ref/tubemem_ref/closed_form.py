@@ -81,6 +81,22 @@ def gps_inflation(ls, kuhn=30.0, law=None):
     return ns / ls, lz
 
 
+def gps_pressure_maximum(kuhn=30.0, law=None, top=4.0):
+    """(lambda_s, w, lambda_z) at the first maximum of the GPS inflation curve w(lambda_s), or
+    None: a scan of w over (1, top] in steps of 0.01 brackets it, a bounded Brent search refines
+    it to 1e-12 in lambda_s."""
+    law = law or ("abb", kuhn)
+    ls = np.arange(1.01, top, 0.01)
+    w = np.array([gps_inflation(x, law=law)[0] for x in ls])
+    k = next((i for i in range(1, len(w) - 1) if w[i] >= w[i - 1] and w[i] >= w[i + 1]), None)
+    if k is None:
+        return None
+    r = optimize.minimize_scalar(lambda x: -gps_inflation(x, law=law)[0], bounds=(ls[k - 1], ls[k + 1]),
+                                 method="bounded", options={"xatol": 1e-12})
+    wm, lz = gps_inflation(r.x, law=law)
+    return r.x, wm, lz
+
+
 def ps_inflation(ls, kuhn=30.0, law=None):
     """w for free inflation under PS, eq. (70) (ABB) or N_s(ls, 1)/ls for any law."""
     if law is not None and law[0] != "abb":

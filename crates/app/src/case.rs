@@ -35,6 +35,7 @@
 //! [[stage]]
 //! kind = "inflate"
 //! control = "volume"    # "pressure" (target_pressure) | "volume" (target_stretch or target_volume_ratio)
+//!                       # | "arc-length" (any of the three, reached along the path through limit points)
 //! target_stretch = 1.3  # mid-span hoop stretch λs*
 //! steps = 6             # initial number of load steps (adaptive afterwards)
 //! ```
@@ -289,6 +290,8 @@ impl PlaneSpec {
 pub enum ControlKind {
     Pressure,
     Volume,
+    /// arc-length continuation in (x, ϖ) to any of the three targets
+    ArcLength,
 }
 
 #[derive(Debug, Deserialize)]
@@ -346,6 +349,21 @@ impl Target {
     }
 }
 
+impl StagePlan {
+    /// The stage label in words, for progress lines.
+    pub fn describe(&self) -> String {
+        if !self.arc_length {
+            return self.target.describe();
+        }
+        match self.target {
+            Target::Pressure(p) => format!("inflate, arc-length continuation to ϖ = {p}"),
+            Target::Stretch(s) => format!("inflate, arc-length continuation to mid-span λs = {s}"),
+            Target::VolumeRatio(r) => format!("inflate, arc-length continuation to V/V0 = {r}"),
+            _ => self.target.describe(),
+        }
+    }
+}
+
 /// How the contact penalty of a squeeze is set.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -365,6 +383,10 @@ pub struct StagePlan {
     pub steps: usize,
     /// squeeze stages only
     pub penalty: Option<PenaltySpec>,
+    /// `control = "arc-length"`: the target is reached along the path by arc-length
+    /// continuation, through limit points and snap-backs, with critical points located
+    #[serde(default)]
+    pub arc_length: bool,
 }
 
 /// The penetration tolerance (in R) that sets the penalty when a squeeze gives neither
@@ -387,6 +409,7 @@ impl StageSpec {
             target,
             steps: self.steps,
             penalty,
+            arc_length: self.control == Some(ControlKind::ArcLength),
         })
     }
 
@@ -401,7 +424,14 @@ impl StageSpec {
             (Kind::Inflate, Some(ControlKind::Pressure), (Some(p), None, None, None)) => Target::Pressure(p),
             (Kind::Inflate, Some(ControlKind::Volume), (None, Some(s), None, None)) => Target::Stretch(s),
             (Kind::Inflate, Some(ControlKind::Volume), (None, None, Some(v), None)) => Target::VolumeRatio(v),
-            (Kind::Inflate, None, _) => invalid!("[[stage]] {}: kind = \"inflate\" needs `control` (\"pressure\" or \"volume\")", i + 1),
+            (Kind::Inflate, Some(ControlKind::ArcLength), (Some(p), None, None, None)) => Target::Pressure(p),
+            (Kind::Inflate, Some(ControlKind::ArcLength), (None, Some(s), None, None)) => Target::Stretch(s),
+            (Kind::Inflate, Some(ControlKind::ArcLength), (None, None, Some(v), None)) => Target::VolumeRatio(v),
+            (Kind::Inflate, Some(ControlKind::ArcLength), _) => invalid!(
+                "[[stage]] {}: control = \"arc-length\" takes exactly one target, `target_pressure`, `target_stretch` (mid-span λs*) or `target_volume_ratio`, reached on the path",
+                i + 1
+            ),
+            (Kind::Inflate, None, _) => invalid!("[[stage]] {}: kind = \"inflate\" needs `control` (\"pressure\", \"volume\" or \"arc-length\")", i + 1),
             (Kind::Inflate, Some(ControlKind::Pressure), _) => {
                 invalid!("[[stage]] {}: control = \"pressure\" takes exactly one target, `target_pressure`", i + 1)
             }

@@ -57,6 +57,19 @@ pub enum AppError {
         #[source]
         source: tubemem_fem::FemError,
     },
+    /// A pressure-controlled stage asked for a pressure above the path's maximum: after its
+    /// Newton failure, arc-length continuation from the last converged step located the limit
+    /// point below the target.
+    #[error("stage {stage} of {stages}: no equilibrium at ϖ = {target} beyond the limit point ϖmax ≈ {w_max:.7} (located at mid-span λs = {lambda_s:.5} by arc-length continuation from the last converged step; use volume or arc-length control)")]
+    BeyondLimit {
+        stage: usize,
+        stages: usize,
+        target: f64,
+        w_max: f64,
+        lambda_s: f64,
+        #[source]
+        source: Box<tubemem_fem::FemError>,
+    },
     #[error("stage {stage}, step {step}: a non-finite mid-span value was computed: {values:?}")]
     NonFinite {
         stage: usize,
@@ -137,6 +150,7 @@ impl AppError {
     pub fn material_cause(&self) -> Option<(usize, &tubemem_material::MaterialError)> {
         match self {
             AppError::Stage { source, .. } => source.material_cause(),
+            AppError::BeyondLimit { source, .. } => source.material_cause(),
             _ => None,
         }
     }

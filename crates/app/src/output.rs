@@ -30,7 +30,23 @@ use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 
 /// The columns of steps.csv. New columns are only ever appended.
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
-gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force";
+gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
+arc_length,dw_ds,critical";
+
+/// The `critical` column of steps.csv: the kind of a critical point located between the
+/// previous step and this one (empty: none).
+pub fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
+    use tubemem_fem::continuation::CriticalKind as K;
+    match k {
+        K::LimitMax => 1.0,
+        K::LimitMin => -1.0,
+        K::Bifurcation => 2.0,
+    }
+}
+
+/// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
+/// bifurcation, as steps.csv's `critical`).
+pub const CRITICAL_HEADER: &str = "stage,step,kind,arc_length,bracket,w,lambda_s,lambda_z,volume,negative_pivots_before,negative_pivots_after,reference_w,reference_lambda_s,polygon_factor,w_error_over_polygon,mode_eigenvalue";
 
 /// The values of one steps.csv row, `None` for an empty field.
 pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
@@ -76,6 +92,11 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
         Some(Ok(l)) => v.extend([l.lambda_s, l.lambda_z, l.chi, l.force].map(Some)),
         _ => v.extend([None; 4]),
     }
+    match &r.arc {
+        Some(a) => v.extend([Some(a.arc_length), Some(a.dw_ds)]),
+        None => v.extend([None; 2]),
+    }
+    v.push(r.critical.map(critical_code));
     v
 }
 
@@ -87,6 +108,7 @@ pub fn format_row(r: &StepRecord) -> String {
         .map(|(k, v)| match (k, v) {
             // integers as integers
             (0 | 1 | 9 | 10, Some(x)) => format!("{}", x as u64),
+            (29, Some(x)) => format!("{}", x as i64),
             (_, Some(x)) => format!("{x}"),
             (_, None) => String::new(),
         })
@@ -104,8 +126,9 @@ pub enum FolderMode {
 }
 
 /// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
-pub const RUN_ENTRIES: [&str; 10] = [
+pub const RUN_ENTRIES: [&str; 11] = [
     "checkpoints",
+    "critical_points.csv",
     "steps.csv",
     "walls.csv",
     "summary.json",
@@ -843,6 +866,77 @@ impl Observer for RunWriter {
             "ckpt-b.bin"
         };
         write_checkpoint(&dir.join(name), &dir.join(".ckpt.tmp"), &ck)?;
+        Ok(())
+    }
+
+    fn critical(
+        &mut self,
+        record: &crate::report::CriticalRecord,
+        model: &Model,
+        state: &State,
+        mode: Option<&[[f64; 3]]>,
+    ) -> Result<(), BoxError> {
+        let path = self.dir.join("critical_points.csv");
+        let fresh = !path.exists();
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(|e| AppError::io(&path, e))?;
+        if fresh {
+            writeln!(f, "{CRITICAL_HEADER}")?;
+        }
+        let r = record;
+        let g = r.reference.as_ref();
+        let vals = [
+            r.stage as f64,
+            r.step as f64,
+            critical_code(r.kind),
+            r.arc_length,
+            r.bracket,
+            r.midspan.w,
+            r.midspan.lambda_s,
+            r.midspan.lambda_z,
+            r.midspan.volume,
+            r.negative_pivots_before as f64,
+            r.negative_pivots_after as f64,
+            g.map_or(f64::NAN, |g| g.w),
+            g.map_or(f64::NAN, |g| g.lambda_s),
+            r.polygon_factor.unwrap_or(f64::NAN),
+            r.w_error_over_polygon.unwrap_or(f64::NAN),
+            r.mode_eigenvalue.unwrap_or(f64::NAN),
+        ];
+        writeln!(f, "{}", crate::curves::csv_line(&vals))?;
+        // a bifurcation: the state with its critical mode, for ParaView
+        if let (Some(mode), Some(name)) = (mode, &r.mode_vtu) {
+            let disp: Vec<f64> = state
+                .x
+                .iter()
+                .zip(&model.mesh().nodes)
+                .flat_map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]])
+                .collect();
+            let m: Vec<f64> = mode.iter().flatten().copied().collect();
+            let path = self.dir.join(name);
+            write_vtu(
+                &path,
+                &state.x,
+                &model.mesh().quads,
+                &[
+                    Field {
+                        name: "displacement",
+                        components: 3,
+                        values: &disp,
+                    },
+                    Field {
+                        name: "mode",
+                        components: 3,
+                        values: &m,
+                    },
+                ],
+                &[],
+                tubemem_mesh::vtu::Encoding::Binary,
+            )?;
+        }
         Ok(())
     }
 

@@ -80,6 +80,37 @@ pub struct StepRecord {
     /// empty otherwise)
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub profile: Vec<RingValues>,
+    /// an arc-length step: the path's arc length at this step and dϖ/ds of its unit tangent
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arc: Option<ArcValues>,
+    /// a critical point located between the previous step and this one
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub critical: Option<tubemem_fem::continuation::CriticalKind>,
+}
+
+/// Two successive limit points whose pressures differ by less than this (relative) are a ripple
+/// of the discrete path: a bulge front that crosses an element boundary makes the pressure
+/// oscillate about the Maxwell plateau with the element length as period, and each oscillation
+/// is a pair of limit points. The bound is the accuracy claimed for the plateau (1e-4, the
+/// Maxwell check); the ripples measured on the λs* = 6 tubes (32 around, 4 elements per R along)
+/// are below 1e-8, a tube's real pair (ϖmax 0.761 → plateau 0.453) differs by 40 %.
+pub const RIPPLE: f64 = 1e-4;
+
+/// The closed-form value a located limit point is compared with.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CriticalReference {
+    /// "GPS limit point (maximum)", "GPS limit point (minimum)" or "Maxwell pressure"
+    pub what: String,
+    pub w: f64,
+    /// the limit point's λs, or the upper coexisting λs of the Maxwell state
+    pub lambda_s: f64,
+}
+
+/// Where an arc-length step is on its path.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct ArcValues {
+    pub arc_length: f64,
+    pub dw_ds: f64,
 }
 
 /// The final state of a stage (the `final` entry of summary.json).
@@ -190,6 +221,9 @@ pub struct StageSummary {
     /// a confine stage: its planes as the case gave them
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub planes: Vec<crate::case::PlaneSpec>,
+    /// an arc-length stage: the critical points located on its path, in path order
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub critical_points: Vec<CriticalRecord>,
 }
 
 /// One wall at the end of a confine stage.
@@ -209,6 +243,51 @@ pub struct StageFailure {
     pub index: usize,
     pub error: String,
     pub last_converged: Option<MidSpan>,
+    /// the critical points an arc-length stage located before it failed
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub critical_points: Vec<CriticalRecord>,
+}
+
+/// A critical point located on an arc-length stage's path
+/// ([`tubemem_fem::continuation`]): a limit point of the pressure or a bifurcation.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CriticalRecord {
+    pub stage: usize,
+    /// it lies between the stage's converged steps `step − 1` and `step`
+    pub step: usize,
+    pub kind: tubemem_fem::continuation::CriticalKind,
+    /// the path's arc length from the stage start (scaled norm: RMS displacement in R, ϖ)
+    pub arc_length: f64,
+    /// the final bracket on the arc length (≤ 1e-8 when located)
+    pub bracket: f64,
+    /// the mid-span values at the point (ϖ, λs, λz, resultants, volume ratio)
+    #[serde(flatten)]
+    pub midspan: MidSpan,
+    /// negative pivots of the pressure-control stiffness before and after the point
+    pub negative_pivots_before: usize,
+    pub negative_pivots_after: usize,
+    /// a limit point: the closed form it is compared with — the Maxwell pressure when the
+    /// mid-span λs is beyond the uniform curve's minimum (the mid-span then sits in the upper
+    /// phase of a bulge, whose pressure is Maxwell's); otherwise the GPS limit point of the
+    /// same kind (the uniform tube's maximum or minimum) —
+    /// and the FE pressure over it divided by the mesh's polygon factor 1/cos(π/n), minus one:
+    /// the end effect plus the discretization error beyond the facets'
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<CriticalReference>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon_factor: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub w_error_over_polygon: Option<f64>,
+    /// a limit point within [`RIPPLE`] (relative, in ϖ) of the stage's previous one: the
+    /// ripple of a propagating front crossing the elements, not a limit point of the tube
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub ripple: bool,
+    /// a bifurcation: the eigenvalue of K nearest zero at the point (inverse iteration) and the
+    /// VTU holding its mode (field `mode`), relative to the run folder
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode_eigenvalue: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode_vtu: Option<String>,
 }
 
 /// One stage of the report: its plan, its steps and how it ended.

@@ -5,9 +5,10 @@ use crate::case::{Caps, Case, PenaltySpec, StagePlan, Target};
 use crate::report::*;
 use crate::{AppError, Result};
 use tubemem_fem::contact::{penalty_for, Contact};
+use tubemem_fem::continuation::{run_arc_stage, Critical, CriticalKind};
 use tubemem_fem::model::{nearest_node, Load, Loading, Model, State};
 use tubemem_fem::post::{cell_values, midspan, midspan_contact, ring_profile, Regime};
-use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepSettings};
+use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepInfo, StepSettings};
 use tubemem_fem::NewtonSettings;
 use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
@@ -67,6 +68,141 @@ pub trait Observer {
     }
     /// The run failed; `report` holds every converged step, and the failed stage's error.
     fn failed(&mut self, _report: &RunReport, _error: &AppError) {}
+    /// An arc-length stage located a critical point (`state` there; `mode` the critical mode
+    /// of a bifurcation as nodal vectors), reported before the step that follows it.
+    fn critical(
+        &mut self,
+        _record: &CriticalRecord,
+        _model: &Model,
+        _state: &State,
+        _mode: Option<&[[f64; 3]]>,
+    ) -> Result<(), BoxError> {
+        Ok(())
+    }
+}
+
+/// After a pressure-controlled stage failed below its target: follow the path by arc length from
+/// the last converged `state` towards `target` and return the first pressure maximum located on
+/// the way (ϖmax and the mid-span λs there), or `None` when the path reaches the target or the
+/// probe fails (the Newton failure is then the whole story). The model's state is not changed.
+fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Option<(f64, f64)> {
+    use tubemem_fem::continuation::{follow, ArcEvent, ArcSettings, MembranePath, Target};
+    let monitor = |s: &State| s.p;
+    let goal = Target {
+        name: "pressure",
+        monitor: &monitor,
+        value: target,
+    };
+    let mut path = MembranePath {
+        model,
+        load: Load::pressure(state.p),
+        last: None,
+    };
+    let mut found = None;
+    let _ = follow(
+        &mut path,
+        state.clone(),
+        &goal,
+        &ArcSettings::default(),
+        |path, e| match e {
+            ArcEvent::Critical(c) if c.kind == CriticalKind::LimitMax => {
+                found = midspan(path.model, &c.state)
+                    .ok()
+                    .map(|m| (c.load, m.lambda_s));
+                Err("located")
+            }
+            _ => Ok(()),
+        },
+    );
+    found.filter(|(w, _)| *w < target)
+}
+
+/// A located critical point waiting for the step that follows it.
+struct PendingCritical {
+    record: CriticalRecord,
+    state: State,
+    mode: Option<Vec<[f64; 3]>>,
+}
+
+/// Inverse iterations for the critical mode of a bifurcation: K is singular there to the
+/// location's tolerance, so the iteration converges by the ratio of the two smallest
+/// eigenvalues, which is tiny; 8 solves leave the mode converged to rounding.
+const MODE_ITERATIONS: usize = 8;
+
+/// The record of a located critical point (its mid-span values, the closed form's limit point
+/// of the same kind, and for a bifurcation the critical mode), queued in `pending`.
+#[allow(clippy::too_many_arguments)]
+fn critical_record(
+    model: &mut Model,
+    c: &Critical<State>,
+    stage: usize,
+    limits: Option<&tubemem_gps::limits::Limits>,
+    polygon: Option<f64>,
+    last_limit: &std::cell::Cell<Option<f64>>,
+    pending: &mut Vec<PendingCritical>,
+) -> std::result::Result<(), tubemem_fem::FemError> {
+    let ms = midspan(model, &c.state)?;
+    let reference = limits.and_then(|l| match c.kind {
+        // a mid-span past the uniform curve's minimum (λs beyond it) is in the upper phase of a
+        // bulge, whose pressure is Maxwell's (a uniform tube cannot be there at a limit point)
+        _ if l.min.is_some_and(|mn| ms.lambda_s > mn.lambda_s) && l.maxwell.is_some() => {
+            l.maxwell.map(|mw| CriticalReference {
+                what: "Maxwell pressure".into(),
+                w: mw.w,
+                lambda_s: mw.lambda_s_upper,
+            })
+        }
+        CriticalKind::LimitMax => l.max.map(|m| CriticalReference {
+            what: "GPS limit point (maximum)".into(),
+            w: m.w,
+            lambda_s: m.lambda_s,
+        }),
+        CriticalKind::LimitMin => l.min.map(|m| CriticalReference {
+            what: "GPS limit point (minimum)".into(),
+            w: m.w,
+            lambda_s: m.lambda_s,
+        }),
+        CriticalKind::Bifurcation => None,
+    });
+    let (mode, mode_eigenvalue) = if c.kind == CriticalKind::Bifurcation {
+        let load = Load::pressure(c.state.p);
+        let (v, mu) = model.smallest_mode(&c.state, &load, MODE_ITERATIONS)?;
+        let mut x = vec![[0.0; 3]; c.state.x.len()];
+        model.free_update(&mut x, &v, 1.0);
+        (Some(x), Some(mu))
+    } else {
+        (None, None)
+    };
+    let record = CriticalRecord {
+        stage,
+        step: c.step,
+        kind: c.kind,
+        arc_length: c.s,
+        bracket: c.bracket,
+        midspan: ms,
+        negative_pivots_before: c.negative_before,
+        negative_pivots_after: c.negative_after,
+        w_error_over_polygon: match (&reference, polygon) {
+            (Some(g), Some(f)) => Some(ms.w / (g.w * f) - 1.0),
+            _ => None,
+        },
+        reference,
+        polygon_factor: polygon,
+        mode_eigenvalue,
+        ripple: c.kind != CriticalKind::Bifurcation
+            && last_limit
+                .replace(Some(ms.w))
+                .is_some_and(|w0| (ms.w - w0).abs() <= RIPPLE * w0.abs()),
+        mode_vtu: mode
+            .as_ref()
+            .map(|_| format!("vtu/critical_stage{stage}_step{}.vtu", c.step)),
+    };
+    pending.push(PendingCritical {
+        record,
+        state: c.state.clone(),
+        mode,
+    });
+    Ok(())
 }
 
 /// A run's outcome: the report (always, with every converged step) and the error if it failed.
@@ -389,7 +525,7 @@ fn setup_stage(
     // a target the closed form has no state for: say so before the run meets it
     let beyond = match plan.target {
         Target::Stretch(s) => inflate(closed_form_law, Hypothesis::Gps, s).err(),
-        Target::Pressure(p) if p > 0.0 => tubemem_gps::limits::limit_points(
+        Target::Pressure(p) if p > 0.0 && !plan.arc_length => tubemem_gps::limits::limit_points(
             closed_form_law,
             Hypothesis::Gps,
         )
@@ -441,7 +577,9 @@ fn setup_stage(
             Target::Rho(_) | Target::Confine(_) => None,
         };
         let mut pre = settings;
-        let target_pressure = matches!(plan.target, Target::Pressure(_));
+        // an arc-length stage always starts pre-stressed: its first tangent needs the
+        // geometric stiffness
+        let target_pressure = matches!(plan.target, Target::Pressure(_)) && !plan.arc_length;
         if let Some(w) = estimate.filter(|w| *w > 0.0 && 0.5 * w < settings.prestress) {
             if !target_pressure {
                 pre.prestress = 0.5 * w;
@@ -500,6 +638,7 @@ fn setup_stage(
                 index: i,
                 error: format!("[[stage]] {i}: {message}"),
                 last_converged: None,
+                critical_points: vec![],
             }),
             profile: vec![],
         });
@@ -827,13 +966,25 @@ fn run_inner(
         let confine_planes =
             matches!(plan.target, Target::Confine(_)).then(|| case.stages[i - 1].plane.clone());
         let finished: &RunReport = report;
-        let result = run_stage_from(
-            &mut model,
-            &mut state,
-            &stage,
-            progress,
-            &load,
-            |m, st, info| {
+        // critical points located by an arc-length stage, reported to the observers with the
+        // step that follows them on the path
+        let pending: std::cell::RefCell<Vec<PendingCritical>> = Default::default();
+        // a resumed arc-length stage goes on in the direction its last two steps went
+        let direction = match steps.as_slice() {
+            [.., a, b] if b.midspan.w < a.midspan.w => -1.0,
+            _ => 1.0,
+        };
+        let mut criticals: Vec<CriticalRecord> = vec![];
+        let mut on_step = |m: &Model, st: &State, info: &StepInfo| {
+            let mut critical_here = None;
+            for p in pending.borrow_mut().drain(..) {
+                for o in observers.iter_mut() {
+                    o.critical(&p.record, m, &p.state, p.mode.as_deref())?;
+                }
+                critical_here = Some(p.record.kind);
+                criticals.push(p.record);
+            }
+            {
                 let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
                 let plates = if confine_planes.is_some() {
                     None
@@ -951,6 +1102,11 @@ fn run_inner(
                     walls,
                     closed_form,
                     profile,
+                    arc: plan.arc_length.then_some(ArcValues {
+                        arc_length: info.progress.lambda,
+                        dw_ds: info.dw_ds,
+                    }),
+                    critical: critical_here,
                 };
                 steps.push(record);
                 let view = StepView {
@@ -970,19 +1126,90 @@ fn run_inner(
                     o.step(&view)?;
                 }
                 Ok::<(), BoxError>(())
-            },
-        );
+            }
+        };
+        let result = if plan.arc_length {
+            let mesh = model.mesh().clone();
+            let mult = model.multiplicity();
+            let monitor: Box<dyn Fn(&State) -> f64> = match plan.target {
+                Target::Pressure(_) => Box::new(|s: &State| s.p),
+                Target::Stretch(_) => Box::new(move |s: &State| s.x[node][0]),
+                _ => Box::new(move |s: &State| mult * mesh.volume_at(&s.x)),
+            };
+            let law = closed_form_law.as_ref();
+            let limits = tubemem_gps::limits::limit_points(law, Hypothesis::Gps).ok();
+            let polygon = case
+                .mesh
+                .around
+                .filter(|_| case.mesh.file.is_none())
+                .map(|n| 1.0 / (std::f64::consts::PI / n as f64).cos());
+            let last_limit = std::cell::Cell::new(None);
+            let found = run_arc_stage(
+                &mut model,
+                &mut state,
+                &stage,
+                progress,
+                None,
+                &*monitor,
+                direction,
+                &mut on_step,
+                |m: &mut Model, c: &Critical<State>| {
+                    critical_record(
+                        m,
+                        c,
+                        i,
+                        limits.as_ref(),
+                        polygon,
+                        &last_limit,
+                        &mut pending.borrow_mut(),
+                    )
+                    .map_err(|e| Box::new(e) as BoxError)
+                },
+            );
+            found.map(|_| ())
+        } else {
+            run_stage_from(
+                &mut model,
+                &mut state,
+                &stage,
+                progress,
+                &load,
+                &mut on_step,
+            )
+        };
         if let Err(e) = result {
             let error = match e {
                 StageError::Solve(tubemem_fem::FemError::Interrupted) => AppError::Interrupted {
                     stage: i,
                     steps: steps.len(),
                 },
-                StageError::Solve(source) => AppError::Stage {
-                    stage: i,
-                    stages,
-                    source,
-                },
+                StageError::Solve(source) => {
+                    match (plan.target, plan.arc_length) {
+                        // a pressure target the path cannot reach: say where its maximum is
+                        (Target::Pressure(target), false) if state.p < target => {
+                            match pressure_maximum_below(&mut model, &state, target) {
+                                Some((w_max, lambda_s)) => AppError::BeyondLimit {
+                                    stage: i,
+                                    stages,
+                                    target,
+                                    w_max,
+                                    lambda_s,
+                                    source: Box::new(source),
+                                },
+                                None => AppError::Stage {
+                                    stage: i,
+                                    stages,
+                                    source,
+                                },
+                            }
+                        }
+                        _ => AppError::Stage {
+                            stage: i,
+                            stages,
+                            source,
+                        },
+                    }
+                }
                 StageError::Observer { step, source, .. } => match source.downcast::<AppError>() {
                     Ok(app) => *app,
                     Err(source) => AppError::Observer {
@@ -1000,6 +1227,7 @@ fn run_inner(
                     index: i,
                     error: error.chain(),
                     last_converged,
+                    critical_points: criticals,
                 }),
                 profile: vec![],
             });
@@ -1130,6 +1358,7 @@ fn run_inner(
             relative_error_vs_gps_at_fe_pressure: local_err,
             walls: wall_summary,
             planes: confine_planes.clone().unwrap_or_default(),
+            critical_points: criticals,
         };
         report.stages.push(StageReport {
             plan: *plan,

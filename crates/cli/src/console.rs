@@ -66,12 +66,7 @@ impl Observer for Console {
     }
 
     fn stage_started(&mut self, plan: &StagePlan, stages: usize) {
-        let label = format!(
-            "stage {}/{} ({})",
-            plan.index,
-            stages,
-            plan.target.describe()
-        );
+        let label = format!("stage {}/{} ({})", plan.index, stages, plan.describe());
         if self.terminal {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             bar.set_style(
@@ -181,8 +176,63 @@ impl Observer for Console {
                 w.fe.penetration
             )?;
         }
+        let ripples: Vec<_> = s.critical_points.iter().filter(|c| c.ripple).collect();
+        if let (Some(lo), Some(hi)) = (
+            ripples.iter().map(|c| c.midspan.w).reduce(f64::min),
+            ripples.iter().map(|c| c.midspan.w).reduce(f64::max),
+        ) {
+            say!(
+                "         {} more limit points within {:.0e} of each other (ϖ {lo:.9} to {hi:.9}): the ripple of the propagating front as it crosses the elements (critical_points.csv)",
+                ripples.len(),
+                tubemem_app::report::RIPPLE
+            )?;
+        }
         if let Some(d) = s.cap_boundary_layer {
             say!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)")?;
+        }
+        Ok(())
+    }
+
+    fn critical(
+        &mut self,
+        r: &tubemem_app::report::CriticalRecord,
+        _model: &Model,
+        _state: &State,
+        _mode: Option<&[[f64; 3]]>,
+    ) -> Result<(), BoxError> {
+        if r.ripple {
+            // counted in the stage's closing lines; each is in critical_points.csv
+            return Ok(());
+        }
+        let gps = match (&r.reference, r.w_error_over_polygon) {
+            (Some(g), Some(e)) => format!(
+                " (vs {} ϖ = {:.7} at λs = {:.5}: FE/(closed form × 1/cos(π/n)) − 1 = {e:+.2e})",
+                g.what, g.w, g.lambda_s
+            ),
+            (Some(g), None) => format!(" ({} ϖ = {:.6} at λs = {:.5})", g.what, g.w, g.lambda_s),
+            _ => String::new(),
+        };
+        let mode = r
+            .mode_vtu
+            .as_ref()
+            .map(|v| format!("; critical mode in {v}"))
+            .unwrap_or_default();
+        let line = format!(
+            "  stage {} ◆ {} between steps {} and {}: ϖ = {:.8}, λs = {:.6}, λz = {:.6}, V/V0 = {:.5}, negative pivots {} → {}{gps}{mode}",
+            r.stage,
+            r.kind,
+            r.step - 1,
+            r.step,
+            r.midspan.w,
+            r.midspan.lambda_s,
+            r.midspan.lambda_z,
+            r.midspan.volume,
+            r.negative_pivots_before,
+            r.negative_pivots_after
+        );
+        match &self.bar {
+            Some(bar) => bar.println(line),
+            None => say!("{line}")?,
         }
         Ok(())
     }

@@ -500,7 +500,8 @@ fn run_writes_steps_summary_profiles_and_vtu() {
         "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,\
          rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
          gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,\
-         local_lambda_s,local_lambda_z,local_chi,local_force"
+         local_lambda_s,local_lambda_z,local_chi,local_force,\
+         arc_length,dw_ds,critical"
     );
     let empty_for_inflation = [
         "rho",

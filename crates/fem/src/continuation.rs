@@ -39,6 +39,7 @@
 //! A target (a monitored quantity of the state, e.g. the volume) reached between k−1 and k is
 //! located the same way, by Illinois on q(σ) − q*, and becomes the stage's last point.
 
+use crate::stepping::{Stage, StageError, StepInfo, StepState};
 use std::fmt;
 
 /// An equilibrium path R(u, λ) = 0 the driver can follow.
@@ -624,6 +625,8 @@ mod tests;
 pub struct MembranePath<'a> {
     pub model: &'a mut crate::model::Model,
     pub load: crate::model::Load,
+    /// the report of the last successful corrector
+    pub last: Option<crate::newton::NewtonReport>,
 }
 
 impl Path for MembranePath<'_> {
@@ -665,11 +668,150 @@ impl Path for MembranePath<'_> {
             w: arc.w,
             ds: arc.ds,
         };
-        self.model
-            .solve_arc(s, &self.load, &c)
-            .map(|r| r.iterations)
+        let r = self.model.solve_arc(s, &self.load, &c)?;
+        let it = r.iterations;
+        self.last = Some(r);
+        Ok(it)
     }
     fn is_final(&self, e: &Self::Error) -> bool {
         matches!(e.cause(), Some(crate::FemError::Interrupted))
     }
+}
+
+/// One arc-length stage of the membrane: from the equilibrium `state`, follow the path in
+/// (x, ϖ) until `monitor` reaches `stage.to` (`stage.from` is its value at the start, for the
+/// progress fraction). Every converged step goes to `on_step` as a [`StepInfo`] (its `value` the
+/// monitored quantity, its Newton report's inertia the negative pivots of the pressure-control
+/// stiffness K), every located critical point to `on_critical`; `state` is the last converged
+/// step whatever happens. [`StepState::lambda`] carries the arc length and `dl` the next Δs.
+#[allow(clippy::too_many_arguments)]
+pub fn run_arc_stage<E>(
+    model: &mut crate::model::Model,
+    state: &mut crate::model::State,
+    stage: &Stage,
+    resume: Option<StepState>,
+    contact: Option<crate::contact::Contact>,
+    monitor: &dyn Fn(&crate::model::State) -> f64,
+    first_direction: f64,
+    mut on_step: impl FnMut(&crate::model::Model, &crate::model::State, &StepInfo) -> Result<(), E>,
+    mut on_critical: impl FnMut(
+        &mut crate::model::Model,
+        &Critical<crate::model::State>,
+    ) -> Result<(), E>,
+) -> Result<Vec<Critical<crate::model::State>>, StageError<E>> {
+    use crate::model::{Load, Loading};
+    use crate::FemError;
+    let settings = ArcSettings {
+        initial_steps: stage.settings.initial_steps,
+        max_cuts: stage.settings.max_cuts,
+        max_steps: stage.settings.max_steps,
+        first_direction,
+        ..ArcSettings::default()
+    };
+    let load = Load {
+        loading: Loading::Pressure(state.p),
+        contact,
+    };
+    let mut path = MembranePath {
+        model,
+        load,
+        last: None,
+    };
+    let target = Target {
+        name: "target",
+        monitor,
+        value: stage.to,
+    };
+    let span = stage.to - stage.from;
+    let index = stage.index;
+    // a resumed stage numbers its steps and measures its arc length on from the checkpoint
+    let (step0, s0) = resume.map_or((0, 0.0), |r| (r.step, r.lambda));
+    let result = follow(
+        &mut path,
+        state.clone(),
+        &target,
+        &settings,
+        |path, event| {
+            match event {
+                ArcEvent::Step(s) => {
+                    let mut newton = path.last.clone().unwrap_or(crate::newton::NewtonReport {
+                        iterations: s.iterations,
+                        residual: 0.0,
+                        history: vec![],
+                        inertia: Default::default(),
+                    });
+                    newton.inertia.negative_pivots = s.negative_pivots;
+                    let info = StepInfo {
+                        progress: StepState {
+                            lambda: s0 + s.s,
+                            dl: s.ds,
+                            step: step0 + s.step,
+                            cuts: s.cuts,
+                        },
+                        step: step0 + s.step,
+                        value: s.monitor,
+                        // exactly 1 at the located target (the stage end), below 1 before it
+                        fraction: if s.at_target || span == 0.0 {
+                            1.0
+                        } else {
+                            ((s.monitor - stage.from) / span).min(1.0 - 1e-12)
+                        },
+                        load: &Load {
+                            loading: Loading::Pressure(s.load),
+                            contact: path.load.contact.clone(),
+                        },
+                        newton: &newton,
+                        dw_ds: s.tl,
+                    };
+                    *state = s.state.clone();
+                    on_step(path.model, s.state, &info)
+                }
+                ArcEvent::Critical(c) => {
+                    let mut c = c.clone();
+                    c.step += step0;
+                    c.s += s0;
+                    on_critical(path.model, &c)
+                }
+            }
+        },
+    );
+    result.map_err(|e| match e {
+        ArcError::Observer { step, source } => StageError::Observer {
+            stage: index,
+            step: step0 + step,
+            source,
+        },
+        ArcError::Final { .. } => StageError::Solve(FemError::Interrupted),
+        ArcError::StepLimit { steps, monitor, .. } => StageError::Solve(FemError::StepLimit {
+            stage: index,
+            steps,
+            fraction: if span != 0.0 {
+                (monitor - stage.from) / span
+            } else {
+                0.0
+            },
+        }),
+        ArcError::Stalled {
+            step,
+            ds,
+            cuts,
+            load,
+            source,
+        } => StageError::Solve(FemError::Arc {
+            stage: index,
+            step: step0 + step,
+            p: load,
+            what: format!(
+                "no convergence after {cuts} halvings of the arc length (last Δs = {ds:.3e})"
+            ),
+            source: Box::new(source),
+        }),
+        ArcError::Tangent { step, source } => StageError::Solve(FemError::Arc {
+            stage: index,
+            step: step0 + step,
+            p: state.p,
+            what: "the path tangent could not be computed".into(),
+            source: Box::new(source),
+        }),
+    })
 }

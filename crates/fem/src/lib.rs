@@ -110,6 +110,16 @@ pub enum FemError {
         #[source]
         source: Box<newton::NewtonError<FemError>>,
     },
+    /// An arc-length stage could not take its next step.
+    #[error("stage {stage}, arc-length step {step} from ϖ = {p:.9}: {what}; last attempt")]
+    Arc {
+        stage: usize,
+        step: usize,
+        p: f64,
+        what: String,
+        #[source]
+        source: Box<newton::NewtonError<FemError>>,
+    },
 }
 
 impl FemError {

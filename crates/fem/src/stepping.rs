@@ -81,6 +81,8 @@ pub struct StepInfo<'a> {
     pub fraction: f64,
     pub load: &'a Load,
     pub newton: &'a NewtonReport,
+    /// an arc-length step: dϖ/ds of the path's unit tangent (NaN for load stepping)
+    pub dw_ds: f64,
 }
 
 /// Run one stage: the load parameter moves linearly from `stage.from` to `stage.to` (the load
@@ -173,6 +175,7 @@ pub fn run_stage_from<E>(
                     fraction: next,
                     load: &l,
                     newton: &report,
+                    dw_ds: f64::NAN,
                 };
                 on_step(model, state, &info).map_err(|source| StageError::Observer {
                     stage: stage.index,

@@ -623,6 +623,7 @@ fn arc_length_passes_and_locates_the_pressure_maximum_of_a_sphere() {
         let mut path = MembranePath {
             model: &mut model,
             load: Load::pressure(0.2),
+            last: None,
         };
         let target = Target {
             name: "volume ratio",
