@@ -5,6 +5,7 @@
 //! The reference paper: *On the generalized plane strain assumption for pressurized membranes*
 //! (README, "References"); equation numbers below are the paper's.
 
+mod bulge;
 mod sphere;
 mod squeeze;
 mod tube;

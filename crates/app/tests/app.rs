@@ -373,3 +373,107 @@ fn a_confine_runs_walls_csv_is_the_report() {
         .fold(0.0f64, |m, p| m.max(p.0.abs()).max(p.1.abs()));
     assert!(worst <= lim && worst > 1.1 - 1e-3, "{worst} against {lim}");
 }
+
+/// The small tube inflated by arc length past its pressure maximum to λs* = 2: the located
+/// maximum is in the report, in summary.json, in critical_points.csv and marked in steps.csv's
+/// `critical` column at the step that follows it; the stage ends exactly at its target.
+#[test]
+fn an_arc_length_stage_reports_its_critical_points_in_every_output() {
+    let text = SMALL
+        .replace("control = \"volume\"", "control = \"arc-length\"")
+        .replace("target_stretch = 1.2", "target_stretch = 2.0");
+    let case = Case::parse(&text).unwrap();
+    assert!(case.plan()[0].arc_length);
+    let out = tmp("arc");
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let report = run(&case, "small", &mut [&mut writer])
+        .into_result()
+        .unwrap();
+    let StageOutcome::Finished(s) = &report.stages[0].outcome else {
+        panic!("the stage failed")
+    };
+    assert!((s.final_state.midspan.lambda_s - 2.0).abs() < 1e-9);
+    let c = &s.critical_points[0];
+    assert_eq!(c.kind, tubemem_fem::continuation::CriticalKind::LimitMax);
+    assert!(c.bracket <= 1e-8 && !c.ripple);
+    // no converged step of the path has a higher pressure than the located maximum
+    let steps = &report.stages[0].steps;
+    assert!(steps.iter().all(|r| r.midspan.w <= c.midspan.w + 1e-12));
+    // the step after the maximum carries its kind; dϖ/ds changed sign there
+    let after = steps.iter().find(|r| r.step == c.step).unwrap();
+    assert!(after.critical.is_some());
+    let before = steps.iter().find(|r| r.step == c.step - 1).unwrap();
+    assert!(before.arc.unwrap().dw_ds > 0.0 && after.arc.unwrap().dw_ds < 0.0);
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let cp = &on_disk["stages"][0]["critical_points"][0];
+    assert_eq!(cp["kind"], "limit-max");
+    assert_eq!(cp["w"].as_f64().unwrap(), c.midspan.w);
+    let csv = std::fs::read_to_string(out.join("critical_points.csv")).unwrap();
+    let row: Vec<f64> = csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse().unwrap_or(f64::NAN))
+        .collect();
+    assert_eq!((row[0], row[1], row[2]), (1.0, c.step as f64, 1.0));
+    assert_eq!(row[5], c.midspan.w);
+    let steps_csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let marked: Vec<&str> = steps_csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.ends_with(",1"))
+        .collect();
+    assert_eq!(marked.len(), 1, "{steps_csv}");
+    assert!(marked[0].starts_with(&format!("1,{},", c.step)));
+}
+
+/// Pressure control to a pressure above the tube's maximum: the stage fails, and the error says
+/// that there is no equilibrium beyond the limit point, with the maximum located by arc length
+/// from the last converged step (the same maximum the arc-length stage locates, to its
+/// bracket), not only that Newton failed. Every converged step is kept, on disk too.
+#[test]
+fn a_pressure_beyond_the_maximum_is_refused_with_the_limit_point() {
+    let text = SMALL
+        .replace("control = \"volume\"", "control = \"pressure\"")
+        .replace("target_stretch = 1.2", "target_pressure = 0.9");
+    let case = Case::parse(&text).unwrap();
+    let out = tmp("beyond");
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let outcome = run(&case, "small", &mut [&mut writer]);
+    let err = outcome.error.expect("no equilibrium at ϖ = 0.9");
+    let tubemem_app::AppError::BeyondLimit { w_max, target, .. } = &err else {
+        panic!("{}", err.chain())
+    };
+    assert_eq!(*target, 0.9);
+    let msg = err.chain();
+    assert!(
+        msg.contains("no equilibrium at ϖ = 0.9 beyond the limit point ϖmax ≈")
+            && msg.contains("use volume or arc-length control"),
+        "{msg}"
+    );
+    // the same maximum as the arc-length stage's
+    let arc = Case::parse(
+        &SMALL
+            .replace("control = \"volume\"", "control = \"arc-length\"")
+            .replace("target_stretch = 1.2", "target_stretch = 2.0"),
+    )
+    .unwrap();
+    let r = run(&arc, "small", &mut []).into_result().unwrap();
+    let StageOutcome::Finished(s) = &r.stages[0].outcome else {
+        panic!()
+    };
+    let located = s.critical_points[0].midspan.w;
+    assert!((w_max - located).abs() < 1e-10, "{w_max} vs {located}");
+    // every converged step is kept, and each is below the maximum
+    let steps = &outcome.report.stages[0].steps;
+    assert!(!steps.is_empty());
+    assert!(steps.iter().all(|r| r.midspan.w < *w_max));
+    let rows = std::fs::read_to_string(out.join("steps.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert_eq!(rows, steps.len());
+}
