@@ -5,9 +5,9 @@
 //!   membrane equations independently of the Rust code): its pressure maximum on the
 //!   mid-span-stretch-controlled path, by golden section to 1e-7 in λs
 //!   (`tubemem_ref.axisym.pressure_maximum(L, 1.54, 1.69, cylinder_elements=8L)`; 16L elements
-//!   change it by < 1e-11):
-//!     L/R = 20: ϖmax = 0.7577382340795 at λs = 1.6097482, i.e. GPS × (1 + 1.12060e-3),
-//!     L/R = 40: ϖmax = 0.7569746324873 at λs = 1.5975167, i.e. GPS × (1 + 1.11733e-4);
+//!   change it by < 1e-11): at L/R = 20, ϖmax = 0.7577382340795 at λs = 1.6097482, i.e.
+//!   GPS × (1 + 1.12060e-3); at L/R = 40, ϖmax = 0.7569746324873 at λs = 1.5975167, i.e.
+//!   GPS × (1 + 1.11733e-4);
 //! * issue 12's closed-form values: the GPS limit point ϖ = 0.7568900627 at λs = 1.5916500471 and
 //!   the Maxwell state ϖ = 0.4508393877 with the upper coexisting λs = 5.90684.
 //!
