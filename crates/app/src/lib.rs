@@ -50,10 +50,12 @@ pub enum AppError {
     Model(#[source] tubemem_fem::FemError),
     #[error("[[stage]] {stage}: {message}")]
     StageInput { stage: usize, message: String },
-    #[error("stage {stage} of {stages} failed")]
+    #[error("stage {stage} of {stages} failed{}", unstable.map(|n| format!(" from an unstable state: its last converged state has {n} negative pivot{} of the tangent stiffness (past a limit or bifurcation point — a bulge or another mode is taking over)", if n == 1 { "" } else { "s" })).unwrap_or_default())]
     Stage {
         stage: usize,
         stages: usize,
+        /// the negative pivots of the last converged state, when it has any
+        unstable: Option<usize>,
         #[source]
         source: tubemem_fem::FemError,
     },

@@ -31,7 +31,7 @@ use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 /// The columns of steps.csv. New columns are only ever appended.
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
-arc_length,dw_ds,critical";
+arc_length,dw_ds,critical,nonuniformity,gps_applicable";
 
 /// The `critical` column of steps.csv: the kind of a critical point located between the
 /// previous step and this one (empty: none).
@@ -97,6 +97,8 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
         None => v.extend([None; 2]),
     }
     v.push(r.critical.map(critical_code));
+    v.push(r.nonuniformity);
+    v.push(r.gps_applicable.map(|a| f64::from(u8::from(a))));
     v
 }
 
@@ -108,7 +110,7 @@ pub fn format_row(r: &StepRecord) -> String {
         .map(|(k, v)| match (k, v) {
             // integers as integers
             (0 | 1 | 9 | 10, Some(x)) => format!("{}", x as u64),
-            (29, Some(x)) => format!("{}", x as i64),
+            (29 | 31, Some(x)) => format!("{}", x as i64),
             (_, Some(x)) => format!("{x}"),
             (_, None) => String::new(),
         })

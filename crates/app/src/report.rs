@@ -86,6 +86,36 @@ pub struct StepRecord {
     /// a critical point located between the previous step and this one
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub critical: Option<tubemem_fem::continuation::CriticalKind>,
+    /// the largest |λs(Z)/λs(0) − 1| over the central half of the cylinder ([`nonuniformity`];
+    /// `None` when the step has no profile)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nonuniformity: Option<f64>,
+    /// whether the comparison with the closed form applies at this step: the tube is uniform
+    /// over its central half ([`NONUNIFORM`]) and, for a squeeze or confine stage, it was
+    /// uniform when the stage started (`None` when the step has no profile)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gps_applicable: Option<bool>,
+}
+
+/// A tube whose hoop stretch varies by more than this (relative) over the central half of its
+/// cylinder is not translation invariant there, and the GPS closed form (a uniform tube) does not
+/// apply to it. A uniform tube's end effect at a quarter length from mid-span is below 1e-3 in
+/// the shipped cases (the boundary layer is 3R at λs* = 1.3, 2R at λs* = 6, against the 5R
+/// between the quarter point and the cap at L/R = 20); a bulge changes λs by O(1) (1.2 → 5.9),
+/// and Mooney–Rivlin α = 0.1 driven past its maximum to λs* = 2 varies by 24 %.
+pub const NONUNIFORM: f64 = 1e-2;
+
+/// The largest |λs(Z)/λs(0) − 1| over the rings with |Z| ≤ L/4 (`half` = L/2R), λs(0) the ring
+/// nearest mid-span.
+pub fn nonuniformity(rings: &[RingValues], half: f64) -> Option<f64> {
+    let mid = rings
+        .iter()
+        .min_by(|a, b| a.z_ref.abs().total_cmp(&b.z_ref.abs()))?;
+    rings
+        .iter()
+        .filter(|r| r.z_ref.abs() <= 0.5 * half + 1e-9)
+        .map(|r| (r.values.lambda_s / mid.values.lambda_s - 1.0).abs())
+        .reduce(f64::max)
 }
 
 /// Two successive limit points whose pressures differ by less than this (relative) are a ripple
@@ -224,6 +254,13 @@ pub struct StageSummary {
     /// an arc-length stage: the critical points located on its path, in path order
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub critical_points: Vec<CriticalRecord>,
+    /// the stage end's [`nonuniformity`], and whether the comparison with the closed form
+    /// applies (the tube is uniform over its central half to [`NONUNIFORM`]); when it does not,
+    /// `gps_not_applicable` says why
+    pub nonuniformity: Option<f64>,
+    pub gps_applicable: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gps_not_applicable: Option<String>,
 }
 
 /// One wall at the end of a confine stage.

@@ -541,6 +541,19 @@ fn setup_stage(
         }),
         _ => None,
     };
+    // a mid-span stretch on the falling branch of the GPS curve: no stable uniform tube there
+    if let Target::Stretch(s) = plan.target {
+        if let Ok(l) = tubemem_gps::limits::limit_points(closed_form_law, Hypothesis::Gps) {
+            if let Some(mx) = l.max.filter(|mx| s > mx.lambda_s) {
+                if l.min.is_none_or(|mn| s < mn.lambda_s) {
+                    report.warnings.push(format!(
+                        "stage {i}: the target λs* = {s} lies past the GPS pressure maximum (ϖ = {:.6} at λs = {:.4}), on the falling branch where a uniform tube is unstable: expect a bulge; the comparison with GPS is marked not applicable wherever the tube is not uniform",
+                        mx.w, mx.lambda_s
+                    ));
+                }
+            }
+        }
+    }
     if let Some(e) = beyond {
         report.warnings.push(format!(
             "stage {i}: the target lies outside the closed form's validity ({}); the run will stop where the law allows no further equilibrium",
@@ -603,6 +616,7 @@ fn setup_stage(
                     StageError::Solve(source) => AppError::Stage {
                         stage: i,
                         stages,
+                        unstable: None,
                         source,
                     },
                     StageError::Observer { step, source, .. } => AppError::Observer {
@@ -969,6 +983,17 @@ fn run_inner(
         // critical points located by an arc-length stage, reported to the observers with the
         // step that follows them on the path
         let pending: std::cell::RefCell<Vec<PendingCritical>> = Default::default();
+        // a squeeze or confine stage compares with a closed form that starts from a uniform
+        // tube: not applicable after a stage that ended with a tube that was not uniform
+        let started_uniform: Option<usize> = match plan.target {
+            Target::Rho(_) | Target::Confine(_) => {
+                report.stages.last().and_then(|s| match &s.outcome {
+                    StageOutcome::Finished(f) if !f.gps_applicable => Some(f.index),
+                    _ => None,
+                })
+            }
+            _ => None,
+        };
         // a resumed arc-length stage goes on in the direction its last two steps went
         let direction = match steps.as_slice() {
             [.., a, b] if b.midspan.w < a.midspan.w => -1.0,
@@ -1090,6 +1115,7 @@ fn run_inner(
                 } else {
                     vec![]
                 };
+                let step_nonuniformity = nonuniformity(&profile, half);
                 let record = StepRecord {
                     stage: i,
                     step: info.step,
@@ -1107,6 +1133,9 @@ fn run_inner(
                         dw_ds: info.dw_ds,
                     }),
                     critical: critical_here,
+                    nonuniformity: step_nonuniformity,
+                    gps_applicable: step_nonuniformity
+                        .map(|u| u <= NONUNIFORM && started_uniform.is_none()),
                 };
                 steps.push(record);
                 let view = StepView {
@@ -1184,6 +1213,16 @@ fn run_inner(
                     steps: steps.len(),
                 },
                 StageError::Solve(source) => {
+                    // the last converged state of the stage, or of the run before it
+                    let last_negative = steps.last().map(|r| r.negative_pivots).or_else(|| {
+                        report
+                            .stages
+                            .last()
+                            .filter(|s| !s.plan.arc_length)
+                            .and_then(|s| s.steps.last())
+                            .map(|r| r.negative_pivots)
+                    });
+                    let unstable = last_negative.filter(|&n| n > 0 && !plan.arc_length);
                     match (plan.target, plan.arc_length) {
                         // a pressure target the path cannot reach: say where its maximum is
                         (Target::Pressure(target), false) if state.p < target => {
@@ -1199,6 +1238,7 @@ fn run_inner(
                                 None => AppError::Stage {
                                     stage: i,
                                     stages,
+                                    unstable,
                                     source,
                                 },
                             }
@@ -1206,6 +1246,7 @@ fn run_inner(
                         _ => AppError::Stage {
                             stage: i,
                             stages,
+                            unstable,
                             source,
                         },
                     }
@@ -1259,6 +1300,22 @@ fn run_inner(
             }
         };
         let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
+        let stage_nonuniformity = nonuniformity(&rings, half);
+        // an inflation past the closed form's pressure maximum: the uniform state is unstable
+        let unstable_note = match plan.target {
+            Target::Pressure(_) | Target::Stretch(_) | Target::VolumeRatio(_) => {
+                tubemem_gps::limits::limit_points(closed_form_law.as_ref(), Hypothesis::Gps)
+                    .ok()
+                    .and_then(|l| l.max)
+                    .filter(|mx| ms.lambda_s > mx.lambda_s)
+                    .map(|mx| format!(
+                        "; the mid-span λs = {:.4} is past the GPS pressure maximum (ϖ = {:.6} at λs = {:.4}), where a uniform tube is unstable and a bulge forms",
+                        ms.lambda_s, mx.w, mx.lambda_s
+                    ))
+                    .unwrap_or_default()
+            }
+            _ => String::new(),
+        };
         let wrinkling = wrinkle_report(&model, &state, i)?;
         let ([(mut gps, mut gps_err), (mut ps, mut ps_err)], local_section, mut local_err) =
             stage_closed_form(
@@ -1359,6 +1416,21 @@ fn run_inner(
             walls: wall_summary,
             planes: confine_planes.clone().unwrap_or_default(),
             critical_points: criticals,
+            nonuniformity: stage_nonuniformity,
+            gps_applicable: stage_nonuniformity.is_none_or(|u| u <= NONUNIFORM)
+                && started_uniform.is_none(),
+            gps_not_applicable: match (stage_nonuniformity.filter(|u| *u > NONUNIFORM), started_uniform) {
+                (Some(u), _) => Some(format!(
+                    "the tube is not uniform: λs varies by {:.1} % over the central half of the cylinder (more than {} %){}",
+                    100.0 * u,
+                    100.0 * NONUNIFORM,
+                    unstable_note
+                )),
+                (None, Some(k)) => Some(format!(
+                    "the stage starts from the end of stage {k}, where the tube was not uniform, and the closed form starts from a uniform tube"
+                )),
+                (None, None) => None,
+            },
         };
         report.stages.push(StageReport {
             plan: *plan,

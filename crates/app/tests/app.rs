@@ -420,13 +420,22 @@ fn an_arc_length_stage_reports_its_critical_points_in_every_output() {
     assert_eq!((row[0], row[1], row[2]), (1.0, c.step as f64, 1.0));
     assert_eq!(row[5], c.midspan.w);
     let steps_csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let col = steps_csv
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == "critical")
+        .unwrap();
     let marked: Vec<&str> = steps_csv
         .lines()
         .skip(1)
-        .filter(|l| l.ends_with(",1"))
+        .filter(|l| l.split(',').nth(col) == Some("1"))
         .collect();
     assert_eq!(marked.len(), 1, "{steps_csv}");
     assert!(marked[0].starts_with(&format!("1,{},", c.step)));
+    // the small tube (L/R = 8) at λs* = 2 has bulged: its end is not uniform
+    assert!(!s.gps_applicable, "{:?}", s.nonuniformity);
 }
 
 /// Pressure control to a pressure above the tube's maximum: the stage fails, and the error says
@@ -476,4 +485,69 @@ fn a_pressure_beyond_the_maximum_is_refused_with_the_limit_point() {
         .count()
         - 1;
     assert_eq!(rows, steps.len());
+}
+
+/// A new user's run (issue 12): Mooney–Rivlin α = 0.1 inflated under mid-span stretch control
+/// to λs* = 2.0, past the closed form's maximum at λs = 1.708, then squeezed. The tube bulges at
+/// mid-span; the run warns at the start that the uniform state is unstable there, and marks the
+/// comparison with GPS not applicable (report, summary.json, steps.csv) for the inflation — the
+/// tube is not uniform — and for the squeeze that starts from it.
+#[test]
+fn a_target_past_the_maximum_marks_gps_not_applicable() {
+    let text = "[geometry]\nradius = 1.0\nlength = 20.0\n\n[material]\nmodel = \"mooney-rivlin\"\nshear_modulus = 1.0\nalpha = 0.1\n\n[mesh]\naround = 16\nalong = 40\nsymmetry = \"eighth\"\n\n[[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = 2.0\nsteps = 8\n\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.2\nsteps = 4\n";
+    let case = Case::parse(text).unwrap();
+    let out = tmp("past-max");
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let report = run(&case, "mr", &mut [&mut writer]).into_result().unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("past the GPS pressure maximum") && w.contains("unstable")),
+        "{:?}",
+        report.warnings
+    );
+    let summaries: Vec<_> = report
+        .stages
+        .iter()
+        .map(|s| match &s.outcome {
+            StageOutcome::Finished(f) => f.clone(),
+            o => panic!("{o:?}"),
+        })
+        .collect();
+    assert!(!summaries[0].gps_applicable);
+    let why = summaries[0].gps_not_applicable.as_deref().unwrap();
+    assert!(
+        why.contains("not uniform") && why.contains("1.7081"),
+        "{why}"
+    );
+    assert!(summaries[0].nonuniformity.unwrap() > 0.1);
+    assert!(!summaries[1].gps_applicable);
+    assert!(summaries[1]
+        .gps_not_applicable
+        .as_deref()
+        .unwrap()
+        .contains("stage 1"));
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(on_disk["stages"][0]["gps_applicable"], false);
+    // steps.csv: applicable while the tube is still uniform, not once it has bulged
+    let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let col = csv
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == "gps_applicable")
+        .unwrap();
+    let flags: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap())
+        .collect();
+    assert_eq!(flags[0], "1", "{csv}");
+    assert_eq!(*flags.last().unwrap(), "0");
+    // the inflation's last step has the flag of its summary
+    let last_inflation = report.stages[0].steps.last().unwrap();
+    assert_eq!(last_inflation.gps_applicable, Some(false));
 }

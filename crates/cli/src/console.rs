@@ -137,6 +137,9 @@ impl Observer for Console {
             "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6} (GPS {:.6}), λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
             s.index, ms.w, w, 100.0 * rel(ms.w, w), ps_w, ms.lambda_s, ls, ms.lambda_z, lz, ms.n_s, ms.n_z, ms.n_sz
         )?;
+        if let Some(why) = &s.gps_not_applicable {
+            say!("         ✗ the comparison with GPS does not apply: {why}")?;
+        }
         if let Some(c) = &s.final_state.contact {
             say!(
                 "         ρ = {:.4}: χ = {:.5} (GPS {:.5}, PS {:.5}), force ϖχ = {:.5} (GPS {:.5}, {:+.2}%; PS {:.5}), contact pressure {:.4}, penetration {:.1e}",
