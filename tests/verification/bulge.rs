@@ -66,6 +66,7 @@ fn bulge(length: f64) -> BulgeRun {
         None,
         &monitor,
         1.0,
+        None,
         |_, _, _| {
             steps += 1;
             Ok::<(), ()>(())

@@ -36,6 +36,8 @@
 //! kind = "inflate"
 //! control = "volume"    # "pressure" (target_pressure) | "volume" (target_stretch or target_volume_ratio)
 //!                       # | "arc-length" (any of the three, reached along the path through limit points)
+//! branch = "follow-stable" # arc-length only: at a bifurcation where the path loses stability,
+//!                       # switch to the branch along the critical mode (default "stay")
 //! target_stretch = 1.3  # mid-span hoop stretch λs*
 //! steps = 6             # initial number of load steps (adaptive afterwards)
 //! ```
@@ -314,6 +316,18 @@ pub struct StageSpec {
     pub plane: Vec<PlaneSpec>,
     #[serde(default = "default_steps")]
     pub steps: usize,
+    /// arc-length stages: "follow-stable" switches branch at a bifurcation where the path
+    /// loses stability, along the critical mode
+    pub branch: Option<BranchSpec>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BranchSpec {
+    /// stay on the path the continuation is on (the default)
+    Stay,
+    /// at a bifurcation where K gains a negative pivot, leave along the critical mode
+    FollowStable,
 }
 
 fn default_steps() -> usize {
@@ -387,6 +401,9 @@ pub struct StagePlan {
     /// continuation, through limit points and snap-backs, with critical points located
     #[serde(default)]
     pub arc_length: bool,
+    /// `branch = "follow-stable"` (arc-length stages)
+    #[serde(default)]
+    pub follow_stable: bool,
 }
 
 /// The penetration tolerance (in R) that sets the penalty when a squeeze gives neither
@@ -410,10 +427,17 @@ impl StageSpec {
             steps: self.steps,
             penalty,
             arc_length: self.control == Some(ControlKind::ArcLength),
+            follow_stable: self.branch == Some(BranchSpec::FollowStable),
         })
     }
 
     fn target(&self, i: usize) -> Result<Target, CaseError> {
+        if self.branch.is_some() && self.control != Some(ControlKind::ArcLength) {
+            invalid!(
+                "[[stage]] {}: `branch` belongs to control = \"arc-length\" stages (only a continuation has a path to leave)",
+                i + 1
+            );
+        }
         let which = (
             self.target_pressure,
             self.target_stretch,

@@ -31,7 +31,7 @@ use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 /// The columns of steps.csv. New columns are only ever appended.
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
-arc_length,dw_ds,critical,nonuniformity,gps_applicable";
+arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume";
 
 /// The `critical` column of steps.csv: the kind of a critical point located between the
 /// previous step and this one (empty: none).
@@ -99,8 +99,13 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
     v.push(r.critical.map(critical_code));
     v.push(r.nonuniformity);
     v.push(r.gps_applicable.map(|a| f64::from(u8::from(a))));
+    v.push(r.negative_pivots_volume.map(|n| n as f64));
     v
 }
+
+/// The columns of fronts.csv: one line per bulge front per step (`row` is the step's row in
+/// steps.csv; `front` counts from the lowest Z).
+pub const FRONTS_HEADER: &str = "row,stage,step,w,volume,front,z_ref";
 
 /// One steps.csv line of a step (integers as integers, empty fields for what it lacks).
 pub fn format_row(r: &StepRecord) -> String {
@@ -110,7 +115,7 @@ pub fn format_row(r: &StepRecord) -> String {
         .map(|(k, v)| match (k, v) {
             // integers as integers
             (0 | 1 | 9 | 10, Some(x)) => format!("{}", x as u64),
-            (29 | 31, Some(x)) => format!("{}", x as i64),
+            (29 | 31 | 32, Some(x)) => format!("{}", x as i64),
             (_, Some(x)) => format!("{x}"),
             (_, None) => String::new(),
         })
@@ -128,8 +133,9 @@ pub enum FolderMode {
 }
 
 /// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
-pub const RUN_ENTRIES: [&str; 11] = [
+pub const RUN_ENTRIES: [&str; 12] = [
     "checkpoints",
+    "fronts.csv",
     "critical_points.csv",
     "steps.csv",
     "walls.csv",
@@ -823,6 +829,31 @@ impl Observer for RunWriter {
                     writeln!(out, "{}", crate::curves::csv_line(&vals))?;
                 }
                 out.flush()?;
+            }
+        }
+        if !view.record.fronts.is_empty() {
+            let path = self.dir.join("fronts.csv");
+            let fresh = !path.exists();
+            let mut f = std::fs::OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(&path)
+                .map_err(|e| AppError::io(&path, e))?;
+            if fresh {
+                writeln!(f, "{FRONTS_HEADER}")?;
+            }
+            let r = view.record;
+            for (k, z) in r.fronts.iter().enumerate() {
+                let vals = [
+                    self.rows as f64,
+                    r.stage as f64,
+                    r.step as f64,
+                    r.midspan.w,
+                    r.midspan.volume,
+                    (k + 1) as f64,
+                    *z,
+                ];
+                writeln!(f, "{}", crate::curves::csv_line(&vals))?;
             }
         }
         if let Some(profiles) = &mut self.profiles {

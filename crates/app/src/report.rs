@@ -95,6 +95,44 @@ pub struct StepRecord {
     /// uniform when the stage started (`None` when the step has no profile)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gps_applicable: Option<bool>,
+    /// an arc-length step: the negative pivots under volume control (a closed tube's
+    /// stability; `negative_pivots` is then the pressure-control count)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub negative_pivots_volume: Option<usize>,
+    /// the reference heights Z of the bulge fronts ([`bulge_fronts`]), lowest first; empty
+    /// when the tube has no bulge
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fronts: Vec<f64>,
+}
+
+/// A profile holds a bulge when its largest hoop stretch exceeds its smallest by more than this
+/// (relative): ten times [`NONUNIFORM`], and far below the bulges of the paper's law (λs 1.2 →
+/// 5.9, a factor of 5).
+pub const BULGE: f64 = 0.1;
+
+/// The fronts of a bulge: where λs(Z) crosses the level halfway between its smallest and
+/// largest values along the profile (linear interpolation between rings), in increasing Z;
+/// empty without a bulge ([`BULGE`]).
+pub fn bulge_fronts(rings: &[RingValues]) -> Vec<f64> {
+    let ls: Vec<f64> = rings.iter().map(|r| r.values.lambda_s).collect();
+    let (Some(lo), Some(hi)) = (
+        ls.iter().copied().reduce(f64::min),
+        ls.iter().copied().reduce(f64::max),
+    ) else {
+        return vec![];
+    };
+    if !(hi > lo * (1.0 + BULGE)) {
+        return vec![];
+    }
+    let level = 0.5 * (lo + hi);
+    rings
+        .windows(2)
+        .filter_map(|w| {
+            let (a, b) = (w[0].values.lambda_s - level, w[1].values.lambda_s - level);
+            (a * b < 0.0 || (b == 0.0 && a != 0.0))
+                .then(|| w[0].z_ref + (w[1].z_ref - w[0].z_ref) * a / (a - b))
+        })
+        .collect()
 }
 
 /// A tube whose hoop stretch varies by more than this (relative) over the central half of its

@@ -117,6 +117,12 @@ fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Opti
     found.filter(|(w, _)| *w < target)
 }
 
+/// `branch = "follow-stable"`: the branch-switching step leaves the bifurcation point along the
+/// critical mode by this fraction of the arc length of the step that crossed it (an RMS nodal
+/// displacement of the same order as the path's own steps, so that the corrector lands on the
+/// new branch rather than falling back onto the old one).
+pub const BRANCH_SWITCH_FRACTION: f64 = 0.5;
+
 /// A located critical point waiting for the step that follows it.
 struct PendingCritical {
     record: CriticalRecord,
@@ -145,6 +151,7 @@ fn critical_record(
     let reference = limits.and_then(|l| match c.kind {
         // a mid-span past the uniform curve's minimum (λs beyond it) is in the upper phase of a
         // bulge, whose pressure is Maxwell's (a uniform tube cannot be there at a limit point)
+        CriticalKind::Bifurcation => None,
         _ if l.min.is_some_and(|mn| ms.lambda_s > mn.lambda_s) && l.maxwell.is_some() => {
             l.maxwell.map(|mw| CriticalReference {
                 what: "Maxwell pressure".into(),
@@ -162,7 +169,6 @@ fn critical_record(
             w: m.w,
             lambda_s: m.lambda_s,
         }),
-        CriticalKind::Bifurcation => None,
     });
     let (mode, mode_eigenvalue) = if c.kind == CriticalKind::Bifurcation {
         let load = Load::pressure(c.state.p);
@@ -1116,6 +1122,7 @@ fn run_inner(
                     vec![]
                 };
                 let step_nonuniformity = nonuniformity(&profile, half);
+                let step_fronts = bulge_fronts(&profile);
                 let record = StepRecord {
                     stage: i,
                     step: info.step,
@@ -1136,6 +1143,8 @@ fn run_inner(
                     nonuniformity: step_nonuniformity,
                     gps_applicable: step_nonuniformity
                         .map(|u| u <= NONUNIFORM && started_uniform.is_none()),
+                    negative_pivots_volume: info.negative_conjugate,
+                    fronts: step_fronts,
                 };
                 steps.push(record);
                 let view = StepView {
@@ -1181,6 +1190,7 @@ fn run_inner(
                 None,
                 &*monitor,
                 direction,
+                plan.follow_stable.then_some(BRANCH_SWITCH_FRACTION),
                 &mut on_step,
                 |m: &mut Model, c: &Critical<State>| {
                     critical_record(

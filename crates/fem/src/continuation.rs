@@ -42,6 +42,33 @@
 use crate::stepping::{Stage, StageError, StepInfo, StepState};
 use std::fmt;
 
+/// The path's tangent data at an equilibrium.
+pub struct Tangent {
+    /// K⁻¹g: du/dλ under load control
+    pub b: Vec<f64>,
+    /// negative pivots of K (stability under load control)
+    pub negative: usize,
+    /// negative pivots of the bordered operator of the conjugate control (the load's work
+    /// conjugate, e.g. the volume, held fixed): `negative` less one when gᵀK⁻¹g < 0
+    pub negative_conjugate: usize,
+}
+
+impl Tangent {
+    /// From K⁻¹g, g and the negative pivots of K.
+    pub fn new(b: Vec<f64>, g: &[f64], negative: usize) -> Self {
+        let gb: f64 = g.iter().zip(&b).map(|(a, c)| a * c).sum();
+        Self {
+            b,
+            negative,
+            negative_conjugate: if gb < 0.0 {
+                negative.saturating_sub(1)
+            } else {
+                negative
+            },
+        }
+    }
+}
+
 /// An equilibrium path R(u, λ) = 0 the driver can follow.
 pub trait Path {
     type State: Clone;
@@ -54,9 +81,13 @@ pub trait Path {
     fn difference(&self, a: &Self::State, b: &Self::State) -> Vec<f64>;
     /// base + ds (t_u, t_λ).
     fn predict(&self, base: &Self::State, tu: &[f64], tl: f64, ds: f64) -> Self::State;
-    /// At an equilibrium: K⁻¹g (du/dλ under load control) and the number of negative pivots of
-    /// K.
-    fn tangent(&mut self, s: &Self::State) -> Result<(Vec<f64>, usize), Self::Error>;
+    /// At an equilibrium: K⁻¹g (du/dλ under load control) and the negative pivots.
+    fn tangent(&mut self, s: &Self::State) -> Result<Tangent, Self::Error>;
+    /// The critical mode at a bifurcation (the eigenvector of K of smallest |eigenvalue|, on
+    /// the free unknowns), for branch switching; `None` when the problem has none to give.
+    fn critical_mode(&mut self, _s: &Self::State) -> Result<Option<Vec<f64>>, Self::Error> {
+        Ok(None)
+    }
     /// Correct the predictor `s` onto the path under `arc`; the Newton iterations taken.
     fn correct(
         &mut self,
@@ -90,6 +121,10 @@ pub struct ArcSettings {
     pub max_ds_factor: f64,
     /// consecutive halvings of one step before the stage fails
     pub max_cuts: usize,
+    /// the smallest cosine of the angle between the unit tangents at the two ends of a step
+    /// (scaled norm); a step that turns more is halved. 0.8 (37°): the paths here turn through
+    /// 90° at a limit point within a few steps, and a reversed corrector turns by 180°
+    pub min_turn_cos: f64,
     /// a step shorter than this multiple of the first fails the stage (a path that can only be
     /// crept along, e.g. towards a state the corrector can never pass)
     pub min_ds_factor: f64,
@@ -103,6 +138,10 @@ pub struct ArcSettings {
     pub target_rtol: f64,
     /// the sign of dλ/ds at the start (+1: the load increases first)
     pub first_direction: f64,
+    /// branch switching: at the first bifurcation where K gains a negative pivot, leave the
+    /// path along the critical mode by this fraction of the step's arc length (`None`: stay on
+    /// the path)
+    pub switch_fraction: Option<f64>,
 }
 
 impl Default for ArcSettings {
@@ -113,11 +152,13 @@ impl Default for ArcSettings {
             max_ds_factor: 4.0,
             max_cuts: 12,
             min_ds_factor: 1e-6,
+            min_turn_cos: 0.8,
             max_steps: 2000,
             locate_tol: 1e-8,
             locate_iterations: 80,
             target_rtol: 1e-10,
             first_direction: 1.0,
+            switch_fraction: None,
         }
     }
 }
@@ -159,13 +200,17 @@ pub struct Critical<S> {
     pub step: usize,
     /// the arc length from the path's start
     pub s: f64,
-    /// the final bracket on σ
+    /// the final bracket on σ (the whole step when a corrector inside it failed: the point
+    /// is then only bracketed by the step, and `state` is the step's end)
     pub bracket: f64,
     pub state: S,
     pub load: f64,
     /// negative pivots of K before and after
     pub negative_before: usize,
     pub negative_after: usize,
+    /// a bifurcation the path left by branch switching: the arc length of the switching step
+    /// along the critical mode
+    pub switched: Option<f64>,
 }
 
 /// A converged step.
@@ -179,7 +224,10 @@ pub struct ArcStep<'a, S> {
     pub iterations: usize,
     /// dλ/ds of the unit tangent there
     pub tl: f64,
+    /// negative pivots of K (stability under load control) and of the conjugate control's
+    /// bordered operator (e.g. under volume control: the stability of a closed tube)
     pub negative_pivots: usize,
+    pub negative_pivots_conjugate: usize,
     /// the monitored quantity
     pub monitor: f64,
     /// the step ends exactly at the target
@@ -212,6 +260,8 @@ pub enum ArcError<E, O> {
         load: f64,
         monitor: f64,
     },
+    /// even the shortest step turned the path by more than the settings allow
+    Turn { step: usize, ds: f64, load: f64 },
     /// the observer failed
     Observer { step: usize, source: O },
     /// the problem asked to stop (an interrupt)
@@ -241,6 +291,10 @@ impl<E: fmt::Display, O: fmt::Display> fmt::Display for ArcError<E, O> {
             } => write!(
                 f,
                 "{steps} arc-length steps without reaching the target (load {load:.9}, monitored value {monitor:.9})"
+            ),
+            Self::Turn { step, ds, load } => write!(
+                f,
+                "arc-length step {step} from load {load:.9}: the path turns by more than the allowed angle even within Δs = {ds:.3e}"
             ),
             Self::Observer { step, source } => write!(f, "step {step}: {source}"),
             Self::Final { step, source } => write!(f, "step {step}: {source}"),
@@ -294,15 +348,15 @@ pub fn follow<P: Path, O>(
     mut on_event: impl FnMut(&mut P, ArcEvent<'_, P::State>) -> Result<(), O>,
 ) -> FollowResult<P, O> {
     let w = path.weight();
-    let (b, negative) = path
+    let t = path
         .tangent(&start)
         .map_err(|source| ArcError::Tangent { step: 0, source })?;
-    let (tu, tl) = unit_tangent(b, w, None, settings.first_direction);
+    let (tu, tl) = unit_tangent(t.b, w, None, settings.first_direction);
     let mut point = Point {
         state: start,
         tu,
         tl,
-        negative,
+        negative: t.negative,
         s: 0.0,
     };
     let q0 = (target.monitor)(&point.state);
@@ -323,6 +377,9 @@ pub fn follow<P: Path, O>(
     let min_ds = settings.min_ds_factor * ds;
     let mut criticals = Vec::new();
     let mut step = 0usize;
+    // branches are switched once: on the new branch the critical mode (e.g. a bulge's
+    // translation, neutral in a long tube) keeps crossing zero as the discretization ripples
+    let mut switched_once = false;
     let qtol = settings.target_rtol * target.value.abs().max(1e-300);
     loop {
         if step >= settings.max_steps {
@@ -332,11 +389,29 @@ pub fn follow<P: Path, O>(
                 monitor: (target.monitor)(&point.state),
             });
         }
-        // one converged step of length ds (halved on failure)
+        // one converged step of length ds, halved when the corrector fails or when the path
+        // turns by more than the settings allow within it (a corrector that lands on a part of
+        // the path folded back across the hyperplane would otherwise reverse the continuation)
         let mut cuts = 0;
-        let (next, iterations) = loop {
-            match corrector(path, &point, w, ds) {
-                Ok(r) => break r,
+        let (next, iterations, t, tu, tl) = loop {
+            let attempt = corrector(path, &point, w, ds).and_then(|(st, it)| {
+                let t = path.tangent(&st)?;
+                Ok((st, it, t))
+            });
+            let failure = match attempt {
+                Ok((st, it, t)) => {
+                    let secant = (
+                        path.difference(&st, &point.state),
+                        path.load(&st) - path.load(&point.state),
+                    );
+                    let (tu, tl) = unit_tangent(t.b.clone(), w, Some((&secant.0, secant.1)), 1.0);
+                    let cos = w * tu.iter().zip(&point.tu).map(|(a, b)| a * b).sum::<f64>()
+                        + tl * point.tl;
+                    if cos >= settings.min_turn_cos {
+                        break (st, it, t, tu, tl);
+                    }
+                    None
+                }
                 Err(e) => {
                     if path.is_final(&e) {
                         return Err(ArcError::Final {
@@ -344,42 +419,53 @@ pub fn follow<P: Path, O>(
                             source: e,
                         });
                     }
-                    cuts += 1;
-                    if cuts > settings.max_cuts || ds * 0.5 < min_ds {
-                        return Err(ArcError::Stalled {
-                            step: step + 1,
-                            ds,
-                            cuts: cuts - 1,
-                            load: path.load(&point.state),
-                            source: e,
-                        });
-                    }
-                    ds *= 0.5;
+                    Some(e)
                 }
+            };
+            cuts += 1;
+            if cuts > settings.max_cuts || ds * 0.5 < min_ds {
+                return Err(match failure {
+                    Some(e) => ArcError::Stalled {
+                        step: step + 1,
+                        ds,
+                        cuts: cuts - 1,
+                        load: path.load(&point.state),
+                        source: e,
+                    },
+                    None => ArcError::Turn {
+                        step: step + 1,
+                        ds,
+                        load: path.load(&point.state),
+                    },
+                });
             }
+            ds *= 0.5;
         };
-        let secant = (
-            path.difference(&next, &point.state),
-            path.load(&next) - path.load(&point.state),
-        );
-        let (b, negative) = path.tangent(&next).map_err(|source| ArcError::Tangent {
-            step: step + 1,
-            source,
-        })?;
-        let (tu, tl) = unit_tangent(b, w, Some((&secant.0, secant.1)), 1.0);
+        let mut next = next;
+        let mut iterations = iterations;
+        let (mut negative, mut negative_conjugate) = (t.negative, t.negative_conjugate);
+        let (mut tu, mut tl) = (tu, tl);
+        let mut s_next = point.s + ds;
+        let mut switched = false;
         let q_prev = (target.monitor)(&point.state);
-        let q_next = (target.monitor)(&next);
         // critical points inside the step, in path order
         if tl * point.tl < 0.0 {
             let (tu0, tl0) = (point.tu.clone(), point.tl);
-            let c = locate(path, &point, w, ds, settings, |path, s| {
-                let (b, _) = path.tangent(s)?;
-                Ok(unit_tangent(b, w, Some((&tu0, tl0)), 1.0).1)
-            })
-            .map_err(|source| ArcError::Tangent {
-                step: step + 1,
-                source,
-            })?;
+            // a corrector that fails inside the bracket leaves the point at the step's end,
+            // with the whole step as its bracket (reported, not fatal: the path goes on)
+            let c = match locate(path, &point, w, ds, settings, |path, s| {
+                let t = path.tangent(s)?;
+                Ok(unit_tangent(t.b, w, Some((&tu0, tl0)), 1.0).1)
+            }) {
+                Ok(c) => c,
+                Err(e) if path.is_final(&e) => {
+                    return Err(ArcError::Final {
+                        step: step + 1,
+                        source: e,
+                    })
+                }
+                Err(_) => (ds, ds, next.clone()),
+            };
             let kind = if point.tl > 0.0 {
                 CriticalKind::LimitMax
             } else {
@@ -394,6 +480,7 @@ pub fn follow<P: Path, O>(
                 state: c.2,
                 negative_before: point.negative,
                 negative_after: negative,
+                switched: None,
             };
             on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
                 step: step + 1,
@@ -402,13 +489,17 @@ pub fn follow<P: Path, O>(
             criticals.push(cp);
         } else if negative != point.negative {
             let before = point.negative as f64;
-            let c = locate_count(path, &point, w, ds, settings, before).map_err(|source| {
-                ArcError::Tangent {
-                    step: step + 1,
-                    source,
+            let c = match locate_count(path, &point, w, ds, settings, before) {
+                Ok(c) => c,
+                Err(e) if path.is_final(&e) => {
+                    return Err(ArcError::Final {
+                        step: step + 1,
+                        source: e,
+                    })
                 }
-            })?;
-            let cp = Critical {
+                Err(_) => (ds, ds, next.clone()),
+            };
+            let mut cp = Critical {
                 kind: CriticalKind::Bifurcation,
                 step: step + 1,
                 s: point.s + c.0,
@@ -417,7 +508,69 @@ pub fn follow<P: Path, O>(
                 state: c.2,
                 negative_before: point.negative,
                 negative_after: negative,
+                switched: None,
             };
+            // branch switching where an instability enters: leave the path along the critical
+            // mode, by an arc of `switch_fraction` of the step that crossed the bifurcation
+            if let (Some(fraction), true, false) = (
+                settings.switch_fraction,
+                negative > point.negative,
+                switched_once,
+            ) {
+                let mode = path
+                    .critical_mode(&cp.state)
+                    .map_err(|source| ArcError::Tangent {
+                        step: step + 1,
+                        source,
+                    })?;
+                if let Some(mode) = mode {
+                    let n = (w * mode.iter().map(|v| v * v).sum::<f64>()).sqrt();
+                    let base = Point {
+                        state: cp.state.clone(),
+                        tu: mode.iter().map(|v| v / n).collect(),
+                        tl: 0.0,
+                        negative: cp.negative_after,
+                        s: cp.s,
+                    };
+                    let mut dsw = fraction * ds;
+                    let mut tries = 0;
+                    let (st, it) = loop {
+                        match corrector(path, &base, w, dsw) {
+                            Ok(r) => break r,
+                            Err(e) => {
+                                tries += 1;
+                                if path.is_final(&e) || tries > settings.max_cuts {
+                                    return Err(ArcError::Stalled {
+                                        step: step + 1,
+                                        ds: dsw,
+                                        cuts: tries - 1,
+                                        load: cp.load,
+                                        source: e,
+                                    });
+                                }
+                                dsw *= 0.5;
+                            }
+                        }
+                    };
+                    let sec = (
+                        path.difference(&st, &cp.state),
+                        path.load(&st) - path.load(&cp.state),
+                    );
+                    let t = path.tangent(&st).map_err(|source| ArcError::Tangent {
+                        step: step + 1,
+                        source,
+                    })?;
+                    negative = t.negative;
+                    negative_conjugate = t.negative_conjugate;
+                    (tu, tl) = unit_tangent(t.b, w, Some((&sec.0, sec.1)), 1.0);
+                    s_next = cp.s + dsw;
+                    next = st;
+                    iterations = it;
+                    switched = true;
+                    switched_once = true;
+                    cp.switched = Some(dsw);
+                }
+            }
             on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
                 step: step + 1,
                 source,
@@ -425,8 +578,13 @@ pub fn follow<P: Path, O>(
             criticals.push(cp);
         }
         step += 1;
-        // the target inside the step: locate it and end there
-        if (q_prev - target.value) * (q_next - target.value) <= 0.0 && q_prev != target.value {
+        let q_next = (target.monitor)(&next);
+        // the target inside the step: locate it and end there (not on a branch-switching step,
+        // whose start is the bifurcation point, not `point`)
+        if !switched
+            && (q_prev - target.value) * (q_next - target.value) <= 0.0
+            && q_prev != target.value
+        {
             let (sigma, end) = if (q_next - target.value).abs() <= qtol {
                 (ds, next)
             } else {
@@ -451,7 +609,7 @@ pub fn follow<P: Path, O>(
                 })?;
                 (sigma, st)
             };
-            let (_, neg_end) = path
+            let t_end = path
                 .tangent(&end)
                 .map_err(|source| ArcError::Tangent { step, source })?;
             let info = ArcStep {
@@ -462,7 +620,8 @@ pub fn follow<P: Path, O>(
                 ds: sigma,
                 iterations,
                 tl: point.tl,
-                negative_pivots: neg_end,
+                negative_pivots: t_end.negative,
+                negative_pivots_conjugate: t_end.negative_conjugate,
                 monitor: (target.monitor)(&end),
                 at_target: true,
                 cuts,
@@ -475,11 +634,12 @@ pub fn follow<P: Path, O>(
             step,
             load: path.load(&next),
             state: &next,
-            s: point.s + ds,
-            ds,
+            s: s_next,
+            ds: s_next - point.s,
             iterations,
             tl,
             negative_pivots: negative,
+            negative_pivots_conjugate: negative_conjugate,
             monitor: q_next,
             at_target: false,
             cuts,
@@ -491,7 +651,7 @@ pub fn follow<P: Path, O>(
             tu,
             tl,
             negative,
-            s: point.s + ds,
+            s: s_next,
         };
         // Crisfield's rule for the next length
         let f = (settings.desired_iterations.max(1) as f64 / iterations.max(1) as f64).sqrt();
@@ -604,7 +764,7 @@ fn locate_count<P: Path>(
         }
         let c = 0.5 * (a + b);
         let (s, _) = corrector(path, point, w, c)?;
-        let (_, neg) = path.tangent(&s)?;
+        let neg = path.tangent(&s)?.negative;
         if neg as f64 == before {
             a = c;
         } else {
@@ -647,9 +807,26 @@ impl Path for MembranePath<'_> {
         s.p += ds * tl;
         s
     }
-    fn tangent(&mut self, s: &Self::State) -> Result<(Vec<f64>, usize), Self::Error> {
-        self.model
+    fn tangent(&mut self, s: &Self::State) -> Result<Tangent, Self::Error> {
+        let (b, g, negative) = self
+            .model
             .pressure_tangent(s, &self.load)
+            .map_err(|source| crate::newton::NewtonError::Problem {
+                iteration: 0,
+                source,
+            })?;
+        Ok(Tangent::new(b, &g, negative))
+    }
+    fn critical_mode(&mut self, s: &Self::State) -> Result<Option<Vec<f64>>, Self::Error> {
+        // K is singular at the located bifurcation to its bracket: inverse iteration converges
+        // by the ratio of the two smallest eigenvalues, 8 solves leave rounding
+        let load = crate::model::Load {
+            loading: crate::model::Loading::Pressure(s.p),
+            contact: self.load.contact.clone(),
+        };
+        self.model
+            .smallest_mode(s, &load, 8)
+            .map(|(v, _)| Some(v))
             .map_err(|source| crate::newton::NewtonError::Problem {
                 iteration: 0,
                 source,
@@ -693,6 +870,7 @@ pub fn run_arc_stage<E>(
     contact: Option<crate::contact::Contact>,
     monitor: &dyn Fn(&crate::model::State) -> f64,
     first_direction: f64,
+    switch_fraction: Option<f64>,
     mut on_step: impl FnMut(&crate::model::Model, &crate::model::State, &StepInfo) -> Result<(), E>,
     mut on_critical: impl FnMut(
         &mut crate::model::Model,
@@ -706,6 +884,7 @@ pub fn run_arc_stage<E>(
         max_cuts: stage.settings.max_cuts,
         max_steps: stage.settings.max_steps,
         first_direction,
+        switch_fraction,
         ..ArcSettings::default()
     };
     let load = Load {
@@ -762,6 +941,7 @@ pub fn run_arc_stage<E>(
                         },
                         newton: &newton,
                         dw_ds: s.tl,
+                        negative_conjugate: Some(s.negative_pivots_conjugate),
                     };
                     *state = s.state.clone();
                     on_step(path.model, s.state, &info)
@@ -804,14 +984,24 @@ pub fn run_arc_stage<E>(
             what: format!(
                 "no convergence after {cuts} halvings of the arc length (last Δs = {ds:.3e})"
             ),
-            source: Box::new(source),
+            source: Some(Box::new(source)),
+        }),
+        ArcError::Turn { step, ds, load } => StageError::Solve(FemError::Arc {
+            stage: index,
+            step: step0 + step,
+            p: load,
+            what: format!(
+                "the path turns by more than {:.0}° even within Δs = {ds:.3e}",
+                ArcSettings::default().min_turn_cos.acos().to_degrees()
+            ),
+            source: None,
         }),
         ArcError::Tangent { step, source } => StageError::Solve(FemError::Arc {
             stage: index,
             step: step0 + step,
             p: state.p,
             what: "the path tangent could not be computed".into(),
-            source: Box::new(source),
+            source: Some(Box::new(source)),
         }),
     })
 }

@@ -111,14 +111,14 @@ pub enum FemError {
         source: Box<newton::NewtonError<FemError>>,
     },
     /// An arc-length stage could not take its next step.
-    #[error("stage {stage}, arc-length step {step} from ϖ = {p:.9}: {what}; last attempt")]
+    #[error("stage {stage}, arc-length step {step} from ϖ = {p:.9}: {what}{}", if source.is_some() { "; last attempt" } else { "" })]
     Arc {
         stage: usize,
         step: usize,
         p: f64,
         what: String,
         #[source]
-        source: Box<newton::NewtonError<FemError>>,
+        source: Option<Box<newton::NewtonError<FemError>>>,
     },
 }
 

@@ -470,18 +470,18 @@ impl Model {
     }
 
     /// The path tangent under pressure as the load parameter at the equilibrium `state`:
-    /// b = K⁻¹ g (dx/dϖ on the free dofs, K = K_int − ϖ H the pressure-control stiffness) and
-    /// the number of negative pivots of K. Factorizes K at `state`.
+    /// b = K⁻¹ g (dx/dϖ on the free dofs, K = K_int − ϖ H the pressure-control stiffness), g
+    /// (∂V_part/∂x) and the number of negative pivots of K. Factorizes K at `state`.
     pub fn pressure_tangent(
         &mut self,
         state: &State,
         load: &Load,
-    ) -> Result<(Vec<f64>, usize), FemError> {
+    ) -> Result<(Vec<f64>, Vec<f64>, usize), FemError> {
         let a = self.assemble(&state.x, true, load.contact.as_ref())?;
         let (neg, _) = self.factorize(&a, state.p)?;
-        let mut b = a.g;
+        let mut b = a.g.clone();
         self.ldlt.solve(&mut b);
-        Ok((b, neg))
+        Ok((b, a.g, neg))
     }
 
     /// Inverse iteration with the factor of K = K_int − ϖ H at `state`: the eigenvector of K of
@@ -720,7 +720,10 @@ impl newton::Problem for MembraneProblem<'_> {
         let res = norm(&r) / reference;
         self.admissible(&a, p, res)?;
         let cscale = match (self.arc, self.load.loading) {
-            (Some(arc), _) => arc.ds.abs().max(1e-300),
+            // the constraint is an arc length (RMS displacement and ϖ, O(1) quantities): held to
+            // 1e-12 of the step, but not below 1e-15 absolute — a locating step of σ ~ 1e-8
+            // would otherwise ask for 1e-20, under the rounding of its own terms
+            (Some(arc), _) => arc.ds.abs().max(1e-3),
             (None, Loading::Volume(v)) => v.abs().max(1e-300),
             _ => 1.0,
         };

@@ -83,6 +83,9 @@ pub struct StepInfo<'a> {
     pub newton: &'a NewtonReport,
     /// an arc-length step: dϖ/ds of the path's unit tangent (NaN for load stepping)
     pub dw_ds: f64,
+    /// an arc-length step: the negative pivots under volume control (the closed tube's
+    /// stability), beside the pressure-control count of `newton.inertia`
+    pub negative_conjugate: Option<usize>,
 }
 
 /// Run one stage: the load parameter moves linearly from `stage.from` to `stage.to` (the load
@@ -176,6 +179,7 @@ pub fn run_stage_from<E>(
                     load: &l,
                     newton: &report,
                     dw_ds: f64::NAN,
+                    negative_conjugate: None,
                 };
                 on_step(model, state, &info).map_err(|source| StageError::Observer {
                     stage: stage.index,

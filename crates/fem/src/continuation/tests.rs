@@ -45,13 +45,33 @@ impl<F: Fn([f64; 2]) -> [f64; 2], K: Fn([f64; 2]) -> [[f64; 2]; 2]> Path for Two
             base[2] + ds * tl,
         ]
     }
-    fn tangent(&mut self, s: &[f64; 3]) -> Result<(Vec<f64>, usize), String> {
+    fn tangent(&mut self, s: &[f64; 3]) -> Result<Tangent, String> {
         let k = (self.k)([s[0], s[1]]);
         // LDLᵀ of the 2 × 2: pivots k₁₁ and det/k₁₁
         let d1 = k[0][0];
         let d2 = (k[0][0] * k[1][1] - k[0][1] * k[1][0]) / d1;
         let neg = usize::from(d1 < 0.0) + usize::from(d2 < 0.0);
-        Ok((solve2(k, self.g).to_vec(), neg))
+        Ok(Tangent::new(solve2(k, self.g).to_vec(), &self.g, neg))
+    }
+    fn critical_mode(&mut self, s: &[f64; 3]) -> Result<Option<Vec<f64>>, String> {
+        // the eigenvector of the symmetric part's eigenvalue of smallest magnitude
+        let k = (self.k)([s[0], s[1]]);
+        let (a, b, d) = (k[0][0], 0.5 * (k[0][1] + k[1][0]), k[1][1]);
+        let m = 0.5 * (a + d);
+        let r = (0.25 * (a - d) * (a - d) + b * b).sqrt();
+        let mu = if (m - r).abs() < (m + r).abs() {
+            m - r
+        } else {
+            m + r
+        };
+        let v = if b.abs() > 1e-300 {
+            [b, mu - a]
+        } else if (a - mu).abs() < (d - mu).abs() {
+            [1.0, 0.0]
+        } else {
+            [0.0, 1.0]
+        };
+        Ok(Some(v.to_vec()))
     }
     fn correct(&mut self, s: &mut [f64; 3], arc: &Arc<'_, [f64; 3]>) -> Result<usize, String> {
         self.corrections += 1;
@@ -281,4 +301,51 @@ fn failed_steps_are_cut_back_and_no_converged_step_is_lost() {
     }
     .to_string();
     assert!(msg.contains("without reaching the target"), "{msg}");
+}
+
+/// Branch switching at the pitchfork: the path leaves u₂ = 0 at λ = 1 along the critical mode
+/// (0, 1) and follows the bifurcated branch u₂² = λ − 1, on which K₂₂ = 2(λ − 1) > 0 (stable,
+/// no negative pivot), to λ = 1.7, where u₂ = ±√0.7.
+#[test]
+fn branch_switching_follows_the_stable_branch_of_a_pitchfork() {
+    let mut p = Two {
+        f: |u: [f64; 2]| [u[0], u[1] * (1.0 - u[0]) + u[1].powi(3)],
+        k: |u: [f64; 2]| [[1.0, 0.0], [-u[1], 1.0 - u[0] + 3.0 * u[1] * u[1]]],
+        g: [1.0, 0.0],
+        fail: Box::new(|_, _| false),
+        corrections: 0,
+    };
+    let l_of = |s: &[f64; 3]| s[2];
+    let target = Target {
+        name: "λ",
+        monitor: &l_of,
+        value: 1.7,
+    };
+    let settings = ArcSettings {
+        switch_fraction: Some(0.5),
+        ..ArcSettings::default()
+    };
+    let mut after = Vec::new();
+    let mut switched_seen = false;
+    let crit = follow(&mut p, [0.0; 3], &target, &settings, |_, e| {
+        match e {
+            ArcEvent::Critical(c) => switched_seen = c.switched.is_some(),
+            ArcEvent::Step(s) if switched_seen => after.push((*s.state, s.negative_pivots)),
+            _ => {}
+        }
+        Ok::<(), String>(())
+    })
+    .unwrap();
+    assert_eq!(crit.len(), 1);
+    assert!(crit[0].switched.is_some_and(|d| d > 0.0));
+    assert!(!after.is_empty());
+    for (s, neg) in &after {
+        assert!(
+            (s[1] * s[1] - (s[2] - 1.0)).abs() < 1e-12,
+            "{s:?} off u₂² = λ − 1"
+        );
+        assert_eq!(*neg, 0, "{s:?}");
+    }
+    let last = after.last().unwrap().0;
+    assert!((last[2] - 1.7).abs() < 1e-10 && (last[1].abs() - 0.7f64.sqrt()).abs() < 1e-9);
 }
