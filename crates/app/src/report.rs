@@ -121,7 +121,7 @@ pub fn bulge_fronts(rings: &[RingValues]) -> Vec<f64> {
     ) else {
         return vec![];
     };
-    if !(hi > lo * (1.0 + BULGE)) {
+    if hi.is_nan() || lo.is_nan() || hi <= lo * (1.0 + BULGE) {
         return vec![];
     }
     let level = 0.5 * (lo + hi);
