@@ -221,7 +221,7 @@ impl Observer for Console {
             .map(|v| format!("; critical mode in {v}"))
             .unwrap_or_default();
         let line = format!(
-            "  stage {} ◆ {} between steps {} and {}: ϖ = {:.8}, λs = {:.6}, λz = {:.6}, V/V0 = {:.5}, negative pivots {} → {}{gps}{mode}",
+            "  stage {} ◆ {} between steps {} and {}: ϖ = {:.8}, λs = {:.6}, λz = {:.6}, V = {:.5} R³, negative pivots {} → {}{gps}{mode}",
             r.stage,
             r.kind,
             r.step - 1,

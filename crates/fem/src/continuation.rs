@@ -125,6 +125,8 @@ pub struct ArcSettings {
     /// (scaled norm); a step that turns more is halved. 0.8 (37°): the paths here turn through
     /// 90° at a limit point within a few steps, and a reversed corrector turns by 180°
     pub min_turn_cos: f64,
+    /// the same for a step across which the negative-pivot count of K changes: 0.98 (11°)
+    pub min_turn_cos_critical: f64,
     /// a step shorter than this multiple of the first fails the stage (a path that can only be
     /// crept along, e.g. towards a state the corrector can never pass)
     pub min_ds_factor: f64,
@@ -153,6 +155,7 @@ impl Default for ArcSettings {
             max_cuts: 12,
             min_ds_factor: 1e-6,
             min_turn_cos: 0.8,
+            min_turn_cos_critical: 0.98,
             max_steps: 2000,
             locate_tol: 1e-8,
             locate_iterations: 80,
@@ -405,9 +408,27 @@ pub fn follow<P: Path, O>(
                         path.load(&st) - path.load(&point.state),
                     );
                     let (tu, tl) = unit_tangent(t.b.clone(), w, Some((&secant.0, secant.1)), 1.0);
-                    let cos = w * tu.iter().zip(&point.tu).map(|(a, b)| a * b).sum::<f64>()
+                    // the turn of the tangent, and of the secant against the old tangent (its
+                    // projection on it is ds by the constraint, so a corrector that travelled
+                    // far from the predictor — across a sharp corner of the path — shows as a
+                    // long secant)
+                    let along = w * tu.iter().zip(&point.tu).map(|(a, b)| a * b).sum::<f64>()
                         + tl * point.tl;
-                    if cos >= settings.min_turn_cos {
+                    let chord = (w * secant.0.iter().map(|v| v * v).sum::<f64>()
+                        + secant.1 * secant.1)
+                        .sqrt();
+                    let cos = along.min(ds / chord.max(1e-300));
+                    // a step across which K's inertia changed must be resolved finely: in a long
+                    // tube the path turns through most of 180° at the pressure maximum (uniform
+                    // inflation → a localized bulge with the rest deflating), and a coarse step
+                    // across it lands on the far leg, where the secant orients the tangent
+                    // backwards and the change of inertia looks like a bifurcation
+                    let needed = if t.negative != point.negative {
+                        settings.min_turn_cos_critical
+                    } else {
+                        settings.min_turn_cos
+                    };
+                    if cos >= needed {
                         break (st, it, t, tu, tl);
                     }
                     None

@@ -172,6 +172,9 @@ pub const REFERENCE_QUANTITIES: &[&str] = &[
     "lambda_z",
     "chi",
     "force",
+    // an arc-length stage's located pressure maximum against the axisymmetric tube's
+    "limit_max_w",
+    "limit_max_lambda_s",
 ];
 /// Final mid-span quantities of a run (convergence, end-effect).
 pub const FINAL_QUANTITIES: &[&str] = &["w", "lambda_s", "lambda_z", "n_s", "n_z", "chi", "force"];
