@@ -474,7 +474,9 @@ fn a_pressure_beyond_the_maximum_is_refused_with_the_limit_point() {
         panic!()
     };
     let located = s.critical_points[0].midspan.w;
-    assert!((w_max - located).abs() < 1e-10, "{w_max} vs {located}");
+    // both are equilibria to Newton's rtol 1e-9 (relative residual), located to |Δs| ≤ 1e-8
+    // (an O(Δs²) error at a maximum): they agree to a few rtol (measured 3.7e-10 relative)
+    assert!((w_max / located - 1.0).abs() < 5e-9, "{w_max} vs {located}");
     // every converged step is kept, and each is below the maximum
     let steps = &outcome.report.stages[0].steps;
     assert!(!steps.is_empty());
