@@ -44,6 +44,48 @@ pub fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
     }
 }
 
+/// The values of one critical_points.csv row ([`CRITICAL_HEADER`]; NaN where one does not apply).
+pub fn critical_row(r: &crate::report::CriticalRecord) -> [f64; 16] {
+    let g = r.reference.as_ref();
+    [
+        r.stage as f64,
+        r.step as f64,
+        critical_code(r.kind),
+        r.arc_length,
+        r.bracket,
+        r.midspan.w,
+        r.midspan.lambda_s,
+        r.midspan.lambda_z,
+        r.midspan.volume,
+        r.negative_pivots_before as f64,
+        r.negative_pivots_after as f64,
+        g.map_or(f64::NAN, |g| g.w),
+        g.map_or(f64::NAN, |g| g.lambda_s),
+        r.polygon_factor.unwrap_or(f64::NAN),
+        r.w_error_over_polygon.unwrap_or(f64::NAN),
+        r.mode_eigenvalue.unwrap_or(f64::NAN),
+    ]
+}
+
+/// The rows of fronts.csv for one step ([`FRONTS_HEADER`]), `row` its row in steps.csv.
+pub fn front_rows(row: usize, r: &StepRecord) -> Vec<[f64; 7]> {
+    r.fronts
+        .iter()
+        .enumerate()
+        .map(|(k, z)| {
+            [
+                row as f64,
+                r.stage as f64,
+                r.step as f64,
+                r.midspan.w,
+                r.midspan.volume,
+                (k + 1) as f64,
+                *z,
+            ]
+        })
+        .collect()
+}
+
 /// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
 /// bifurcation, as steps.csv's `critical`).
 pub const CRITICAL_HEADER: &str = "stage,step,kind,arc_length,bracket,w,lambda_s,lambda_z,volume,negative_pivots_before,negative_pivots_after,reference_w,reference_lambda_s,polygon_factor,w_error_over_polygon,mode_eigenvalue";
@@ -842,17 +884,7 @@ impl Observer for RunWriter {
             if fresh {
                 writeln!(f, "{FRONTS_HEADER}")?;
             }
-            let r = view.record;
-            for (k, z) in r.fronts.iter().enumerate() {
-                let vals = [
-                    self.rows as f64,
-                    r.stage as f64,
-                    r.step as f64,
-                    r.midspan.w,
-                    r.midspan.volume,
-                    (k + 1) as f64,
-                    *z,
-                ];
+            for vals in front_rows(self.rows, view.record) {
                 writeln!(f, "{}", crate::curves::csv_line(&vals))?;
             }
         }
@@ -919,29 +951,10 @@ impl Observer for RunWriter {
         if fresh {
             writeln!(f, "{CRITICAL_HEADER}")?;
         }
-        let r = record;
-        let g = r.reference.as_ref();
-        let vals = [
-            r.stage as f64,
-            r.step as f64,
-            critical_code(r.kind),
-            r.arc_length,
-            r.bracket,
-            r.midspan.w,
-            r.midspan.lambda_s,
-            r.midspan.lambda_z,
-            r.midspan.volume,
-            r.negative_pivots_before as f64,
-            r.negative_pivots_after as f64,
-            g.map_or(f64::NAN, |g| g.w),
-            g.map_or(f64::NAN, |g| g.lambda_s),
-            r.polygon_factor.unwrap_or(f64::NAN),
-            r.w_error_over_polygon.unwrap_or(f64::NAN),
-            r.mode_eigenvalue.unwrap_or(f64::NAN),
-        ];
+        let vals = critical_row(record);
         writeln!(f, "{}", crate::curves::csv_line(&vals))?;
         // a bifurcation: the state with its critical mode, for ParaView
-        if let (Some(mode), Some(name)) = (mode, &r.mode_vtu) {
+        if let (Some(mode), Some(name)) = (mode, &record.mode_vtu) {
             let disp: Vec<f64> = state
                 .x
                 .iter()

@@ -434,6 +434,14 @@ impl RunReport {
     pub fn steps(&self) -> impl Iterator<Item = &StepRecord> {
         self.stages.iter().flat_map(|s| s.steps.iter())
     }
+
+    /// Every located critical point of every stage (finished or failed), in order.
+    pub fn critical_points(&self) -> impl Iterator<Item = &CriticalRecord> {
+        self.stages.iter().flat_map(|s| match &s.outcome {
+            StageOutcome::Finished(f) => f.critical_points.iter(),
+            StageOutcome::Failed(f) => f.critical_points.iter(),
+        })
+    }
 }
 
 /// (FE − closed form)/|closed form|.

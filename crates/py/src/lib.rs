@@ -585,6 +585,35 @@ fn step_columns(report: &tubemem_app::report::RunReport) -> Vec<(&'static str, V
         .collect()
 }
 
+/// Rows under a CSV header as (column, values) pairs.
+fn header_columns(header: &str, rows: &[Vec<f64>]) -> Vec<(String, Vec<f64>)> {
+    header
+        .split(',')
+        .enumerate()
+        .map(|(j, name)| (name.to_string(), rows.iter().map(|r| r[j]).collect()))
+        .collect()
+}
+
+/// The located critical points of a run: the columns of critical_points.csv.
+fn critical_columns(report: &tubemem_app::report::RunReport) -> Vec<(String, Vec<f64>)> {
+    let rows: Vec<Vec<f64>> = report
+        .critical_points()
+        .map(|c| tubemem_app::output::critical_row(c).to_vec())
+        .collect();
+    header_columns(tubemem_app::output::CRITICAL_HEADER, &rows)
+}
+
+/// The bulge fronts of a run's steps: the columns of fronts.csv.
+fn front_columns(report: &tubemem_app::report::RunReport) -> Vec<(String, Vec<f64>)> {
+    let rows: Vec<Vec<f64>> = report
+        .steps()
+        .enumerate()
+        .flat_map(|(k, r)| tubemem_app::output::front_rows(k + 1, r))
+        .map(|r| r.to_vec())
+        .collect();
+    header_columns(tubemem_app::output::FRONTS_HEADER, &rows)
+}
+
 /// Named numpy columns of equal shape: a closed-form curve, a vectorized closed form, the
 /// steps or profiles of a run. `t["w"]` is a column, `t.columns` their names, `len(t)` the
 /// number of rows, `t.to_pandas()` a DataFrame (columns flattened), `t.to_dict()` a plain dict.
@@ -677,16 +706,14 @@ fn profile_columns(report: &tubemem_app::report::RunReport) -> Vec<(String, Vec<
             rows.push(row);
         }
     }
-    PROFILES_HEADER
-        .split(',')
-        .enumerate()
-        .map(|(j, name)| (name.to_string(), rows.iter().map(|r| r[j]).collect()))
-        .collect()
+    header_columns(PROFILES_HEADER, &rows)
 }
 
 /// A finished FE run: `summary` (the dict of summary.json), `steps` (a `Table` of numpy arrays,
 /// one per steps.csv column, NaN where a column does not apply), `profiles` (a `Table` in long
-/// form: one row per ring and step, the columns of profiles/profiles.csv), `path` (the run
+/// form: one row per ring and step, the columns of profiles/profiles.csv), `critical_points`
+/// (a `Table`: the columns of critical_points.csv, one row per located critical point of an
+/// arc-length stage), `fronts` (a `Table`: the columns of fronts.csv), `path` (the run
 /// folder) and `to_pandas()` (the steps); `vtu(k)` is the path of VTU frame k (0 the reference
 /// state; which steps have a frame follows `[output] vtu`), readable with meshio.
 #[pyclass(name = "Run", module = "tubemem")]
@@ -694,6 +721,8 @@ struct Run {
     summary: Py<PyAny>,
     steps: Py<Table>,
     profiles: Py<Table>,
+    critical_points: Py<Table>,
+    fronts: Py<Table>,
     path: PathBuf,
     frames: usize,
 }
@@ -711,6 +740,14 @@ impl Run {
     #[getter]
     fn profiles(&self, py: Python<'_>) -> Py<Table> {
         self.profiles.clone_ref(py)
+    }
+    #[getter]
+    fn critical_points(&self, py: Python<'_>) -> Py<Table> {
+        self.critical_points.clone_ref(py)
+    }
+    #[getter]
+    fn fronts(&self, py: Python<'_>) -> Py<Table> {
+        self.fronts.clone_ref(py)
     }
     #[getter]
     fn path(&self) -> PathBuf {
@@ -869,6 +906,8 @@ fn run<'py>(
         summary: to_py(py, &report.summary())?.unbind(),
         steps: Py::new(py, Table::from_columns(py, steps)?)?,
         profiles: Py::new(py, Table::from_columns(py, profile_columns(&report))?)?,
+        critical_points: Py::new(py, Table::from_columns(py, critical_columns(&report))?)?,
+        fronts: Py::new(py, Table::from_columns(py, front_columns(&report))?)?,
         path: out,
         frames,
     })

@@ -456,3 +456,30 @@ tolerance.w = {{ value = 1e-6, source = "a tolerance the 16-gon cannot meet" }}
         bad = tmp_path / "bad.toml"
         bad.write_text(f'[[check]]\nname = "x"\ncase = "{small}"\nkind = "gold"\ntolerance.w = {{ value = 1.0, source = "" }}\n')
         tubemem.verify([str(bad)], str(tmp_path / "bad"))
+
+
+def test_an_arc_length_run_returns_its_critical_points_and_fronts(tmp_path):
+    """The small tube inflated by arc length past its pressure maximum to λs* = 2: the located
+    maximum is a row of `run.critical_points` equal to critical_points.csv and to summary.json,
+    and the bulge fronts of every step are `run.fronts`, equal to fronts.csv."""
+    import numpy as np
+
+    text = SMALL.replace('control = "volume"', 'control = "arc-length"').replace(
+        "target_stretch = 1.2", "target_stretch = 2.0"
+    )
+    r = tubemem.run(text, str(tmp_path / "arc"))
+    cp = r.critical_points
+    assert cp["kind"][0] == 1.0  # the pressure maximum
+    assert cp["bracket"][0] <= 1e-8
+    rows = list(csv.DictReader(open(tmp_path / "arc" / "critical_points.csv")))
+    assert len(rows) == len(cp)
+    for k in rows[0]:
+        np.testing.assert_array_equal(cp[k], [float(x[k]) if x[k] else np.nan for x in rows])
+    assert r.summary["stages"][0]["critical_points"][0]["w"] == cp["w"][0]
+    # no converged step above the located maximum
+    assert np.all(r.steps["w"] <= cp["w"][0] + 1e-12)
+    fr = r.fronts
+    assert list(fr) == ["row", "stage", "step", "w", "volume", "front", "z_ref"]
+    if len(fr):
+        on_disk = list(csv.DictReader(open(tmp_path / "arc" / "fronts.csv")))
+        np.testing.assert_array_equal(fr["z_ref"], [float(x["z_ref"]) for x in on_disk])
