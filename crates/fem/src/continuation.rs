@@ -125,7 +125,8 @@ pub struct ArcSettings {
     /// (scaled norm); a step that turns more is halved. 0.8 (37°): the paths here turn through
     /// 90° at a limit point within a few steps, and a reversed corrector turns by 180°
     pub min_turn_cos: f64,
-    /// the same for a step across which the negative-pivot count of K changes: 0.98 (11°)
+    /// the same for a step that would read as crossing a bifurcation (the negative-pivot count
+    /// of K changes, dλ/ds keeps its sign): 0.98 (11°)
     pub min_turn_cos_critical: f64,
     /// a step shorter than this multiple of the first fails the stage (a path that can only be
     /// crept along, e.g. towards a state the corrector can never pass)
@@ -418,12 +419,14 @@ pub fn follow<P: Path, O>(
                         + secant.1 * secant.1)
                         .sqrt();
                     let cos = along.min(ds / chord.max(1e-300));
-                    // a step across which K's inertia changed must be resolved finely: in a long
-                    // tube the path turns through most of 180° at the pressure maximum (uniform
-                    // inflation → a localized bulge with the rest deflating), and a coarse step
-                    // across it lands on the far leg, where the secant orients the tangent
-                    // backwards and the change of inertia looks like a bifurcation
-                    let needed = if t.negative != point.negative {
+                    // a step that would be read as crossing a bifurcation (K's inertia changed,
+                    // dλ/ds did not) must be resolved finely: in a long tube the path turns
+                    // through most of 180° at the pressure maximum (uniform inflation → a
+                    // localized bulge with the rest deflating), and a coarse step across it lands
+                    // on the far leg, where the secant orients the tangent backwards, dλ/ds keeps
+                    // its sign and the limit point looks like a bifurcation. A real bifurcation
+                    // passes the test once the step is short (the path is smooth through it)
+                    let needed = if t.negative != point.negative && tl * point.tl > 0.0 {
                         settings.min_turn_cos_critical
                     } else {
                         settings.min_turn_cos
@@ -713,9 +716,14 @@ fn locate_root<P: Path>(
     mut f: impl FnMut(&mut P, &P::State) -> Result<f64, P::Error>,
 ) -> Result<(f64, f64, P::State), P::Error> {
     let mut best: Option<(f64, f64, P::State)> = None;
+    // a bisection whenever two Illinois steps did not halve the bracket: the secant steps may
+    // converge from one side only, leaving the bracket long; this bounds it by 2·log₂(ds/tol)
+    // iterations
+    let mut widths = vec![(b - a).abs()];
     for _ in 0..settings.locate_iterations {
+        let bisect = widths.len() >= 3 && widths[widths.len() - 1] > 0.5 * widths[widths.len() - 3];
         let mut c = (a * fb - b * fa) / (fb - fa);
-        if !(c > a.min(b) && c < a.max(b)) {
+        if bisect || !(c > a.min(b) && c < a.max(b)) {
             c = 0.5 * (a + b);
         }
         let (s, _) = corrector(path, point, w, c)?;
@@ -724,17 +732,19 @@ fn locate_root<P: Path>(
             best = Some((c, fc.abs(), s.clone()));
         }
         if fc == 0.0 || fc.abs() <= ftol {
-            return Ok((c, (b - a).abs(), s));
+            // exactly at the root (or the target to its tolerance): no bracket left
+            return Ok((c, if fc == 0.0 { 0.0 } else { (b - a).abs() }, s));
         }
         if fc * fb < 0.0 {
             a = b;
             fa = fb;
-        } else {
+        } else if !bisect {
             // the same end stays: halve its value (Illinois)
             fa *= 0.5;
         }
         b = c;
         fb = fc;
+        widths.push((b - a).abs());
         if (b - a).abs() <= settings.locate_tol {
             return Ok((c, (b - a).abs(), s));
         }

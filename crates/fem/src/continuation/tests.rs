@@ -180,7 +180,13 @@ fn arc_length_follows_the_snap_back_of_a_truss_with_a_series_spring() {
     let wn = H * (1.0 + 1.0 / 3f64.sqrt());
     assert_eq!(crit[0].kind, CriticalKind::LimitMax);
     assert_eq!(crit[1].kind, CriticalKind::LimitMin);
-    assert!(crit[0].bracket <= 1e-8 && crit[1].bracket <= 1e-8);
+    assert!(
+        crit[0].bracket <= 1e-8 && crit[1].bracket <= 1e-8,
+        "{:?}",
+        crit.iter()
+            .map(|c| (c.bracket, c.s, c.load))
+            .collect::<Vec<_>>()
+    );
     assert!((crit[0].state[0] - wm).abs() < 1e-7, "{:?}", crit[0].state);
     assert!((crit[1].state[0] - wn).abs() < 1e-7, "{:?}", crit[1].state);
     assert!((crit[0].load - truss_force(wm)).abs() < 1e-12);
