@@ -235,10 +235,18 @@ pub fn run_study(
             tubemem_gps::limits::limit_points(law.as_ref(), tubemem_gps::Hypothesis::Gps)
         {
             if let Some(mx) = lim.max.filter(|mx| ls > mx.lambda_s) {
-                verdict.push_str(&format!(
-                    "the target λs* = {ls} lies past the GPS pressure maximum (ϖ = {:.4} at λs = {:.3}), where the uniform state is unstable and a bulge forms; ",
-                    mx.w, mx.lambda_s
-                ));
+                match lim.min.filter(|mn| ls >= mn.lambda_s) {
+                    // beyond both limit points the uniform state is stable again, but the path
+                    // to it went through a bulge, whose fronts may still be near the caps
+                    Some(mn) => verdict.push_str(&format!(
+                        "the target λs* = {ls} lies beyond both GPS limit points (maximum ϖ = {:.4} at λs = {:.3}, minimum {:.4} at {:.3}): a uniform tube is stable there again, but the path to it passes a bulge that propagates to the caps, and the tube may still be transitioning near them; ",
+                        mx.w, mx.lambda_s, mn.w, mn.lambda_s
+                    )),
+                    None => verdict.push_str(&format!(
+                        "the target λs* = {ls} lies past the GPS pressure maximum (ϖ = {:.4} at λs = {:.3}), where the uniform state is unstable and a bulge forms; ",
+                        mx.w, mx.lambda_s
+                    )),
+                }
             }
         }
     }
