@@ -142,7 +142,7 @@ fn arc_length_locates_the_pressure_maximum_and_the_maxwell_plateau_of_a_bulging_
             .unwrap();
         assert_eq!(min.negative, (1, 0));
         if length >= 40.0 {
-            // inside the propagating bulge (measured 3.4e-5 below Maxwell's λs)
+            // inside the propagating bulge (measured 1.9e-5 below Maxwell's λs)
             assert!(
                 (min.lambda_s / MAXWELL_LAMBDA_S - 1.0).abs() < 1e-4,
                 "bulge stretch {}",
