@@ -44,6 +44,28 @@ pub fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
     }
 }
 
+/// Append `rows` to the CSV at `path`, writing `header` first when the file is new (the files
+/// that only some runs have: fronts.csv, critical_points.csv).
+fn append_csv<R: AsRef<[f64]>>(path: &Path, header: &str, rows: &[R]) -> Result<()> {
+    let fresh = !path.exists();
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .map_err(|e| AppError::io(path, e))?;
+    let mut text = String::new();
+    if fresh {
+        text.push_str(header);
+        text.push('\n');
+    }
+    for r in rows {
+        text.push_str(&crate::curves::csv_line(r.as_ref()));
+        text.push('\n');
+    }
+    f.write_all(text.as_bytes())
+        .map_err(|e| AppError::io(path, e))
+}
+
 /// The values of one critical_points.csv row ([`CRITICAL_HEADER`]; NaN where one does not apply).
 pub fn critical_row(r: &crate::report::CriticalRecord) -> [f64; 16] {
     let g = r.reference.as_ref();
@@ -874,19 +896,11 @@ impl Observer for RunWriter {
             }
         }
         if !view.record.fronts.is_empty() {
-            let path = self.dir.join("fronts.csv");
-            let fresh = !path.exists();
-            let mut f = std::fs::OpenOptions::new()
-                .create(true)
-                .append(true)
-                .open(&path)
-                .map_err(|e| AppError::io(&path, e))?;
-            if fresh {
-                writeln!(f, "{FRONTS_HEADER}")?;
-            }
-            for vals in front_rows(self.rows, view.record) {
-                writeln!(f, "{}", crate::curves::csv_line(&vals))?;
-            }
+            append_csv(
+                &self.dir.join("fronts.csv"),
+                FRONTS_HEADER,
+                &front_rows(self.rows, view.record),
+            )?;
         }
         if let Some(profiles) = &mut self.profiles {
             let r = view.record;
@@ -941,18 +955,11 @@ impl Observer for RunWriter {
         state: &State,
         mode: Option<&[[f64; 3]]>,
     ) -> Result<(), BoxError> {
-        let path = self.dir.join("critical_points.csv");
-        let fresh = !path.exists();
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&path)
-            .map_err(|e| AppError::io(&path, e))?;
-        if fresh {
-            writeln!(f, "{CRITICAL_HEADER}")?;
-        }
-        let vals = critical_row(record);
-        writeln!(f, "{}", crate::curves::csv_line(&vals))?;
+        append_csv(
+            &self.dir.join("critical_points.csv"),
+            CRITICAL_HEADER,
+            &[critical_row(record)],
+        )?;
         // a bifurcation: the state with its critical mode, for ParaView
         if let (Some(mode), Some(name)) = (mode, &record.mode_vtu) {
             let disp: Vec<f64> = state

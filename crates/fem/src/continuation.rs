@@ -475,37 +475,18 @@ pub fn follow<P: Path, O>(
         // critical points inside the step, in path order
         if tl * point.tl < 0.0 {
             let (tu0, tl0) = (point.tu.clone(), point.tl);
-            // a corrector that fails inside the bracket leaves the point at the step's end,
-            // with the whole step as its bracket (reported, not fatal: the path goes on)
-            let c = match locate(path, &point, w, ds, settings, |path, s| {
+            let c = locate(path, &point, w, ds, settings, |path, s| {
                 let t = path.tangent(s)?;
                 Ok(unit_tangent(t.b, w, Some((&tu0, tl0)), 1.0).1)
-            }) {
-                Ok(c) => c,
-                Err(e) if path.is_final(&e) => {
-                    return Err(ArcError::Final {
-                        step: step + 1,
-                        source: e,
-                    })
-                }
-                Err(_) => (ds, ds, next.clone()),
-            };
+            });
+            let c = located_or_step(path, c, step + 1, ds, &next)?;
             let kind = if point.tl > 0.0 {
                 CriticalKind::LimitMax
             } else {
                 CriticalKind::LimitMin
             };
-            let cp = Critical {
-                kind,
-                step: step + 1,
-                s: point.s + c.0,
-                bracket: c.1,
-                load: path.load(&c.2),
-                state: c.2,
-                negative_before: point.negative,
-                negative_after: negative,
-                switched: None,
-            };
+            let load = path.load(&c.2);
+            let cp = Critical::at(kind, step + 1, &point, c, load, negative);
             on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
                 step: step + 1,
                 source,
@@ -513,27 +494,17 @@ pub fn follow<P: Path, O>(
             criticals.push(cp);
         } else if negative != point.negative {
             let before = point.negative as f64;
-            let c = match locate_count(path, &point, w, ds, settings, before) {
-                Ok(c) => c,
-                Err(e) if path.is_final(&e) => {
-                    return Err(ArcError::Final {
-                        step: step + 1,
-                        source: e,
-                    })
-                }
-                Err(_) => (ds, ds, next.clone()),
-            };
-            let mut cp = Critical {
-                kind: CriticalKind::Bifurcation,
-                step: step + 1,
-                s: point.s + c.0,
-                bracket: c.1,
-                load: path.load(&c.2),
-                state: c.2,
-                negative_before: point.negative,
-                negative_after: negative,
-                switched: None,
-            };
+            let c = locate_count(path, &point, w, ds, settings, before);
+            let c = located_or_step(path, c, step + 1, ds, &next)?;
+            let load = path.load(&c.2);
+            let mut cp = Critical::at(
+                CriticalKind::Bifurcation,
+                step + 1,
+                &point,
+                c,
+                load,
+                negative,
+            );
             // branch switching where an instability enters: leave the path along the critical
             // mode, by an arc of `switch_fraction` of the step that crossed the bifurcation
             if let (Some(fraction), true, false) = (
@@ -680,6 +651,51 @@ pub fn follow<P: Path, O>(
         // Crisfield's rule for the next length
         let f = (settings.desired_iterations.max(1) as f64 / iterations.max(1) as f64).sqrt();
         ds = (ds * f.clamp(0.5, 2.0)).min(max_ds);
+    }
+}
+
+impl<S> Critical<S> {
+    /// The critical point located at `c` in the step `step` from `point`, with `negative`
+    /// pivots after it.
+    fn at(
+        kind: CriticalKind,
+        step: usize,
+        point: &Point<S>,
+        (sigma, bracket, state): Located<S>,
+        load: f64,
+        negative: usize,
+    ) -> Self {
+        Self {
+            kind,
+            step,
+            s: point.s + sigma,
+            bracket,
+            load,
+            state,
+            negative_before: point.negative,
+            negative_after: negative,
+            switched: None,
+        }
+    }
+}
+
+/// A located point: its arc length σ from the step's start, its final bracket and its state.
+type Located<S> = (f64, f64, S);
+
+/// A located critical point, or — when a corrector inside the bracket failed — the step's end
+/// with the whole step as its bracket (reported, not fatal: the path goes on); an interrupt
+/// ends the stage.
+fn located_or_step<P: Path, O>(
+    path: &P,
+    located: Result<Located<P::State>, P::Error>,
+    step: usize,
+    ds: f64,
+    end: &P::State,
+) -> Result<Located<P::State>, ArcError<P::Error, O>> {
+    match located {
+        Ok(c) => Ok(c),
+        Err(e) if path.is_final(&e) => Err(ArcError::Final { step, source: e }),
+        Err(_) => Ok((ds, ds, end.clone())),
     }
 }
 

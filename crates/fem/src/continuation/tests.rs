@@ -202,18 +202,23 @@ fn arc_length_follows_the_snap_back_of_a_truss_with_a_series_spring() {
     assert!(events.contains(&"critical"));
 }
 
-/// A pitchfork: R₁ = u₁ − λ, R₂ = u₂(1 − λ) + u₂³ (g = (1, 0)). On the primary path u₂ = 0, K =
-/// diag(1, 1 − λ) loses positive definiteness at λ = 1 with its mode (0, 1) orthogonal to g, and
-/// λ keeps rising: a bifurcation, not a limit point.
-#[test]
-fn a_pivot_change_without_a_load_turn_is_a_bifurcation_located_to_the_tolerance() {
-    let mut p = Two {
+/// The pitchfork of the two tests below.
+fn pitchfork() -> Two<Residual, Stiffness> {
+    Two {
         f: |u: [f64; 2]| [u[0], u[1] * (1.0 - u[0]) + u[1].powi(3)],
         k: |u: [f64; 2]| [[1.0, 0.0], [-u[1], 1.0 - u[0] + 3.0 * u[1] * u[1]]],
         g: [1.0, 0.0],
         fail: Box::new(|_, _| false),
         corrections: 0,
-    };
+    }
+}
+
+/// A pitchfork: R₁ = u₁ − λ, R₂ = u₂(1 − λ) + u₂³ (g = (1, 0)). On the primary path u₂ = 0, K =
+/// diag(1, 1 − λ) loses positive definiteness at λ = 1 with its mode (0, 1) orthogonal to g, and
+/// λ keeps rising: a bifurcation, not a limit point.
+#[test]
+fn a_pivot_change_without_a_load_turn_is_a_bifurcation_located_to_the_tolerance() {
+    let mut p = pitchfork();
     let l_of = |s: &[f64; 3]| s[2];
     let target = Target {
         name: "λ",
@@ -314,13 +319,7 @@ fn failed_steps_are_cut_back_and_no_converged_step_is_lost() {
 /// no negative pivot), to λ = 1.7, where u₂ = ±√0.7.
 #[test]
 fn branch_switching_follows_the_stable_branch_of_a_pitchfork() {
-    let mut p = Two {
-        f: |u: [f64; 2]| [u[0], u[1] * (1.0 - u[0]) + u[1].powi(3)],
-        k: |u: [f64; 2]| [[1.0, 0.0], [-u[1], 1.0 - u[0] + 3.0 * u[1] * u[1]]],
-        g: [1.0, 0.0],
-        fail: Box::new(|_, _| false),
-        corrections: 0,
-    };
+    let mut p = pitchfork();
     let l_of = |s: &[f64; 3]| s[2];
     let target = Target {
         name: "λ",
