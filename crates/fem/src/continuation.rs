@@ -139,8 +139,11 @@ pub struct ArcSettings {
     pub locate_iterations: usize,
     /// the relative accuracy of a located target, |q − q*| ≤ target_rtol·max(|q*|, 1e-300)
     pub target_rtol: f64,
-    /// the sign of dλ/ds at the start (+1: the load increases first)
+    /// the sign of dλ/ds at the start (+1: the load increases first)…
     pub first_direction: f64,
+    /// … unless the monitored quantity would then move away from the target: a fresh stage
+    /// sets out towards it (off for a resumed stage, which keeps `first_direction`)
+    pub orient_to_target: bool,
     /// branch switching: at the first bifurcation where K gains a negative pivot, leave the
     /// path along the critical mode by this fraction of the step's arc length (`None`: stay on
     /// the path)
@@ -162,6 +165,7 @@ impl Default for ArcSettings {
             locate_iterations: 80,
             target_rtol: 1e-10,
             first_direction: 1.0,
+            orient_to_target: true,
             switch_fraction: None,
         }
     }
@@ -368,7 +372,14 @@ pub fn follow<P: Path, O>(
     // a difference along the predictor: q is a function of the state alone)
     let h = 1e-6;
     let probe = path.predict(&point.state, &point.tu, point.tl, h);
-    let dqds = ((target.monitor)(&probe) - q0) / h;
+    let mut dqds = ((target.monitor)(&probe) - q0) / h;
+    // a fresh stage sets out towards its target (a deflation, a stage that starts past a
+    // maximum); a resumed one keeps the direction it had (`first_direction`)
+    if settings.orient_to_target && dqds * (target.value - q0) < 0.0 {
+        point.tu.iter_mut().for_each(|v| *v = -*v);
+        point.tl = -point.tl;
+        dqds = -dqds;
+    }
     let mut ds = if dqds.is_finite() && dqds.abs() > 0.0 {
         ((target.value - q0) / dqds).abs() / settings.initial_steps.max(1) as f64
     } else {
@@ -591,7 +602,11 @@ pub fn follow<P: Path, O>(
                     w,
                     (0.0, q_prev - goal),
                     (ds, q_next - goal),
-                    settings,
+                    // the target to its own accuracy, not to the critical points' bracket on s
+                    &ArcSettings {
+                        locate_tol: 1e-15 * ds,
+                        ..*settings
+                    },
                     qtol,
                     |_, s| Ok(monitor(s) - goal),
                 )
@@ -931,6 +946,7 @@ pub fn run_arc_stage<E>(
         max_cuts: stage.settings.max_cuts,
         max_steps: stage.settings.max_steps,
         first_direction,
+        orient_to_target: resume.is_none(),
         switch_fraction,
         ..ArcSettings::default()
     };

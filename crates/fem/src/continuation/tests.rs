@@ -354,3 +354,33 @@ fn branch_switching_follows_the_stable_branch_of_a_pitchfork() {
     let last = after.last().unwrap().0;
     assert!((last[2] - 1.7).abs() < 1e-10 && (last[1].abs() - 0.7f64.sqrt()).abs() < 1e-9);
 }
+
+/// A fresh stage sets out towards its target: from a point on the truss's rising branch
+/// (w = 0.2) with the target v = 0.05 behind it, the path goes back down, and ends on the
+/// closed-form path at v = 0.05 without passing a limit point.
+#[test]
+fn a_fresh_stage_sets_out_towards_its_target() {
+    let mut p = truss();
+    let w0 = 0.2;
+    let start = [w0, w0 + truss_force(w0) / KS, truss_force(w0)];
+    let v_of = |s: &[f64; 3]| s[1];
+    let target = Target {
+        name: "v",
+        monitor: &v_of,
+        value: 0.05,
+    };
+    let mut last = start;
+    let crit = follow(&mut p, start, &target, &ArcSettings::default(), |_, e| {
+        if let ArcEvent::Step(s) = e {
+            last = *s.state;
+        }
+        Ok::<(), String>(())
+    })
+    .unwrap();
+    assert!(crit.is_empty(), "{crit:?}");
+    assert!(
+        (last[1] - 0.05).abs() < 1e-12 && (last[2] - truss_force(last[0])).abs() < 1e-12,
+        "{last:?}"
+    );
+    assert!(last[0] < w0);
+}
