@@ -441,6 +441,21 @@ impl RunWriter {
                 .map_err(|e| AppError::io(&path, e))?;
             w.profiles = Some(BufWriter::new(f));
         }
+        // fronts.csv: the rows of the kept steps; critical_points.csv: the checkpoint's points
+        trim_rows(&dir.join("fronts.csv"), ck.rows)?;
+        let path = dir.join("critical_points.csv");
+        let points: Vec<[f64; 16]> = ck
+            .report
+            .critical_points()
+            .chain(&ck.critical_points)
+            .map(critical_row)
+            .collect();
+        if path.exists() {
+            std::fs::remove_file(&path).map_err(|e| AppError::io(&path, e))?;
+        }
+        if !points.is_empty() {
+            append_csv(&path, CRITICAL_HEADER, &points)?;
+        }
         w.pvd = ck.pvd.clone();
         w.frames = ck.frames;
         w.rows = ck.rows;
@@ -933,6 +948,7 @@ impl Observer for RunWriter {
             progress: view.progress,
             report: view.report.clone(),
             steps: view.stage_steps.to_vec(),
+            critical_points: view.stage_critical_points.to_vec(),
             rows: self.rows,
             frames: self.frames,
             pvd: self.pvd.clone(),

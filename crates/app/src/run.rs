@@ -30,6 +30,8 @@ pub struct StepView<'a> {
     pub report: &'a RunReport,
     /// the current stage's steps so far, this one last
     pub stage_steps: &'a [StepRecord],
+    /// the critical points the current stage has located so far (arc-length stages)
+    pub stage_critical_points: &'a [CriticalRecord],
     /// how the current stage was set up, and where its stepping stands (for checkpoints)
     pub context: &'a StageContext,
     pub progress: tubemem_fem::stepping::StepState,
@@ -484,6 +486,9 @@ pub struct Checkpoint {
     pub report: RunReport,
     /// the current stage's steps so far
     pub steps: Vec<StepRecord>,
+    /// the critical points the current stage (arc length) has located so far
+    #[serde(default)]
+    pub critical_points: Vec<CriticalRecord>,
     /// steps.csv rows and VTU frames written up to this step, and the PVD entries
     pub rows: usize,
     pub frames: usize,
@@ -932,8 +937,13 @@ fn run_inner(
         for o in observers.iter_mut() {
             o.stage_started(plan, stages);
         }
-        let (context, progress, restored) = match resume_here {
-            Some(ck) => (ck.context, Some(ck.progress), ck.steps.clone()),
+        let (context, progress, restored, restored_critical) = match resume_here {
+            Some(ck) => (
+                ck.context,
+                Some(ck.progress),
+                ck.steps.clone(),
+                ck.critical_points.clone(),
+            ),
             None => {
                 let ctx = setup_stage(
                     plan,
@@ -946,7 +956,7 @@ fn run_inner(
                     node,
                     v0,
                 )?;
-                (ctx, None, vec![])
+                (ctx, None, vec![], vec![])
             }
         };
         let settings = StepSettings {
@@ -1005,7 +1015,13 @@ fn run_inner(
             [.., a, b] if b.midspan.w < a.midspan.w => -1.0,
             _ => 1.0,
         };
-        let mut criticals: Vec<CriticalRecord> = vec![];
+        let mut criticals: Vec<CriticalRecord> = restored_critical;
+        // the last limit point before a restart, for the ripple test of the next one
+        let last_limit_w0 = criticals
+            .iter()
+            .rev()
+            .find(|c| c.kind != CriticalKind::Bifurcation)
+            .map(|c| c.midspan.w);
         let mut on_step = |m: &Model, st: &State, info: &StepInfo| {
             let mut critical_here = None;
             for p in pending.borrow_mut().drain(..) {
@@ -1150,6 +1166,7 @@ fn run_inner(
                 let view = StepView {
                     report: finished,
                     stage_steps: &steps,
+                    stage_critical_points: &criticals,
                     context: &context,
                     progress: info.progress,
                     model: m,
@@ -1181,7 +1198,7 @@ fn run_inner(
                 .around
                 .filter(|_| case.mesh.file.is_none())
                 .map(|n| 1.0 / (std::f64::consts::PI / n as f64).cos());
-            let last_limit = std::cell::Cell::new(None);
+            let last_limit = std::cell::Cell::new(last_limit_w0);
             let found = run_arc_stage(
                 &mut model,
                 &mut state,

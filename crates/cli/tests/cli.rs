@@ -1249,6 +1249,83 @@ fn a_killed_run_resumes_bit_identical() {
     }
 }
 
+/// Restart of an arc-length stage: the bulge case killed (SIGKILL) after its tenth step, past
+/// the located pressure maximum, and resumed. The continuation starts afresh from the
+/// checkpointed state (its step lengths differ), so the steps are not bit-identical; what must
+/// be equal is what the path defines: the final state at the target (the same equilibrium, to
+/// the Newton tolerance 1e-9 and the target's 1e-10) and the located maximum (to a few Newton
+/// tolerances, as the probe's test), kept across the restart in summary.json and once in
+/// critical_points.csv.
+#[test]
+fn a_killed_arc_length_run_resumes_with_its_critical_points() {
+    let d = tmp("resume-arc");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        include_str!("../../../cases/inflate_abb30_ls6.0_bulge.toml"),
+    )
+    .unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    assert!(run_in(&case, &reference, &[]).status.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            killed.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    loop {
+        let rows = std::fs::read_to_string(killed.join("steps.csv"))
+            .map(|t| t.lines().count().saturating_sub(1))
+            .unwrap_or(0);
+        if rows >= 10 || t0.elapsed().as_secs() > 60 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    // (a run that finished meanwhile has nothing to kill)
+    let _ = child.kill();
+    child.wait().unwrap();
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |dir: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (read(&reference), read(&killed));
+    let (fa, fb) = (&a["stages"][0]["final"], &b["stages"][0]["final"]);
+    for k in ["w", "lambda_s", "lambda_z"] {
+        let (x, y) = (fa[k].as_f64().unwrap(), fb[k].as_f64().unwrap());
+        assert!((x / y - 1.0).abs() < 1e-8, "{k}: {x} vs {y}");
+    }
+    let maxima = |v: &serde_json::Value| -> Vec<f64> {
+        v["stages"][0]["critical_points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["kind"] == "limit-max" && c.get("ripple").is_none())
+            .map(|c| c["w"].as_f64().unwrap())
+            .collect()
+    };
+    let (ma, mb) = (maxima(&a), maxima(&b));
+    assert_eq!(ma.len(), 1);
+    assert_eq!(mb.len(), 1, "the maximum located before the kill is kept");
+    assert!((ma[0] / mb[0] - 1.0).abs() < 5e-9, "{ma:?} vs {mb:?}");
+    let csv_rows = std::fs::read_to_string(killed.join("critical_points.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert_eq!(
+        csv_rows,
+        b["stages"][0]["critical_points"].as_array().unwrap().len()
+    );
+}
+
 /// Resource guards: the 6.6 M-equation full tube is refused before anything is built (well
 /// within a second), with its estimate; a case file that is /dev/zero is read through the size
 /// limit; an overlay whose steps.csv holds NaN or NUL bytes is refused.
