@@ -480,6 +480,9 @@ def test_an_arc_length_run_returns_its_critical_points_and_fronts(tmp_path):
     assert np.all(r.steps["w"] <= cp["w"][0] + 1e-12)
     fr = r.fronts
     assert list(fr) == ["row", "stage", "step", "w", "volume", "front", "z_ref"]
+    # the type stub has both
+    stub = (pathlib.Path(__file__).resolve().parents[1] / "tubemem.pyi").read_text()
+    assert "def critical_points(self) -> Table" in stub and "def fronts(self) -> Table" in stub
     if len(fr):
         on_disk = list(csv.DictReader(open(tmp_path / "arc" / "fronts.csv")))
         np.testing.assert_array_equal(fr["z_ref"], [float(x["z_ref"]) for x in on_disk])
