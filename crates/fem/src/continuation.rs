@@ -481,9 +481,45 @@ pub fn follow<P: Path, O>(
         let (mut negative, mut negative_conjugate) = (t.negative, t.negative_conjugate);
         let (mut tu, mut tl) = (tu, tl);
         let mut s_next = point.s + ds;
-        let mut switched = false;
         let q_prev = (target.monitor)(&point.state);
-        // critical points inside the step, in path order
+        // the target inside the step: located first, so that a critical point beyond it (in the
+        // same step) is not reported, and no branch is switched in the stage's last step
+        let q_step = (target.monitor)(&next);
+        let target_end =
+            if (q_prev - target.value) * (q_step - target.value) <= 0.0 && q_prev != target.value {
+                Some(if (q_step - target.value).abs() <= qtol {
+                    (ds, next.clone())
+                } else {
+                    let monitor = target.monitor;
+                    let goal = target.value;
+                    let (sigma, _, st) = locate_root(
+                        path,
+                        &point,
+                        w,
+                        (0.0, q_prev - goal),
+                        (ds, q_step - goal),
+                        // the target to its own accuracy, not to the critical points' bracket on s
+                        &ArcSettings {
+                            locate_tol: 1e-15 * ds,
+                            ..*settings
+                        },
+                        qtol,
+                        |_, s| Ok(monitor(s) - goal),
+                    )
+                    .map_err(|source| ArcError::Stalled {
+                        step: step + 1,
+                        ds,
+                        cuts: 0,
+                        load: path.load(&point.state),
+                        source,
+                    })?;
+                    (sigma, st)
+                })
+            } else {
+                None
+            };
+        let sigma_target = target_end.as_ref().map_or(f64::INFINITY, |t| t.0);
+        // critical points inside the step (before the target), in path order
         if tl * point.tl < 0.0 {
             let (tu0, tl0) = (point.tu.clone(), point.tl);
             let c = locate(path, &point, w, ds, settings, |path, s| {
@@ -496,17 +532,20 @@ pub fn follow<P: Path, O>(
             } else {
                 CriticalKind::LimitMin
             };
-            let load = path.load(&c.2);
-            let cp = Critical::at(kind, step + 1, &point, c, load, negative);
-            on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
-                step: step + 1,
-                source,
-            })?;
-            criticals.push(cp);
+            if c.0 <= sigma_target {
+                let load = path.load(&c.2);
+                let cp = Critical::at(kind, step + 1, &point, c, load, negative);
+                on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
+                    step: step + 1,
+                    source,
+                })?;
+                criticals.push(cp);
+            }
         } else if negative != point.negative {
             let before = point.negative as f64;
             let c = locate_count(path, &point, w, ds, settings, before);
             let c = located_or_step(path, c, step + 1, ds, &next)?;
+            let beyond_target = c.0 > sigma_target;
             let load = path.load(&c.2);
             let mut cp = Critical::at(
                 CriticalKind::Bifurcation,
@@ -518,10 +557,11 @@ pub fn follow<P: Path, O>(
             );
             // branch switching where an instability enters: leave the path along the critical
             // mode, by an arc of `switch_fraction` of the step that crossed the bifurcation
-            if let (Some(fraction), true, false) = (
+            if let (Some(fraction), true, false, None) = (
                 settings.switch_fraction,
                 negative > point.negative,
                 switched_once,
+                &target_end,
             ) {
                 let mode = path
                     .critical_mode(&cp.state)
@@ -572,53 +612,21 @@ pub fn follow<P: Path, O>(
                     s_next = cp.s + dsw;
                     next = st;
                     iterations = it;
-                    switched = true;
                     switched_once = true;
                     cp.switched = Some(dsw);
                 }
             }
-            on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
-                step: step + 1,
-                source,
-            })?;
-            criticals.push(cp);
+            if !beyond_target {
+                on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
+                    step: step + 1,
+                    source,
+                })?;
+                criticals.push(cp);
+            }
         }
         step += 1;
         let q_next = (target.monitor)(&next);
-        // the target inside the step: locate it and end there (not on a branch-switching step,
-        // whose start is the bifurcation point, not `point`)
-        if !switched
-            && (q_prev - target.value) * (q_next - target.value) <= 0.0
-            && q_prev != target.value
-        {
-            let (sigma, end) = if (q_next - target.value).abs() <= qtol {
-                (ds, next)
-            } else {
-                let monitor = target.monitor;
-                let goal = target.value;
-                let (sigma, _, st) = locate_root(
-                    path,
-                    &point,
-                    w,
-                    (0.0, q_prev - goal),
-                    (ds, q_next - goal),
-                    // the target to its own accuracy, not to the critical points' bracket on s
-                    &ArcSettings {
-                        locate_tol: 1e-15 * ds,
-                        ..*settings
-                    },
-                    qtol,
-                    |_, s| Ok(monitor(s) - goal),
-                )
-                .map_err(|source| ArcError::Stalled {
-                    step,
-                    ds,
-                    cuts: 0,
-                    load: path.load(&point.state),
-                    source,
-                })?;
-                (sigma, st)
-            };
+        if let Some((sigma, end)) = target_end {
             let t_end = path
                 .tangent(&end)
                 .map_err(|source| ArcError::Tangent { step, source })?;

@@ -384,3 +384,41 @@ fn a_fresh_stage_sets_out_towards_its_target() {
     );
     assert!(last[0] < w0);
 }
+
+/// Targets just before the truss's load maximum, reached in steps long enough to cross the
+/// maximum as well: each stage ends at its target, on the rising branch, and reports no limit
+/// point (it lies beyond the target). For δ = 1e-4 the last step's end lies past the maximum:
+/// located before the target was, the maximum used to be reported.
+#[test]
+fn a_critical_point_beyond_the_target_is_not_reported() {
+    let wm = H * (1.0 - 1.0 / 3f64.sqrt());
+    let vm = wm + truss_force(wm) / KS;
+    for delta in [1e-4, 3e-4, 1e-3, 3e-3, 1e-2] {
+        let mut p = truss();
+        let v_of = |s: &[f64; 3]| s[1];
+        let target = Target {
+            name: "v",
+            monitor: &v_of,
+            value: vm - delta,
+        };
+        let settings = ArcSettings {
+            initial_steps: 1,
+            max_ds_factor: 8.0,
+            ..ArcSettings::default()
+        };
+        let mut last = [0.0; 3];
+        let crit = follow(&mut p, [0.0; 3], &target, &settings, |_, e| {
+            if let ArcEvent::Step(s) = e {
+                last = *s.state;
+            }
+            Ok::<(), String>(())
+        })
+        .unwrap();
+        assert!(crit.is_empty(), "δ = {delta}: {crit:?}");
+        // the target to its tolerance, `target_rtol` = 1e-10 relative
+        assert!(
+            last[0] < wm && (last[1] - (vm - delta)).abs() < 1e-10 * vm,
+            "δ = {delta}: {last:?}"
+        );
+    }
+}
