@@ -256,6 +256,16 @@ pub struct MeshSpec {
     pub symmetry: Symmetry,
 }
 
+impl MeshSpec {
+    /// The generated tube's polygon factor 1/cos(π/n), n elements around: the n-gon prism's
+    /// pressure over the smooth tube's at the same state (`None` for a user mesh).
+    pub fn polygon_factor(&self) -> Option<f64> {
+        self.around
+            .filter(|_| self.file.is_none())
+            .map(|n| 1.0 / (std::f64::consts::PI / n as f64).cos())
+    }
+}
+
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Kind {

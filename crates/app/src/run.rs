@@ -132,11 +132,6 @@ struct PendingCritical {
     mode: Option<Vec<[f64; 3]>>,
 }
 
-/// Inverse iterations for the critical mode of a bifurcation: K is singular there to the
-/// location's tolerance, so the iteration converges by the ratio of the two smallest
-/// eigenvalues, which is tiny; 8 solves leave the mode converged to rounding.
-const MODE_ITERATIONS: usize = 8;
-
 /// The record of a located critical point (its mid-span values, the closed form's limit point
 /// of the same kind, and for a bifurcation the critical mode), queued in `pending`.
 #[allow(clippy::too_many_arguments)]
@@ -174,7 +169,8 @@ fn critical_record(
     });
     let (mode, mode_eigenvalue) = if c.kind == CriticalKind::Bifurcation {
         let load = Load::pressure(c.state.p);
-        let (v, mu) = model.smallest_mode(&c.state, &load, MODE_ITERATIONS)?;
+        let (v, mu) =
+            model.smallest_mode(&c.state, &load, tubemem_fem::continuation::MODE_ITERATIONS)?;
         let mut x = vec![[0.0; 3]; c.state.x.len()];
         model.free_update(&mut x, &v, 1.0);
         (Some(x), Some(mu))
@@ -524,6 +520,7 @@ fn setup_stage(
     state: &mut State,
     report: &mut RunReport,
     closed_form_law: &dyn MembraneLaw,
+    limits: Option<&tubemem_gps::limits::Limits>,
     node: usize,
     v0: f64,
 ) -> Result<StageContext> {
@@ -536,12 +533,8 @@ fn setup_stage(
     // a target the closed form has no state for: say so before the run meets it
     let beyond = match plan.target {
         Target::Stretch(s) => inflate(closed_form_law, Hypothesis::Gps, s).err(),
-        Target::Pressure(p) if p > 0.0 && !plan.arc_length => tubemem_gps::limits::limit_points(
-            closed_form_law,
-            Hypothesis::Gps,
-        )
-        .ok()
-        .and_then(|l| l.max)
+        Target::Pressure(p) if p > 0.0 && !plan.arc_length => limits
+            .and_then(|l| l.max)
         .filter(|mx| p > mx.w)
         .map(|_| {
             tubemem_gps::GpsError::InvalidInput {
@@ -554,7 +547,7 @@ fn setup_stage(
     };
     // a mid-span stretch on the falling branch of the GPS curve: no stable uniform tube there
     if let Target::Stretch(s) = plan.target {
-        if let Ok(l) = tubemem_gps::limits::limit_points(closed_form_law, Hypothesis::Gps) {
+        if let Some(l) = limits {
             if let Some(mx) = l.max.filter(|mx| s > mx.lambda_s) {
                 if l.min.is_none_or(|mn| s < mn.lambda_s) {
                     report.warnings.push(format!(
@@ -868,6 +861,10 @@ fn run_inner(
     let symmetry = mesh.symmetry;
     let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;
+    // the closed form's limit points, for the warnings, the critical points' references and the
+    // stage-end notes (one scan per run)
+    let gps_limits =
+        tubemem_gps::limits::limit_points(closed_form_law.as_ref(), Hypothesis::Gps).ok();
     let mut model = Model::new(mesh, law).map_err(AppError::Model)?;
     model.set_interrupt(options.interrupt.clone());
     model.set_settings(NewtonSettings {
@@ -953,6 +950,7 @@ fn run_inner(
                     &mut state,
                     report,
                     closed_form_law.as_ref(),
+                    gps_limits.as_ref(),
                     node,
                     v0,
                 )?;
@@ -1191,13 +1189,8 @@ fn run_inner(
                 Target::Stretch(_) => Box::new(move |s: &State| s.x[node][0]),
                 _ => Box::new(move |s: &State| mult * mesh.volume_at(&s.x)),
             };
-            let law = closed_form_law.as_ref();
-            let limits = tubemem_gps::limits::limit_points(law, Hypothesis::Gps).ok();
-            let polygon = case
-                .mesh
-                .around
-                .filter(|_| case.mesh.file.is_none())
-                .map(|n| 1.0 / (std::f64::consts::PI / n as f64).cos());
+            let limits = gps_limits.as_ref();
+            let polygon = case.mesh.polygon_factor();
             let last_limit = std::cell::Cell::new(last_limit_w0);
             let found = run_arc_stage(
                 &mut model,
@@ -1214,7 +1207,7 @@ fn run_inner(
                         m,
                         c,
                         i,
-                        limits.as_ref(),
+                        limits,
                         polygon,
                         &last_limit,
                         &mut pending.borrow_mut(),
@@ -1331,8 +1324,8 @@ fn run_inner(
         // an inflation past the closed form's pressure maximum: the uniform state is unstable
         let unstable_note = match plan.target {
             Target::Pressure(_) | Target::Stretch(_) | Target::VolumeRatio(_) => {
-                tubemem_gps::limits::limit_points(closed_form_law.as_ref(), Hypothesis::Gps)
-                    .ok()
+                gps_limits
+                    .as_ref()
                     .and_then(|l| l.max)
                     .filter(|mx| ms.lambda_s > mx.lambda_s)
                     .map(|mx| format!(

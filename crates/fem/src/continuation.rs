@@ -788,8 +788,14 @@ fn locate_root<P: Path>(
             return Ok((c, (b - a).abs(), s));
         }
     }
-    let (c, _, s) = best.expect("at least one iteration");
-    Ok((c, (b - a).abs(), s))
+    match best {
+        Some((c, _, s)) => Ok((c, (b - a).abs(), s)),
+        // no iteration allowed: the bracket's far end
+        None => {
+            let (s, _) = corrector(path, point, w, b)?;
+            Ok((b, (b - a).abs(), s))
+        }
+    }
 }
 
 /// Locate a limit point: the zero of the oriented t_λ(σ) in (0, ds].
@@ -848,6 +854,11 @@ fn locate_count<P: Path>(
 #[cfg(test)]
 mod tests;
 
+/// Inverse iterations for the critical mode of a bifurcation: K is singular at the located
+/// point to its bracket, so the iteration converges by the ratio of the two smallest
+/// eigenvalues, which is tiny; 8 solves leave the mode converged to rounding.
+pub const MODE_ITERATIONS: usize = 8;
+
 /// The membrane model as a [`Path`]: u the free dofs, λ the reduced pressure ϖ, under the
 /// planes of `load` (its own control is replaced by the arc-length constraint). The weight of
 /// the displacements is 1/n_eq, so that ‖Δu‖ is their root mean square (in R), of the same order
@@ -888,14 +899,12 @@ impl Path for MembranePath<'_> {
         Ok(Tangent::new(b, &g, negative))
     }
     fn critical_mode(&mut self, s: &Self::State) -> Result<Option<Vec<f64>>, Self::Error> {
-        // K is singular at the located bifurcation to its bracket: inverse iteration converges
-        // by the ratio of the two smallest eigenvalues, 8 solves leave rounding
         let load = crate::model::Load {
             loading: crate::model::Loading::Pressure(s.p),
             contact: self.load.contact.clone(),
         };
         self.model
-            .smallest_mode(s, &load, 8)
+            .smallest_mode(s, &load, MODE_ITERATIONS)
             .map(|(v, _)| Some(v))
             .map_err(|source| crate::newton::NewtonError::Problem {
                 iteration: 0,

@@ -485,15 +485,13 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             .map_err(|e| e.to_string())?
             .maxwell
             .ok_or("the law has no Maxwell pressure (no pressure minimum)")?;
-        let around: toml::Table = toml::from_str(&c.case_text).map_err(|e| e.to_string())?;
-        let n = around
-            .get("mesh")
-            .and_then(|m| m.get("around"))
-            .and_then(|v| v.as_integer())
+        let polygon = crate::case::Case::parse(&c.case_text)
+            .map_err(|e| crate::error_chain(&e))?
+            .mesh
+            .polygon_factor()
             .ok_or(
                 "maxwell_*: the case needs a generated mesh (`around`) for its polygon factor",
             )?;
-        let polygon = 1.0 / (std::f64::consts::PI / n as f64).cos();
         Some((m, polygon))
     } else {
         None
