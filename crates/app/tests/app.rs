@@ -392,13 +392,18 @@ fn an_arc_length_stage_reports_its_critical_points_in_every_output() {
     let StageOutcome::Finished(s) = &report.stages[0].outcome else {
         panic!("the stage failed")
     };
+    // the target to `target_rtol` 1e-10 relative (2e-10 here), with room for the mid-span
+    // extraction's rounding
     assert!((s.final_state.midspan.lambda_s - 2.0).abs() < 1e-9);
     let c = &s.critical_points[0];
     assert_eq!(c.kind, tubemem_fem::continuation::CriticalKind::LimitMax);
     assert!(c.bracket <= 1e-8 && !c.ripple);
     // no converged step of the path has a higher pressure than the located maximum
     let steps = &report.stages[0].steps;
-    assert!(steps.iter().all(|r| r.midspan.w <= c.midspan.w + 1e-12));
+    // (each step an equilibrium to Newton's 1e-9 relative residual: a few of those, 5e-9)
+    assert!(steps
+        .iter()
+        .all(|r| r.midspan.w <= c.midspan.w * (1.0 + 5e-9)));
     // the step after the maximum carries its kind; dϖ/ds changed sign there
     let after = steps.iter().find(|r| r.step == c.step).unwrap();
     assert!(after.critical.is_some());
@@ -523,6 +528,7 @@ fn a_target_past_the_maximum_marks_gps_not_applicable() {
         why.contains("not uniform") && why.contains("1.7081"),
         "{why}"
     );
+    // a bulge, not an end effect: above `report::BULGE` (0.1), where fronts are reported
     assert!(summaries[0].nonuniformity.unwrap() > 0.1);
     assert!(!summaries[1].gps_applicable);
     assert!(summaries[1]

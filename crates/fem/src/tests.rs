@@ -643,6 +643,7 @@ fn arc_length_passes_and_locates_the_pressure_maximum_of_a_sphere() {
         })
         .unwrap();
         assert!(
+            // the volume-ratio target to `target_rtol` 1e-10, a third of that in the stretch
             (stretch_at_target - 1.8).abs() < 1e-10,
             "{stretch_at_target}"
         );
@@ -653,7 +654,9 @@ fn arc_length_passes_and_locates_the_pressure_maximum_of_a_sphere() {
         assert_eq!(maxima.len(), 1, "{crit:?}");
         let c = maxima[0];
         assert!(c.bracket <= 1e-8);
-        assert!(pressures.iter().all(|&p| p <= c.load + 1e-12));
+        // every point is an equilibrium to Newton's relative residual 1e-9: none lies above the
+        // located maximum by more than a few of those (5e-9 relative)
+        assert!(pressures.iter().all(|&p| p <= c.load * (1.0 + 5e-9)));
         // the sphere's discrete pressure has one negative pivot past the maximum (the
         // inflation mode), none before
         assert_eq!((c.negative_before, c.negative_after), (0, 1));

@@ -477,7 +477,8 @@ def test_an_arc_length_run_returns_its_critical_points_and_fronts(tmp_path):
         np.testing.assert_array_equal(cp[k], [float(x[k]) if x[k] else np.nan for x in rows])
     assert r.summary["stages"][0]["critical_points"][0]["w"] == cp["w"][0]
     # no converged step above the located maximum
-    assert np.all(r.steps["w"] <= cp["w"][0] + 1e-12)
+    # (each step an equilibrium to Newton's 1e-9 relative residual: a few of those, 5e-9)
+    assert np.all(r.steps["w"] <= cp["w"][0] * (1 + 5e-9))
     fr = r.fronts
     assert list(fr) == ["row", "stage", "step", "w", "volume", "front", "z_ref"]
     # the type stub has both
