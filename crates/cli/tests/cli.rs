@@ -3,7 +3,7 @@
 //! Reference values come from the paper's explicit formulas (eq. 68), not from the binary.
 
 use serde_json::Value;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn tubemem(args: &[&str]) -> Output {
@@ -1179,6 +1179,32 @@ fn nonsense_is_refused_and_small_targets_work() {
     }
 }
 
+/// Start `tubemem run CASE --out OUT` and kill it (SIGKILL) once its steps.csv satisfies `done`
+/// (or after 60 s); a run that finished meanwhile has nothing to kill.
+fn run_and_kill(case: &Path, out: &Path, done: impl Fn(&str) -> bool) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    loop {
+        let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap_or_default();
+        if done(&steps) || t0.elapsed().as_secs() > 60 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let _ = child.kill();
+    child.wait().unwrap();
+}
+
 /// Restart: a run killed (SIGKILL) in the middle of its squeeze and resumed with `--resume`
 /// ends bit-identical to an uninterrupted run (steps.csv, summary.json, the PVD index and every
 /// VTU frame); before it is resumed, the folder is refused as "killed"; a changed case file is
@@ -1194,30 +1220,10 @@ fn a_killed_run_resumes_bit_identical() {
     .unwrap();
     let (reference, killed) = (d.join("ref"), d.join("killed"));
     assert!(run_in(&case, &reference, &[]).status.success());
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            killed.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
     // kill it after its second squeeze step
-    let t0 = std::time::Instant::now();
-    loop {
-        let squeeze_rows = std::fs::read_to_string(killed.join("steps.csv"))
-            .map(|t| t.lines().filter(|l| l.starts_with("2,")).count())
-            .unwrap_or(0);
-        if squeeze_rows >= 2 || t0.elapsed().as_secs() > 60 {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
+    });
     let o = run_in(&case, &killed, &[]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("was killed"));
     let changed = d.join("changed.toml");
@@ -1267,30 +1273,9 @@ fn a_killed_arc_length_run_resumes_with_its_critical_points() {
     .unwrap();
     let (reference, killed) = (d.join("ref"), d.join("killed"));
     assert!(run_in(&case, &reference, &[]).status.success());
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            killed.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let t0 = std::time::Instant::now();
-    loop {
-        let rows = std::fs::read_to_string(killed.join("steps.csv"))
-            .map(|t| t.lines().count().saturating_sub(1))
-            .unwrap_or(0);
-        if rows >= 10 || t0.elapsed().as_secs() > 60 {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(1));
-    }
-    // (a run that finished meanwhile has nothing to kill)
-    let _ = child.kill();
-    child.wait().unwrap();
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().count().saturating_sub(1) >= 10
+    });
     let o = run_in(&case, &killed, &["--resume"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let read = |dir: &std::path::Path| -> serde_json::Value {
