@@ -12,6 +12,19 @@ use tubemem_app::run::run;
 const SMALL: &str = include_str!("../../../cases/small_abb30_ls1.2.toml");
 const SQUEEZE: &str = "\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.0\nsteps = 4\n";
 
+/// The fields of column `name` of a CSV text, row by row (without the header).
+fn column<'a>(csv: &'a str, name: &str) -> Vec<&'a str> {
+    let col = csv
+        .lines()
+        .next()
+        .and_then(|h| h.split(',').position(|c| c == name))
+        .unwrap_or_else(|| panic!("no column {name}"));
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap_or(""))
+        .collect()
+}
+
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("tubemem-app-test-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -425,20 +438,13 @@ fn an_arc_length_stage_reports_its_critical_points_in_every_output() {
     assert_eq!((row[0], row[1], row[2]), (1.0, c.step as f64, 1.0));
     assert_eq!(row[5], c.midspan.w);
     let steps_csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
-    let col = steps_csv
-        .lines()
-        .next()
-        .unwrap()
-        .split(',')
-        .position(|h| h == "critical")
-        .unwrap();
-    let marked: Vec<&str> = steps_csv
-        .lines()
-        .skip(1)
-        .filter(|l| l.split(',').nth(col) == Some("1"))
+    let critical = column(&steps_csv, "critical");
+    let marked: Vec<usize> = (0..critical.len())
+        .filter(|&k| critical[k] == "1")
         .collect();
     assert_eq!(marked.len(), 1, "{steps_csv}");
-    assert!(marked[0].starts_with(&format!("1,{},", c.step)));
+    assert_eq!(column(&steps_csv, "stage")[marked[0]], "1");
+    assert_eq!(column(&steps_csv, "step")[marked[0]], c.step.to_string());
     // the small tube (L/R = 8) at λs* = 2 has bulged: its end is not uniform
     assert!(!s.gps_applicable, "{:?}", s.nonuniformity);
 }
@@ -541,18 +547,7 @@ fn a_target_past_the_maximum_marks_gps_not_applicable() {
     assert_eq!(on_disk["stages"][0]["gps_applicable"], false);
     // steps.csv: applicable while the tube is still uniform, not once it has bulged
     let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
-    let col = csv
-        .lines()
-        .next()
-        .unwrap()
-        .split(',')
-        .position(|h| h == "gps_applicable")
-        .unwrap();
-    let flags: Vec<&str> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(col).unwrap())
-        .collect();
+    let flags = column(&csv, "gps_applicable");
     assert_eq!(flags[0], "1", "{csv}");
     assert_eq!(*flags.last().unwrap(), "0");
     // the inflation's last step has the flag of its summary
