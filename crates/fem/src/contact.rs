@@ -1,5 +1,5 @@
 //! Frictionless penalty contact with rigid planes, integrated at the Gauss points of the
-//! membrane elements (reference-area weights). [`Contact`] is the one owner of the planes and
+//! membrane elements (reference-area weights; any element, N nodes). [`Contact`] is the one owner of the planes and
 //! the penalty: the assembly, the outputs and the closed-form comparison all read them from it.
 //!
 //! ```text
@@ -13,8 +13,8 @@
 //! chosen from the pressure, the area stretch and a stated penetration tolerance
 //! ([`penalty_for`]).
 
-use crate::element::{Matrix12, Vector12};
 use crate::geometry::{RefElement, Vec3};
+use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
 /// A rigid plane {x : normal·x = offset}; `normal` is a unit vector pointing to the side where
@@ -79,12 +79,12 @@ impl Contact {
     }
 
     /// Add the contact energy, residual and (if asked) stiffness of one element.
-    pub fn kernel(
+    pub fn kernel<const N: usize, const D: usize>(
         &self,
-        re: &RefElement,
-        xe: &[Vec3; 4],
-        r: &mut Vector12,
-        mut k: Option<&mut Matrix12>,
+        re: &RefElement<N>,
+        xe: &[Vec3; N],
+        r: &mut SVector<f64, D>,
+        mut k: Option<&mut SMatrix<f64, D, D>>,
     ) -> f64 {
         let mut energy = 0.0;
         for (g, gp) in re.gauss.iter().enumerate() {
@@ -98,7 +98,7 @@ impl Contact {
                 let w = gp.w * self.penalty;
                 energy += 0.5 * w * gap * gap;
                 // u = ∂g/∂x_e: u[3a + i] = N_a n_i, so r += w g u and K += w u uᵀ (rank one)
-                let u = Vector12::from_fn(|row, _| n[row / 3] * plane.normal[row % 3]);
+                let u = SVector::<f64, D>::from_fn(|row, _| n[row / 3] * plane.normal[row % 3]);
                 r.axpy(w * gap, &u, 1.0);
                 if let Some(k) = k.as_deref_mut() {
                     k.ger(w, &u, &u, 1.0);
@@ -109,13 +109,14 @@ impl Contact {
     }
 
     /// Mean contact pressure per current area of an element (for output).
-    pub fn element_pressure(&self, re: &RefElement, xe: &[Vec3; 4]) -> f64 {
+    pub fn element_pressure<const N: usize>(&self, re: &RefElement<N>, xe: &[Vec3; N]) -> f64 {
         let mut s = 0.0;
-        for g in 0..4 {
+        let share = 1.0 / re.gauss.len() as f64;
+        for g in 0..re.gauss.len() {
             let p = re.position(g, xe);
             let da = re.area_ratio(g, xe);
             for pl in &self.planes {
-                s += 0.25 * self.traction(pl.gap_at(&p)) / da;
+                s += share * self.traction(pl.gap_at(&p)) / da;
             }
         }
         s

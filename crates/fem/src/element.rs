@@ -1,4 +1,5 @@
-//! The 4-node membrane kernel (bilinear, 2×2 Gauss, finite strain, any law).
+//! The membrane kernel of the 4- and 9-node elements (finite strain, any law; N nodes, D = 3N
+//! element dofs, both compile-time constants).
 //!
 //! ```text
 //! C_ij = f_i·f_j,  (W, S, ℂ) = law(C)  (per unit μH; f_i from [`crate::geometry`])
@@ -8,9 +9,9 @@
 //! ```
 
 use crate::geometry::{RefElement, Vec3};
-use nalgebra::{Matrix2, Matrix3};
+use nalgebra::{Matrix2, Matrix3, SMatrix, SVector};
 use tubemem_material::{MaterialError, MembraneLaw};
-pub use tubemem_mesh::volume::{Matrix12, Vector12};
+pub use tubemem_mesh::volume::{Matrix12, Matrix27, Vector12, Vector27};
 
 /// The right Cauchy–Green components (C11, C22, C12) of the gradient columns f_1, f_2.
 pub fn cauchy_green(f: &[Vec3; 2]) -> [f64; 3] {
@@ -19,13 +20,14 @@ pub fn cauchy_green(f: &[Vec3; 2]) -> [f64; 3] {
 
 /// Add the energy (per μH), residual r and, if asked, stiffness K of one element.
 /// On failure returns the Gauss point and the material error.
-pub fn membrane_kernel(
+pub fn membrane_kernel<const N: usize, const D: usize>(
     law: &dyn MembraneLaw,
-    re: &RefElement,
-    xe: &[Vec3; 4],
-    r: &mut Vector12,
-    mut k: Option<&mut Matrix12>,
+    re: &RefElement<N>,
+    xe: &[Vec3; N],
+    r: &mut SVector<f64, D>,
+    mut k: Option<&mut SMatrix<f64, D, D>>,
 ) -> Result<f64, (usize, MaterialError)> {
+    const { assert!(D == 3 * N) };
     let mut energy = 0.0;
     for (g, gp) in re.gauss.iter().enumerate() {
         let f = re.gradient(g, xe);
@@ -34,7 +36,7 @@ pub fn membrane_kernel(
         energy += w * st.w;
         let s = Matrix2::new(st.s[0], st.s[2], st.s[2], st.s[1]);
         let dn = &gp.dn;
-        for a in 0..4 {
+        for a in 0..N {
             for i in 0..2 {
                 for j in 0..2 {
                     let coef = w * s[(i, j)] * dn[a][i];
@@ -44,7 +46,7 @@ pub fn membrane_kernel(
             }
         }
         if let Some(k) = k.as_deref_mut() {
-            let b: [Matrix3<f64>; 4] = std::array::from_fn(|a| {
+            let b: [Matrix3<f64>; N] = std::array::from_fn(|a| {
                 Matrix3::from_rows(&[
                     (f[0] * dn[a][0]).transpose(),
                     (f[1] * dn[a][1]).transpose(),
@@ -52,9 +54,9 @@ pub fn membrane_kernel(
                 ])
             });
             let d = Matrix3::from_fn(|p, q| st.tangent[p][q]);
-            for a in 0..4 {
+            for a in 0..N {
                 let db = d * b[a];
-                for bb in 0..4 {
+                for bb in 0..N {
                     let mut geo = 0.0;
                     for i in 0..2 {
                         let mut row = 0.0;
@@ -84,14 +86,18 @@ pub struct PointState {
     pub principal: [f64; 2],
 }
 
-pub fn point_state(
+pub fn point_state<const N: usize>(
     law: &dyn MembraneLaw,
-    re: &RefElement,
+    re: &RefElement<N>,
     g: usize,
-    xe: &[Vec3; 4],
+    xe: &[Vec3; N],
 ) -> Result<PointState, MaterialError> {
-    let f = re.gradient(g, xe);
-    let c = cauchy_green(&f);
+    point_state_of(law, &re.gradient(g, xe))
+}
+
+/// [`point_state`] from the gradient columns f_1, f_2.
+pub fn point_state_of(law: &dyn MembraneLaw, f: &[Vec3; 2]) -> Result<PointState, MaterialError> {
+    let c = cauchy_green(f);
     let st = law.stress_tangent(c)?;
     let (tr, det) = (c[0] + c[1], c[0] * c[1] - c[2] * c[2]);
     let disc = (0.25 * tr * tr - det).max(0.0).sqrt();

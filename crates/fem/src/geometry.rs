@@ -1,4 +1,5 @@
-//! Gauss-point geometry of the 4-node element: the one owner of shape-function values, reference
+//! Gauss-point geometry of the membrane elements (4-node bilinear, 9-node biquadratic; N the
+//! node count, a const parameter so that each element's arrays are sized at compile time): the one owner of shape-function values, reference
 //! derivatives, area weights, the local reference frame, and of the current position, in-plane
 //! deformation gradient and area ratio at a Gauss point.
 //!
@@ -18,41 +19,52 @@
 
 use crate::FemError;
 use nalgebra::{Matrix2, Vector3};
-use tubemem_mesh::{shape, GAUSS2};
+use tubemem_mesh::shape::{full_rule, shape_n};
 
 /// A 3-vector.
 pub type Vec3 = Vector3<f64>;
 
 /// Reference data at one Gauss point.
 #[derive(Clone, Debug)]
-pub struct GaussPoint {
+pub struct GaussPoint<const N: usize> {
     /// shape-function values N_a
-    pub n: [f64; 4],
+    pub n: [f64; N],
     /// ∂N_a/∂X_i in the local orthonormal reference frame
-    pub dn: [[f64; 2]; 4],
-    /// reference area weight dA0
+    pub dn: [[f64; 2]; N],
+    /// reference area weight dA0 (the rule's weight times det J)
     pub w: f64,
     /// the local orthonormal reference frame (e1, e2)
     pub frame: [Vec3; 2],
 }
 
-/// Reference data of one element at its four Gauss points.
+/// Reference data of one element at its Gauss points.
 #[derive(Clone, Debug)]
-pub struct RefElement {
-    pub nodes: [usize; 4],
-    pub gauss: [GaussPoint; 4],
+pub struct RefElement<const N: usize = 4> {
+    pub nodes: [usize; N],
+    pub gauss: Box<[GaussPoint<N>]>,
 }
 
-impl RefElement {
-    /// The reference geometry of element `id` with nodes `nodes` at reference positions `x`.
-    pub fn new(id: usize, nodes: [usize; 4], x: &[[f64; 3]; 4]) -> Result<Self, FemError> {
+impl<const N: usize> RefElement<N> {
+    /// The reference geometry of element `id` with nodes `nodes` at reference positions `x`,
+    /// with the element's full rule (2 × 2 for N = 4, 3 × 3 for N = 9).
+    pub fn new(id: usize, nodes: [usize; N], x: &[[f64; 3]; N]) -> Result<Self, FemError> {
+        Self::with_rule(id, nodes, x, full_rule::<N>())
+    }
+
+    /// [`RefElement::new`] with the quadrature rule `rule` of (ξ, η, weight) points.
+    pub fn with_rule(
+        id: usize,
+        nodes: [usize; N],
+        x: &[[f64; 3]; N],
+        rule: &[(f64, f64, f64)],
+    ) -> Result<Self, FemError> {
         let xv = x.map(Vec3::from);
-        let mut gauss = Vec::with_capacity(4);
-        for (g, &(xi, eta)) in GAUSS2.iter().enumerate() {
-            let (n, d) = shape(xi, eta);
+        let mut gauss = Vec::with_capacity(rule.len());
+        for (g, &(xi, eta, weight)) in rule.iter().enumerate() {
+            let (n, d) = shape_n::<N>(xi, eta);
             let mut g1 = Vec3::zeros();
             let mut g2 = Vec3::zeros();
-            for a in 0..4 {
+            for a in 0..N {
                 g1 += xv[a] * d[a][0];
                 g2 += xv[a] * d[a][1];
             }
@@ -75,8 +87,8 @@ impl RefElement {
                 -j[(1, 0)] / det,
                 j[(0, 0)] / det,
             );
-            let mut dn = [[0.0; 2]; 4];
-            for a in 0..4 {
+            let mut dn = [[0.0; 2]; N];
+            for a in 0..N {
                 for i in 0..2 {
                     dn[a][i] = d[a][0] * inv[(0, i)] + d[a][1] * inv[(1, i)];
                 }
@@ -84,44 +96,38 @@ impl RefElement {
             gauss.push(GaussPoint {
                 n,
                 dn,
-                w: det,
+                // the 2 × 2 rule's weights are 1: det * 1 is det, bit for bit
+                w: det * weight,
                 frame: [e1, e2],
             });
         }
-        let gauss: [GaussPoint; 4] = gauss.try_into().map_err(|_| FemError::DegenerateElement {
-            element: id,
-            gauss_point: 0,
-        })?;
-        Ok(Self { nodes, gauss })
+        Ok(Self {
+            nodes,
+            gauss: gauss.into_boxed_slice(),
+        })
     }
 
     /// The element's nodal positions taken from the global array `x`.
     #[inline]
-    pub fn gather(&self, x: &[[f64; 3]]) -> [Vec3; 4] {
-        let n = &self.nodes;
-        [
-            Vec3::from(x[n[0]]),
-            Vec3::from(x[n[1]]),
-            Vec3::from(x[n[2]]),
-            Vec3::from(x[n[3]]),
-        ]
+    pub fn gather(&self, x: &[[f64; 3]]) -> [Vec3; N] {
+        self.nodes.map(|i| Vec3::from(x[i]))
     }
 
     /// x at Gauss point `g`.
-    pub fn position(&self, g: usize, xe: &[Vec3; 4]) -> Vec3 {
+    pub fn position(&self, g: usize, xe: &[Vec3; N]) -> Vec3 {
         let n = &self.gauss[g].n;
         let mut p = Vec3::zeros();
-        for a in 0..4 {
+        for a in 0..N {
             p += xe[a] * n[a];
         }
         p
     }
 
     /// The in-plane deformation gradient columns f_1, f_2 at Gauss point `g`.
-    pub fn gradient(&self, g: usize, xe: &[Vec3; 4]) -> [Vec3; 2] {
+    pub fn gradient(&self, g: usize, xe: &[Vec3; N]) -> [Vec3; 2] {
         let dn = &self.gauss[g].dn;
         let mut f = [Vec3::zeros(); 2];
-        for a in 0..4 {
+        for a in 0..N {
             for i in 0..2 {
                 f[i] += xe[a] * dn[a][i];
             }
@@ -130,7 +136,7 @@ impl RefElement {
     }
 
     /// The area ratio J = da/dA0 = |f_1 × f_2| at Gauss point `g`.
-    pub fn area_ratio(&self, g: usize, xe: &[Vec3; 4]) -> f64 {
+    pub fn area_ratio(&self, g: usize, xe: &[Vec3; N]) -> f64 {
         let f = self.gradient(g, xe);
         f[0].cross(&f[1]).norm()
     }

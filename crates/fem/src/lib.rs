@@ -40,6 +40,8 @@ pub use newton::NewtonSettings;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_quad9;
 
 use thiserror::Error;
 use tubemem_material::MaterialError;

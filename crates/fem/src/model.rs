@@ -20,16 +20,17 @@
 
 use crate::contact::Contact;
 use crate::dofs::DofMap;
-use crate::element::{membrane_kernel, Matrix12, Vector12};
+use crate::element::membrane_kernel;
 use crate::geometry::{RefElement, Vec3};
 use crate::linsolve::SparseLdlt;
 use crate::newton::{self, Evaluation, Inertia, Linearization, NewtonError, NewtonSettings};
 use crate::pattern::Pattern;
 use crate::FemError;
+use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 use tubemem_material::MembraneLaw;
-use tubemem_mesh::volume::volume_kernel;
-use tubemem_mesh::Mesh;
+use tubemem_mesh::volume::volume_kernel_n;
+use tubemem_mesh::{ElementKind, Mesh};
 
 /// How the enclosed gas is loaded.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,59 +89,92 @@ pub struct State {
     pub p: f64,
 }
 
-/// One element's contribution to the energy, the residual and the tangent.
-pub trait Term: Sync {
-    /// Add the energy (returned), residual and, if asked, the stiffness of element `e`.
-    fn add(
-        &self,
-        e: usize,
-        el: &RefElement,
-        xe: &[Vec3; 4],
-        r: &mut Vector12,
-        k: Option<&mut Matrix12>,
-    ) -> Result<f64, FemError>;
+/// The reference elements of a model: all 4-node or all 9-node.
+#[derive(Clone, Debug)]
+pub enum Elements {
+    Quad4(Vec<RefElement<4>>),
+    Quad9(Vec<RefElement<9>>),
 }
 
-/// The hyperelastic membrane ([`crate::element`]).
-pub struct MembraneTerm<'a>(pub &'a dyn MembraneLaw);
+/// Run `$body` with `$v` bound to the element vector of either kind (the body is compiled once
+/// per kind, so generic kernels are monomorphized for both).
+#[macro_export]
+macro_rules! with_elements {
+    ($els:expr, $v:ident => $body:expr) => {
+        match $els {
+            $crate::model::Elements::Quad4($v) => $body,
+            $crate::model::Elements::Quad9($v) => $body,
+        }
+    };
+}
 
-impl Term for MembraneTerm<'_> {
-    fn add(
-        &self,
-        e: usize,
-        el: &RefElement,
-        xe: &[Vec3; 4],
-        r: &mut Vector12,
-        k: Option<&mut Matrix12>,
-    ) -> Result<f64, FemError> {
-        membrane_kernel(self.0, el, xe, r, k).map_err(|(gp, source)| FemError::Material {
-            element: e,
-            gauss_point: gp,
-            source,
-        })
+impl Elements {
+    pub fn len(&self) -> usize {
+        with_elements!(self, v => v.len())
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// The nodes of element `e` (4 or 9).
+    pub fn nodes(&self, e: usize) -> &[usize] {
+        with_elements!(self, v => &v[e].nodes[..])
+    }
+    /// The corner nodes of element `e`.
+    pub fn corners(&self, e: usize) -> [usize; 4] {
+        let n = self.nodes(e);
+        [n[0], n[1], n[2], n[3]]
+    }
+    /// The number of Gauss points of element `e`.
+    pub fn gauss_points(&self, e: usize) -> usize {
+        with_elements!(self, v => v[e].gauss.len())
+    }
+    pub fn kind(&self) -> ElementKind {
+        match self {
+            Elements::Quad4(_) => ElementKind::Quad4,
+            Elements::Quad9(_) => ElementKind::Quad9,
+        }
     }
 }
 
-/// Penalty contact with rigid planes ([`crate::contact`]).
-impl Term for Contact {
-    fn add(
+/// What one element contributes besides the enclosed volume: the hyperelastic membrane
+/// ([`crate::element`]) and, if any, penalty contact with rigid planes ([`crate::contact`]).
+#[derive(Clone, Copy)]
+struct Terms<'a> {
+    law: &'a dyn MembraneLaw,
+    contact: Option<&'a Contact>,
+}
+
+impl Terms<'_> {
+    /// Add the energy (returned), residual and, if asked, the stiffness of element `e`.
+    fn add<const N: usize, const D: usize>(
         &self,
-        _e: usize,
-        el: &RefElement,
-        xe: &[Vec3; 4],
-        r: &mut Vector12,
-        k: Option<&mut Matrix12>,
+        e: usize,
+        el: &RefElement<N>,
+        xe: &[Vec3; N],
+        r: &mut SVector<f64, D>,
+        mut k: Option<&mut SMatrix<f64, D, D>>,
     ) -> Result<f64, FemError> {
-        Ok(self.kernel(el, xe, r, k))
+        let mut energy =
+            membrane_kernel(self.law, el, xe, r, k.as_deref_mut()).map_err(|(gp, source)| {
+                FemError::Material {
+                    element: e,
+                    gauss_point: gp,
+                    source,
+                }
+            })?;
+        if let Some(c) = self.contact {
+            energy += c.kernel(el, xe, r, k);
+        }
+        Ok(energy)
     }
 }
 
 /// One element's energy, residual, volume and volume gradient.
-struct Local {
+struct Local<const D: usize> {
     energy: f64,
-    r: Vector12,
+    r: SVector<f64, D>,
     v: f64,
-    g: Vector12,
+    g: SVector<f64, D>,
 }
 
 /// Global quantities at a configuration.
@@ -163,7 +197,7 @@ pub struct Model {
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     mesh: Mesh,
     law: Box<dyn MembraneLaw>,
-    elements: Vec<RefElement>,
+    elements: Elements,
     dofs: DofMap,
     pattern: Pattern,
     ldlt: SparseLdlt,
@@ -176,13 +210,24 @@ impl Model {
     pub fn new(mesh: Mesh, law: Box<dyn MembraneLaw>) -> Result<Self, FemError> {
         mesh.check()?;
         let dofs = DofMap::new(&mesh);
-        let elements = mesh
-            .quads
-            .iter()
-            .enumerate()
-            .map(|(e, q)| RefElement::new(e, *q, &q.map(|i| mesh.nodes[i])))
-            .collect::<Result<Vec<_>, _>>()?;
-        let pattern = Pattern::new(&dofs, &elements);
+        let elements = match mesh.element() {
+            ElementKind::Quad4 => Elements::Quad4(
+                mesh.quads
+                    .iter()
+                    .enumerate()
+                    .map(|(e, q)| RefElement::new(e, *q, &q.map(|i| mesh.nodes[i])))
+                    .collect::<Result<Vec<_>, _>>()?,
+            ),
+            ElementKind::Quad9 => Elements::Quad9(
+                (0..mesh.quads.len())
+                    .map(|e| {
+                        let q = mesh.nodes9(e);
+                        RefElement::new(e, q, &q.map(|i| mesh.nodes[i]))
+                    })
+                    .collect::<Result<Vec<_>, _>>()?,
+            ),
+        };
+        let pattern = Pattern::new(&dofs, (0..elements.len()).map(|e| elements.nodes(e)));
         if let Some(k) = pattern.diagonal().iter().position(|&d| d == usize::MAX) {
             let node = (0..mesh.nodes.len())
                 .find(|&i| (0..3).any(|c| dofs.eq(i, c) == Some(k)))
@@ -219,7 +264,7 @@ impl Model {
     pub fn law(&self) -> &dyn MembraneLaw {
         self.law.as_ref()
     }
-    pub fn elements(&self) -> &[RefElement] {
+    pub fn elements(&self) -> &Elements {
         &self.elements
     }
     pub fn dofs(&self) -> &DofMap {
@@ -268,22 +313,25 @@ impl Model {
         tangent: bool,
         contact: Option<&Contact>,
     ) -> Result<Assembled, FemError> {
-        let membrane = MembraneTerm(self.law.as_ref());
-        let mut terms: Vec<&dyn Term> = vec![&membrane];
-        if let Some(c) = contact {
-            terms.push(c);
+        let terms = Terms {
+            law: self.law.as_ref(),
+            contact,
+        };
+        match &self.elements {
+            Elements::Quad4(els) => self.assemble_with::<4, 12>(els, x, tangent, terms),
+            Elements::Quad9(els) => self.assemble_with::<9, 27>(els, x, tangent, terms),
         }
-        self.assemble_terms(x, tangent, &terms)
     }
 
-    /// [`Model::assemble`] for any list of terms (plus the enclosed volume, always).
-    pub fn assemble_terms(
+    /// [`Model::assemble`] for elements of N nodes (D = 3N dofs).
+    fn assemble_with<const N: usize, const D: usize>(
         &self,
+        elements: &[RefElement<N>],
         x: &[[f64; 3]],
         tangent: bool,
-        terms: &[&dyn Term],
+        terms: Terms<'_>,
     ) -> Result<Assembled, FemError> {
-        // Each element writes its 12 × 12 entries straight into its own contiguous range of
+        // Each element writes its D × D entries straight into its own contiguous range of
         // the value arrays (the pattern lists entries element by element); the vectors and
         // scalars come back per element and are summed in element order. No element matrix is
         // stored, and the result does not depend on the number of threads.
@@ -292,10 +340,10 @@ impl Model {
         } else {
             (Vec::new(), Vec::new())
         };
-        let mut slices: Vec<(&mut [f64], &mut [f64])> = Vec::with_capacity(self.elements.len());
+        let mut slices: Vec<(&mut [f64], &mut [f64])> = Vec::with_capacity(elements.len());
         if tangent {
             let (mut ki, mut kv) = (k_int.as_mut_slice(), k_vol.as_mut_slice());
-            for e in 0..self.elements.len() {
+            for e in 0..elements.len() {
                 let n = self.pattern.element_entries(e).len();
                 let (a, rest_i) = ki.split_at_mut(n);
                 let (b, rest_v) = kv.split_at_mut(n);
@@ -304,14 +352,14 @@ impl Model {
                 kv = rest_v;
             }
         }
-        let locals: Vec<Result<Local, FemError>> = if tangent {
-            self.elements
+        let locals: Vec<Result<Local<D>, FemError>> = if tangent {
+            elements
                 .par_iter()
                 .zip(slices.par_iter_mut())
                 .enumerate()
                 .map(|(e, (el, (ki, kv)))| {
-                    let (mut k, mut h) = (Matrix12::zeros(), Matrix12::zeros());
-                    let l = self.element(e, el, x, terms, Some((&mut k, &mut h)))?;
+                    let (mut k, mut h) = (SMatrix::<f64, D, D>::zeros(), SMatrix::zeros());
+                    let l = Self::element(e, el, x, terms, Some((&mut k, &mut h)))?;
                     for (slot, &(i, j)) in self.pattern.element_entries(e).iter().enumerate() {
                         let (i, j) = (i as usize, j as usize);
                         ki[slot] = k[(i, j)];
@@ -321,10 +369,10 @@ impl Model {
                 })
                 .collect()
         } else {
-            self.elements
+            elements
                 .par_iter()
                 .enumerate()
-                .map(|(e, el)| self.element(e, el, x, terms, None))
+                .map(|(e, el)| Self::element(e, el, x, terms, None))
                 .collect()
         };
         drop(slices);
@@ -341,8 +389,8 @@ impl Model {
             let l = l?;
             out.energy += l.energy;
             out.volume += l.v;
-            let el = &self.elements[e];
-            for i in 0..12 {
+            let el = &elements[e];
+            for i in 0..D {
                 if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {
                     out.f_int[a] += l.r[i];
                     out.g[a] += l.g[i];
@@ -353,7 +401,12 @@ impl Model {
         // translation z_d (A is fixed, the ring being tied to the disc), so no Hessian term.
         let closed = self.mesh.symmetry.rings_closed();
         for (ring, eq) in self.mesh.plugs.iter().zip(self.dofs.plug_equations()) {
-            let face = tubemem_mesh::plug_face(x, ring, closed);
+            let face = tubemem_mesh::plug_face(
+                x,
+                ring,
+                closed,
+                self.mesh.element() == tubemem_mesh::ElementKind::Quad9,
+            );
             out.volume += face.volume();
             if let Some(k) = eq {
                 out.g[*k] += face.area * face.sign / 3.0;
@@ -364,29 +417,26 @@ impl Model {
 
     /// One element: the terms' energy and residual (and stiffness into `mats.0`), the volume,
     /// its gradient (and Hessian into `mats.1`). The matrices must come in zeroed.
-    fn element(
-        &self,
+    fn element<const N: usize, const D: usize>(
         e: usize,
-        el: &RefElement,
+        el: &RefElement<N>,
         x: &[[f64; 3]],
-        terms: &[&dyn Term],
-        mats: Option<(&mut Matrix12, &mut Matrix12)>,
-    ) -> Result<Local, FemError> {
+        terms: Terms<'_>,
+        mats: Option<(&mut SMatrix<f64, D, D>, &mut SMatrix<f64, D, D>)>,
+    ) -> Result<Local<D>, FemError> {
         let xe = el.gather(x);
         let mut l = Local {
             energy: 0.0,
-            r: Vector12::zeros(),
+            r: SVector::zeros(),
             v: 0.0,
-            g: Vector12::zeros(),
+            g: SVector::zeros(),
         };
-        let (mut k, h) = match mats {
+        let (k, h) = match mats {
             Some((k, h)) => (Some(k), Some(h)),
             None => (None, None),
         };
-        for term in terms {
-            l.energy += term.add(e, el, &xe, &mut l.r, k.as_deref_mut())?;
-        }
-        l.v = volume_kernel(&xe, Some(&mut l.g), h);
+        l.energy += terms.add(e, el, &xe, &mut l.r, k)?;
+        l.v = volume_kernel_n(&xe, Some(&mut l.g), h);
         Ok(l)
     }
 
@@ -551,12 +601,13 @@ impl Model {
         };
         let mut out = vec![0.0; self.n_eq()];
         let mut k = 0;
-        for (e, el) in self.elements.iter().enumerate() {
+        for e in 0..self.elements.len() {
+            let nodes = self.elements.nodes(e);
             for &(i, j) in self.pattern.element_entries(e) {
                 let (i, j) = (i as usize, j as usize);
                 let (Some(ra), Some(cb)) = (
-                    self.dofs.eq(el.nodes[i / 3], i % 3),
-                    self.dofs.eq(el.nodes[j / 3], j % 3),
+                    self.dofs.eq(nodes[i / 3], i % 3),
+                    self.dofs.eq(nodes[j / 3], j % 3),
                 ) else {
                     continue;
                 };
@@ -858,9 +909,9 @@ impl Model {
     pub fn locking_proximity(&self, x: &[[f64; 3]]) -> Option<LockingProximity> {
         let limit = self.law.locking_limit()?;
         let mut best: Option<LockingProximity> = None;
-        for (e, el) in self.elements.iter().enumerate() {
+        with_elements!(&self.elements, els => for (e, el) in els.iter().enumerate() {
             let xe = el.gather(x);
-            for g in 0..4 {
+            for g in 0..el.gauss.len() {
                 let c = crate::element::cauchy_green(&el.gradient(g, &xe));
                 let det = c[0] * c[1] - c[2] * c[2];
                 let i1 = c[0] + c[1] + 1.0 / det;
@@ -873,7 +924,7 @@ impl Model {
                     });
                 }
             }
-        }
+        });
         best
     }
 }

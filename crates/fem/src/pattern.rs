@@ -1,9 +1,8 @@
 //! The sparsity pattern of the global tangent, built once per mesh: for every element, the
-//! positions of its 12 × 12 entries in the lower triangle of the global matrix (in pattern
+//! positions of its 3N × 3N entries (N = 4 or 9 nodes) in the lower triangle of the global matrix (in pattern
 //! order), and the position of every diagonal entry (for shifts).
 
 use crate::dofs::DofMap;
-use crate::geometry::RefElement;
 
 #[derive(Clone, Debug)]
 pub struct Pattern {
@@ -16,18 +15,19 @@ pub struct Pattern {
 }
 
 impl Pattern {
-    pub fn new(dofs: &DofMap, elements: &[RefElement]) -> Self {
-        let mut entries = Vec::with_capacity(elements.len());
+    /// The pattern of elements given by their node lists (in element order).
+    pub fn new<'a>(dofs: &DofMap, elements: impl IntoIterator<Item = &'a [usize]>) -> Self {
+        let mut entries = Vec::new();
         let mut pairs = Vec::new();
         let mut diag = vec![usize::MAX; dofs.len()];
-        for el in elements {
+        for nodes in elements {
             let mut list = Vec::new();
-            for i in 0..12 {
-                for j in 0..12 {
-                    if let (Some(a), Some(b)) = (
-                        dofs.eq(el.nodes[i / 3], i % 3),
-                        dofs.eq(el.nodes[j / 3], j % 3),
-                    ) {
+            let d = 3 * nodes.len();
+            for i in 0..d {
+                for j in 0..d {
+                    if let (Some(a), Some(b)) =
+                        (dofs.eq(nodes[i / 3], i % 3), dofs.eq(nodes[j / 3], j % 3))
+                    {
                         if a >= b {
                             if a == b && diag[a] == usize::MAX {
                                 diag[a] = pairs.len();

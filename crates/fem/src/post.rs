@@ -2,19 +2,24 @@
 //! it, contact values and per-element output values.
 //!
 //! ```text
-//! λs   = (current length of the mid-span ring polygon) / (its reference length)
-//!        (the discrete analogue of L_γ/L_Γ, eq. 57: no chordal bias for a uniform state)
-//! λz   = mean over the ring of |x_j − x_i| / |X_j − X_i| for the meridian edges i → j that
-//!        leave the ring (both sides where both exist): the axial stretch at ±ΔZ/2
+//! λs   = (current length of the mid-span ring) / (its reference length): the polygon through
+//!        the ring nodes for the 4-node element, the chain of parabolic arcs (corner, mid-side,
+//!        corner) of the element edges for the 9-node element (the discrete analogue of
+//!        L_γ/L_Γ, eq. 57: no chordal bias for a uniform state)
+//! λz   = mean over the ring of the stretch of the meridian edges that leave the ring (both
+//!        sides where both exist): |x_j − x_i| / |X_j − X_i| for the 4-node element (the axial
+//!        stretch at ±ΔZ/2), |x'(a)|/|X'(a)| at the ring end a of the parabolic edge a, m, b
+//!        for the 9-node element (x'(a) ∝ −3x_a + 4x_m − x_b: the axial stretch at the ring)
 //! N_s, N_z, N_sz = tᵀNt, aᵀNa, tᵀNa averaged over the Gauss points of the elements that touch
 //!        the ring, with t the current hoop tangent (image of the reference hoop direction,
 //!        made horizontal) and a the axial direction in the tangent plane
 //! ϖ    = the reduced pressure,  volume = total enclosed volume (all symmetry copies)
 //! ```
 use crate::contact::Contact;
-use crate::element::point_state;
-use crate::geometry::Vec3;
-use crate::model::{Model, State};
+use crate::element::point_state_of;
+use crate::geometry::{RefElement, Vec3};
+use crate::model::{Elements, Model, State};
+use crate::with_elements;
 use crate::FemError;
 use serde::{Deserialize, Serialize};
 pub use tubemem_material::relaxed::Regime;
@@ -35,6 +40,67 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     (Vec3::from(a) - Vec3::from(b)).norm()
 }
 
+/// One Gauss point of an element, for output: its reference area weight and frame, reference
+/// and current position, and the in-plane gradient columns f_1, f_2.
+#[derive(Clone, Copy, Debug)]
+pub struct GaussSample {
+    pub w: f64,
+    pub frame: [Vec3; 2],
+    pub x_ref: Vec3,
+    pub x: Vec3,
+    pub f: [Vec3; 2],
+}
+
+impl GaussSample {
+    /// The image F v of a vector v of the reference tangent plane.
+    pub fn push_forward(&self, v: &Vec3) -> Vec3 {
+        self.f[0] * self.frame[0].dot(v) + self.f[1] * self.frame[1].dot(v)
+    }
+    /// The area ratio J = |f_1 × f_2|.
+    pub fn area_ratio(&self) -> f64 {
+        self.f[0].cross(&self.f[1]).norm()
+    }
+}
+
+fn samples_of<const N: usize>(
+    el: &RefElement<N>,
+    x0: &[[f64; 3]],
+    x: &[[f64; 3]],
+) -> Vec<GaussSample> {
+    let (xe, xr) = (el.gather(x), el.gather(x0));
+    (0..el.gauss.len())
+        .map(|g| GaussSample {
+            w: el.gauss[g].w,
+            frame: el.gauss[g].frame,
+            x_ref: el.position(g, &xr),
+            x: el.position(g, &xe),
+            f: el.gradient(g, &xe),
+        })
+        .collect()
+}
+
+/// The Gauss points of element `e` at the nodal positions `x`.
+pub fn gauss_samples(model: &Model, e: usize, x: &[[f64; 3]]) -> Vec<GaussSample> {
+    with_elements!(model.elements(), els => samples_of(&els[e], &model.mesh().nodes, x))
+}
+
+/// The length of a chain of parabolic arcs through the points `p` (corner, mid-side, corner,
+/// mid-side, …; an odd count), each arc x(t) = Σ L_i(t) p_i on t ∈ [−1, 1], by 4-point Gauss
+/// per arc (the arcs of a uniformly scaled ring are scaled copies, so ratios of such lengths are
+/// exact whatever the rule).
+fn parabolic_length(p: &[[f64; 3]]) -> f64 {
+    let rule = tubemem_mesh::shape::gauss_1d(4).unwrap_or_default();
+    let mut len = 0.0;
+    for k in (0..p.len().saturating_sub(2)).step_by(2) {
+        let (a, m, b) = (Vec3::from(p[k]), Vec3::from(p[k + 1]), Vec3::from(p[k + 2]));
+        for &(t, w) in &rule {
+            // x'(t) = (t − ½) a − 2t m + (t + ½) b
+            len += w * (a * (t - 0.5) - m * (2.0 * t) + b * (t + 0.5)).norm();
+        }
+    }
+    len
+}
+
 /// A ring of nodes around the axis at one reference height: the one owner of ring topology.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Ring {
@@ -42,6 +108,8 @@ pub struct Ring {
     pub nodes: Vec<usize>,
     /// whether the ring goes all the way round (no symmetry plane through the axis cuts it)
     pub closed: bool,
+    /// whether the ring runs along 9-node element edges (corner, mid-side, corner, …)
+    pub quadratic: bool,
 }
 
 impl Ring {
@@ -59,6 +127,7 @@ impl Ring {
         Self {
             nodes,
             closed: mesh.symmetry.rings_closed(),
+            quadratic: model.elements().kind() == tubemem_mesh::ElementKind::Quad9,
         }
     }
 
@@ -74,13 +143,30 @@ impl Ring {
         (0..segs).map(move |k| (self.nodes[k], self.nodes[(k + 1) % n]))
     }
 
+    /// The ring's length at the nodal positions `x`: the polygon through its nodes, or for a
+    /// quadratic ring the chain of parabolic arcs of its element edges.
+    pub fn length(&self, x: &[[f64; 3]]) -> f64 {
+        if self.quadratic {
+            let mut p: Vec<[f64; 3]> = self.nodes.iter().map(|&i| x[i]).collect();
+            if self.closed {
+                if let Some(&first) = p.first() {
+                    p.push(first);
+                }
+            }
+            parabolic_length(&p)
+        } else {
+            self.segments().map(|(a, b)| dist(x[a], x[b])).sum()
+        }
+    }
+
     /// The elements with a node on the ring, in ascending order.
     pub fn touching(&self, model: &Model) -> Vec<usize> {
         let on_ring = self.contains_set();
         (0..model.elements().len())
             .filter(|&e| {
-                model.elements()[e]
-                    .nodes
+                model
+                    .elements()
+                    .nodes(e)
                     .iter()
                     .any(|i| on_ring.contains(i))
             })
@@ -106,36 +192,35 @@ pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, 
         .iter()
         .map(|&e| projected_resultants(model, state, e))
         .collect::<Result<Vec<_>, _>>()?;
+    let pr = &projected;
     ring_state_of(
         model,
         state,
         ring,
         &touching,
-        |k, _| projected[k],
+        move |k, _| pr[k].as_slice(),
         model.total_volume(&state.x),
     )
 }
 
-/// (t·Nt, a·Na, t·Na) at the four Gauss points of element `e`: the resultants projected on the
+/// (t·Nt, a·Na, t·Na) at the Gauss points of element `e`: the resultants projected on the
 /// current hoop tangent t (image of the reference hoop direction, made horizontal) and the axial
 /// direction a in the tangent plane. They do not depend on the ring, so a profile computes them
 /// once per element.
-fn projected_resultants(model: &Model, state: &State, e: usize) -> Result<[[f64; 3]; 4], FemError> {
-    let el = &model.elements()[e];
-    let xe = el.gather(&state.x);
-    let x0 = el.gather(&model.mesh().nodes);
-    let mut out = [[0.0; 3]; 4];
-    for (g, o) in out.iter_mut().enumerate() {
-        let ps = point_state(model.law(), el, g, &xe).map_err(|source| FemError::Material {
+fn projected_resultants(model: &Model, state: &State, e: usize) -> Result<Vec<[f64; 3]>, FemError> {
+    let samples = gauss_samples(model, e, &state.x);
+    let mut out = vec![[0.0; 3]; samples.len()];
+    for (g, (o, sp)) in out.iter_mut().zip(&samples).enumerate() {
+        let f = sp.f;
+        let ps = point_state_of(model.law(), &f).map_err(|source| FemError::Material {
             element: e,
             gauss_point: g,
             source,
         })?;
         // reference hoop direction at the Gauss point and its image F T
-        let xr = el.position(g, &x0);
+        let xr = sp.x_ref;
         let t_ref = Vec3::new(-xr[1], xr[0], 0.0).normalize();
-        let f = el.gradient(g, &xe);
-        let ft = el.push_forward(g, &f, &t_ref);
+        let ft = sp.push_forward(&t_ref);
         let t = Vec3::new(ft[0], ft[1], 0.0).normalize();
         let normal = f[0].cross(&f[1]).normalize();
         let ez = Vec3::z();
@@ -151,38 +236,45 @@ fn projected_resultants(model: &Model, state: &State, e: usize) -> Result<[[f64;
 
 /// [`ring_state`] given the elements that touch the ring (in ascending order), their projected
 /// resultants (`projected(k, e)` for the k-th of them, element e) and the enclosed volume.
-fn ring_state_of(
+fn ring_state_of<'p>(
     model: &Model,
     state: &State,
     ring: &Ring,
     touching: &[usize],
-    projected: impl Fn(usize, usize) -> [[f64; 3]; 4],
+    projected: impl Fn(usize, usize) -> &'p [[f64; 3]],
     volume: f64,
 ) -> Result<MidSpan, FemError> {
     let mesh = model.mesh();
-    let mut cur = 0.0;
-    let mut reference = 0.0;
-    for (a, b) in ring.segments() {
-        cur += dist(state.x[a], state.x[b]);
-        reference += dist(mesh.nodes[a], mesh.nodes[b]);
-    }
+    let cur = ring.length(&state.x);
+    let reference = ring.length(&mesh.nodes);
     let on_ring = ring.contains_set();
     let mut lz_sum = 0.0;
     let mut lz_n = 0usize;
     let (mut ns, mut nz, mut nsz, mut ng) = (0.0, 0.0, 0.0, 0usize);
+    let els = model.elements();
     for (k, &e) in touching.iter().enumerate() {
-        let el = &model.elements()[e];
-        let q = el.nodes;
+        let q = els.nodes(e);
         for j in 0..4 {
             let (a, b) = (q[j], q[(j + 1) % 4]);
-            if on_ring.contains(&a) != on_ring.contains(&b) {
-                // meridian edge: each is shared by two elements, so each is counted twice
-                lz_sum += dist(state.x[a], state.x[b]) / dist(mesh.nodes[a], mesh.nodes[b]);
-                lz_n += 1;
+            if on_ring.contains(&a) == on_ring.contains(&b) {
+                continue;
             }
+            // meridian edge: each is shared by two elements, so each is counted twice
+            lz_sum += if let Elements::Quad9(_) = els {
+                // the parabolic edge from the ring end `a` through the mid-side node `m`
+                let (a, b) = if on_ring.contains(&a) { (a, b) } else { (b, a) };
+                let m = q[4 + j];
+                let d = |x: &[[f64; 3]]| {
+                    (Vec3::from(x[a]) * -3.0 + Vec3::from(x[m]) * 4.0 - Vec3::from(x[b])).norm()
+                };
+                d(&state.x) / d(&mesh.nodes)
+            } else {
+                dist(state.x[a], state.x[b]) / dist(mesh.nodes[a], mesh.nodes[b])
+            };
+            lz_n += 1;
         }
         // summed Gauss point by Gauss point, in element order (as before the split)
-        for [s, z, sz] in projected(k, e) {
+        for &[s, z, sz] in projected(k, e) {
             ns += s;
             nz += z;
             nsz += sz;
@@ -201,7 +293,7 @@ fn ring_state_of(
     })
 }
 
-/// Per-element output values (averaged over the four Gauss points).
+/// Per-element output values (averaged over the Gauss points).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CellValues {
     /// stretch along the reference hoop direction (horizontal tangent)
@@ -240,24 +332,20 @@ pub fn regime_code(r: Regime) -> f64 {
 
 /// Element values for output (VTU cell data).
 pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemError> {
-    let mesh = model.mesh();
-    model
-        .elements()
-        .iter()
-        .enumerate()
-        .map(|(e, el)| {
-            let xe = el.gather(&state.x);
-            let x0 = el.gather(&mesh.nodes);
+    (0..model.elements().len())
+        .map(|e| {
+            let samples = gauss_samples(model, e, &state.x);
+            let share = 1.0 / samples.len() as f64;
             let mut c = CellValues::default();
-            for g in 0..4 {
+            for (g, sp) in samples.iter().enumerate() {
                 let ps =
-                    point_state(model.law(), el, g, &xe).map_err(|source| FemError::Material {
+                    point_state_of(model.law(), &sp.f).map_err(|source| FemError::Material {
                         element: e,
                         gauss_point: g,
                         source,
                     })?;
-                let xr = el.position(g, &x0);
-                let [e1, e2] = el.gauss[g].frame;
+                let xr = sp.x_ref;
+                let [e1, e2] = sp.frame;
                 let normal = e1.cross(&e2);
                 let horizontal = Vec3::new(-xr[1], xr[0], 0.0);
                 let t = if horizontal.dot(&horizontal) > 1e-20 {
@@ -268,11 +356,10 @@ pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemE
                 // project onto the reference tangent plane
                 let t = (t - normal * t.dot(&normal)).normalize();
                 let m = normal.cross(&t);
-                let f = el.gradient(g, &xe);
-                c.hoop_stretch += 0.25 * el.push_forward(g, &f, &t).norm();
-                c.axial_stretch += 0.25 * el.push_forward(g, &f, &m).norm();
-                c.n1 += 0.25 * ps.principal[0];
-                c.n2 += 0.25 * ps.principal[1];
+                c.hoop_stretch += share * sp.push_forward(&t).norm();
+                c.axial_stretch += share * sp.push_forward(&m).norm();
+                c.n1 += share * ps.principal[0];
+                c.n2 += share * ps.principal[1];
             }
             Ok(c)
         })
@@ -315,11 +402,20 @@ pub fn ring_profile(
         .iter()
         .map(|p| p[0].hypot(p[1]))
         .fold(0.0, f64::max);
+    // rings at element boundaries: the heights of corner nodes (every node of a 4-node mesh;
+    // the interior rows of 9-node elements are not rings of element edges)
+    let mut corner = vec![false; mesh.nodes.len()];
+    for q in &mesh.quads {
+        for &i in q {
+            corner[i] = true;
+        }
+    }
     let mut heights: Vec<f64> = mesh
         .nodes
         .iter()
-        .filter(|p| (p[0].hypot(p[1]) - radius).abs() <= 1e-9 * radius)
-        .map(|p| p[2])
+        .zip(&corner)
+        .filter(|(p, &c)| c && (p[0].hypot(p[1]) - radius).abs() <= 1e-9 * radius)
+        .map(|(p, _)| p[2])
         .collect();
     heights.sort_by(f64::total_cmp);
     heights.dedup_by(|a, b| (*a - *b).abs() <= tol);
@@ -337,8 +433,13 @@ pub fn ring_profile(
         }
     }
     let mut touching: Vec<Vec<usize>> = vec![vec![]; heights.len()];
-    for (e, el) in model.elements().iter().enumerate() {
-        let mut rings: Vec<usize> = el.nodes.iter().filter_map(|&i| node_ring[i]).collect();
+    for e in 0..model.elements().len() {
+        let mut rings: Vec<usize> = model
+            .elements()
+            .nodes(e)
+            .iter()
+            .filter_map(|&i| node_ring[i])
+            .collect();
         rings.sort_unstable();
         rings.dedup();
         for k in rings {
@@ -360,10 +461,9 @@ pub fn ring_profile(
     let forces: Vec<f64> = match (contact, half_gap) {
         (Some(c), Some(h)) => {
             use rayon::prelude::*;
-            model
-                .elements()
-                .par_iter()
-                .map(|el| element_contact_force(el, &el.gather(&state.x), c, h))
+            (0..model.elements().len())
+                .into_par_iter()
+                .map(|e| element_contact_force(&gauss_samples(model, e, &state.x), c, h))
                 .collect()
         }
         _ => vec![],
@@ -380,6 +480,7 @@ pub fn ring_profile(
             let ring = Ring {
                 nodes: ring_nodes,
                 closed,
+                quadratic: model.elements().kind() == tubemem_mesh::ElementKind::Quad9,
             };
             let n = ring.nodes.len() as f64;
             Ok(RingValues {
@@ -391,7 +492,14 @@ pub fn ring_profile(
                     .map(|&i| state.x[i][0].hypot(state.x[i][1]))
                     .sum::<f64>()
                     / n,
-                values: ring_state_of(model, state, &ring, touching, |_, e| projected[e], volume)?,
+                values: ring_state_of(
+                    model,
+                    state,
+                    &ring,
+                    touching,
+                    |_, e| projected[e].as_slice(),
+                    volume,
+                )?,
                 contact_width: half_gap.map_or(0.0, |h| contact_width(model, state, &ring, h)),
                 contact_force: if forces.is_empty() {
                     0.0
@@ -483,15 +591,15 @@ fn ring_force_per_length(
     let mut side_force = [0.0; 2];
     let mut side_extent = [(0.0, 0usize); 2];
     for e in touching {
-        let el = &model.elements()[e];
-        let zc = el.nodes.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0;
+        let q = model.elements().corners(e);
+        let zc = q.iter().map(|&i| mesh.nodes[i][2]).sum::<f64>() / 4.0;
         let side = usize::from(zc < z_ring);
         side_force[side] += fe(e);
-        // axial extent: mean |Δz| of the element's meridian edges (one end on the ring)
+        // axial extent: mean |Δz| of the element's meridian edges (one corner on the ring)
         let mut ext = 0.0;
         let mut m = 0;
         for k in 0..4 {
-            let (a, b) = (el.nodes[k], el.nodes[(k + 1) % 4]);
+            let (a, b) = (q[k], q[(k + 1) % 4]);
             if on_ring.contains(&a) != on_ring.contains(&b) {
                 ext += (state.x[a][2] - state.x[b][2]).abs();
                 m += 1;
@@ -543,16 +651,13 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
         .map(|plane| {
             let c = penetrated_length(state, &ring, |p| plane.gap(p));
             let mut penetration = 0.0f64;
-            let forces: Vec<f64> = model
-                .elements()
-                .iter()
-                .map(|el| {
-                    let xe = el.gather(&state.x);
+            let forces: Vec<f64> = (0..model.elements().len())
+                .map(|e| {
                     let mut fe = 0.0;
-                    for g in 0..4 {
-                        let gap = plane.gap(el.position(g, &xe).into());
+                    for sp in gauss_samples(model, e, &state.x) {
+                        let gap = plane.gap(sp.x.into());
                         if gap < 0.0 {
-                            fe += el.gauss[g].w * contact.traction(gap);
+                            fe += sp.w * contact.traction(gap);
                             penetration = penetration.max(-gap);
                         }
                     }
@@ -591,19 +696,14 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
         .collect()
 }
 
-/// The contact force of one element against the plate y = h: Σ_g w_g t(gap_g) over its Gauss
-/// points in contact.
-fn element_contact_force(
-    el: &crate::geometry::RefElement,
-    xe: &[Vec3; 4],
-    contact: &Contact,
-    h: f64,
-) -> f64 {
+/// The contact force of one element (its Gauss points `samples`) against the plate y = h:
+/// Σ_g w_g t(gap_g) over its Gauss points in contact.
+fn element_contact_force(samples: &[GaussSample], contact: &Contact, h: f64) -> f64 {
     let mut fe = 0.0;
-    for g in 0..4 {
-        let gp_gap = h - el.position(g, xe)[1];
+    for sp in samples {
+        let gp_gap = h - sp.x[1];
         if gp_gap < 0.0 {
-            fe += el.gauss[g].w * contact.traction(gp_gap);
+            fe += sp.w * contact.traction(gp_gap);
         }
     }
     fe
@@ -648,18 +748,21 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
     let (mut total, mut penetration) = (0.0, 0.0_f64);
     let mut forces = vec![0.0; model.elements().len()];
     let mut touching = vec![];
-    for (e, el) in model.elements().iter().enumerate() {
-        let xe = el.gather(&state.x);
-        let touches = el.nodes.iter().any(|i| on_ring.contains(i));
+    for e in 0..model.elements().len() {
+        let touches = model
+            .elements()
+            .nodes(e)
+            .iter()
+            .any(|i| on_ring.contains(i));
         let mut fe = 0.0;
-        for g in 0..4 {
-            let gp_gap = gap(el.position(g, &xe).into());
+        for sp in gauss_samples(model, e, &state.x) {
+            let gp_gap = gap(sp.x.into());
             if gp_gap < 0.0 {
                 let t = contact.traction(gp_gap);
-                fe += el.gauss[g].w * t;
+                fe += sp.w * t;
                 penetration = penetration.max(-gp_gap);
                 if touches {
-                    pc_sum += t / el.area_ratio(g, &xe);
+                    pc_sum += t / sp.area_ratio();
                     pc_n += 1;
                 }
             }
@@ -685,12 +788,11 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
 
 /// Mean contact pressure per current area of each element (VTU cell data).
 pub fn cell_contact_pressure(model: &Model, state: &State, contact: Option<&Contact>) -> Vec<f64> {
-    model
-        .elements()
+    with_elements!(model.elements(), els => els
         .iter()
         .map(|el| match contact {
             Some(c) => c.element_pressure(el, &el.gather(&state.x)),
             None => 0.0,
         })
-        .collect()
+        .collect())
 }

@@ -12,12 +12,13 @@ use crate::newton::NewtonError;
 use crate::post::{CellValues, Regime};
 use crate::stepping::{run_stage, Stage, StepSettings};
 use crate::FemError;
+use nalgebra::{SMatrix, SVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tubemem_material::laws::{AnssariBenamBucchi, MooneyRivlin};
 use tubemem_material::{MaterialError, MembraneLaw};
 use tubemem_mesh::tube::{capped_tube, plugged_tube, sphere};
-use tubemem_mesh::volume::volume_kernel;
+use tubemem_mesh::volume::volume_kernel_n;
 use tubemem_mesh::Symmetry;
 
 fn random_quad(rng: &mut ChaCha8Rng) -> [[f64; 3]; 4] {
@@ -52,10 +53,46 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 }
 
 /// Membrane energy, residual and tangent of one element (residual and tangent zeroed first).
-fn membrane(law: &dyn MembraneLaw, re: &RefElement, x: &[Vec3; 4]) -> (f64, Vector12, Matrix12) {
-    let (mut r, mut k) = (Vector12::zeros(), Matrix12::zeros());
+fn membrane<const N: usize, const D: usize>(
+    law: &dyn MembraneLaw,
+    re: &RefElement<N>,
+    x: &[Vec3; N],
+) -> (f64, SVector<f64, D>, SMatrix<f64, D, D>) {
+    let (mut r, mut k) = (SVector::zeros(), SMatrix::zeros());
     let e = membrane_kernel(law, re, x, &mut r, Some(&mut k)).unwrap();
     (e, r, k)
+}
+
+/// Check an element's residual r and tangent K, as functions of its D nodal coordinates,
+/// against central differences (step `h`) of its energy and residual (`eval` gives all three),
+/// and K for symmetry.
+pub(crate) fn check_element_fd<const N: usize, const D: usize>(
+    x: &[Vec3; N],
+    h: f64,
+    what: &str,
+    eval: impl Fn(&[Vec3; N]) -> (f64, SVector<f64, D>, SMatrix<f64, D, D>),
+) {
+    let (_, r, k) = eval(x);
+    let scale = k.amax();
+    for j in 0..D {
+        let (mut xp, mut xm) = (*x, *x);
+        xp[j / 3][j % 3] += h;
+        xm[j / 3][j % 3] -= h;
+        let ((ep, rp, _), (em, rm, _)) = (eval(&xp), eval(&xm));
+        assert!(close(r[j], (ep - em) / (2.0 * h), scale), "{what} r[{j}]");
+        for i in 0..D {
+            let fd = (rp[i] - rm[i]) / (2.0 * h);
+            assert!(
+                close(k[(i, j)], fd, scale),
+                "{what} K[{i}][{j}] = {} vs {fd}",
+                k[(i, j)]
+            );
+        }
+    }
+    assert!(
+        (k - k.transpose()).amax() <= 1e-12 * scale.max(1.0),
+        "{what}: K not symmetric"
+    );
 }
 
 #[test]
@@ -65,63 +102,34 @@ fn membrane_tangents_match_finite_differences() {
         Box::new(AnssariBenamBucchi::new(1.0, 30.0).unwrap()),
         Box::new(MooneyRivlin::new(1.0, 0.2).unwrap()),
     ];
-    let h = 1e-6;
     for law in &laws {
         for _ in 0..20 {
             let x0 = random_quad(&mut rng);
             let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
             let x = deform(&x0, &mut rng);
-            let (_, r, k) = membrane(law.as_ref(), &re, &x);
-            let scale = k.amax();
-            for j in 0..12 {
-                let (mut xp, mut xm) = (x, x);
-                xp[j / 3][j % 3] += h;
-                xm[j / 3][j % 3] -= h;
-                let (ep, rp, _) = membrane(law.as_ref(), &re, &xp);
-                let (em, rm, _) = membrane(law.as_ref(), &re, &xm);
-                assert!(
-                    close(r[j], (ep - em) / (2.0 * h), scale),
-                    "{} r[{j}]",
-                    law.name()
-                );
-                for i in 0..12 {
-                    let fd = (rp[i] - rm[i]) / (2.0 * h);
-                    assert!(
-                        close(k[(i, j)], fd, scale),
-                        "{} K[{i}][{j}] = {} vs {fd}",
-                        law.name(),
-                        k[(i, j)]
-                    );
-                }
-            }
-            assert!((k - k.transpose()).amax() <= 1e-12 * scale);
+            check_element_fd(&x, 1e-6, &law.name(), |x| {
+                membrane::<4, 12>(law.as_ref(), &re, x)
+            });
         }
     }
+}
+
+/// The volume as an "energy" for [`check_element_fd`]: (V, ∂V/∂x, ∂²V/∂x²).
+pub(crate) fn volume_eval<const N: usize, const D: usize>(
+    x: &[Vec3; N],
+) -> (f64, SVector<f64, D>, SMatrix<f64, D, D>) {
+    let (mut g, mut hs) = (SVector::zeros(), SMatrix::zeros());
+    let v = volume_kernel_n(x, Some(&mut g), Some(&mut hs));
+    (v, g, hs)
 }
 
 #[test]
 fn volume_gradient_and_hessian_match_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let h = 1e-6;
     for _ in 0..50 {
         let x = deform(&random_quad(&mut rng), &mut rng);
-        let (mut g, mut hs) = (Vector12::zeros(), Matrix12::zeros());
-        volume_kernel(&x, Some(&mut g), Some(&mut hs));
-        for j in 0..12 {
-            let (mut xp, mut xm) = (x, x);
-            xp[j / 3][j % 3] += h;
-            xm[j / 3][j % 3] -= h;
-            let (mut gp, mut gm) = (Vector12::zeros(), Vector12::zeros());
-            let vp = volume_kernel(&xp, Some(&mut gp), None);
-            let vm = volume_kernel(&xm, Some(&mut gm), None);
-            assert!(close(g[j], (vp - vm) / (2.0 * h), 1.0), "dV/dx[{j}]");
-            for i in 0..12 {
-                assert!(
-                    close(hs[(i, j)], (gp[i] - gm[i]) / (2.0 * h), 1.0),
-                    "d2V[{i}][{j}]"
-                );
-            }
-        }
+        check_element_fd(&x, 1e-6, "volume", volume_eval::<4, 12>);
+        let (_, _, hs) = volume_eval::<4, 12>(&x);
         assert!((hs - hs.transpose()).amax() < 1e-14);
     }
 }
@@ -145,30 +153,23 @@ fn contact_tangent_matches_finite_differences() {
             }],
             penalty: 300.0,
         };
-        let eval = |x: &[Vec3; 4]| {
-            let (mut r, mut k) = (Vector12::zeros(), Matrix12::zeros());
-            let e = contact.kernel(&re, x, &mut r, Some(&mut k));
-            (e, r, k)
-        };
-        let (e, r, k) = eval(&x);
-        assert!(e > 0.0, "the plane penetrates the element");
-        let scale = k.amax();
-        for j in 0..12 {
-            let (mut xp, mut xm) = (x, x);
-            xp[j / 3][j % 3] += h;
-            xm[j / 3][j % 3] -= h;
-            let ((ep, rp, _), (em, rm, _)) = (eval(&xp), eval(&xm));
-            assert!(close(r[j], (ep - em) / (2.0 * h), scale), "r[{j}]");
-            for i in 0..12 {
-                // the penalty is C¹: where a Gauss point crosses the plane within ±h the
-                // difference quotient sees the kink; none does at these random states
-                assert!(
-                    close(k[(i, j)], (rp[i] - rm[i]) / (2.0 * h), scale),
-                    "K[{i}][{j}]"
-                );
-            }
-        }
+        let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x);
+        assert!(eval(&x).0 > 0.0, "the plane penetrates the element");
+        // the penalty is C¹: where a Gauss point crosses the plane within ±h the difference
+        // quotient sees the kink; none does at these random states
+        check_element_fd(&x, h, "contact", eval);
     }
+}
+
+/// The contact kernel as an energy for [`check_element_fd`].
+pub(crate) fn contact_eval<const N: usize, const D: usize>(
+    contact: &Contact,
+    re: &RefElement<N>,
+    x: &[Vec3; N],
+) -> (f64, SVector<f64, D>, SMatrix<f64, D, D>) {
+    let (mut r, mut k) = (SVector::zeros(), SMatrix::zeros());
+    let e = contact.kernel(re, x, &mut r, Some(&mut k));
+    (e, r, k)
 }
 
 /// Patch test: a flat (tilted, distorted) element under a uniform in-plane stretch reproduces the
@@ -275,7 +276,7 @@ fn wrinkle_state_classification_works() {
 /// Check the assembled tangent's action A·v against central differences of the assembled
 /// residual along `v` (step 1e-6; tolerance 1e-6 relative to max |A·v|: truncation ~1e-11,
 /// rounding ~1e-9 relative).
-fn check_tangent_along(model: &Model, x: &[[f64; 3]], load: &Load, p: f64, v: &[f64]) {
+pub(crate) fn check_tangent_along(model: &Model, x: &[[f64; 3]], load: &Load, p: f64, v: &[f64]) {
     let av = model.tangent_times(x, load, p, v).unwrap();
     let h = 1e-6;
     let shifted = |t: f64| {
@@ -607,12 +608,24 @@ fn the_one_pass_profile_is_the_per_ring_extraction() {
 /// the located maximum: no converged pressure above it).
 #[test]
 fn arc_length_passes_and_locates_the_pressure_maximum_of_a_sphere() {
+    let errors = sphere_limit_errors(tubemem_mesh::ElementKind::Quad4, &[4, 8]);
+    let ratio = errors[0] / errors[1];
+    assert!(
+        (3.0..=5.0).contains(&ratio),
+        "limit-pressure errors {errors:?}, ratio {ratio}"
+    );
+}
+
+/// The relative errors of the located pressure maximum of the eighth sphere against Rivlin's,
+/// for elements of `kind` at `ms` elements per cube-face edge (the checks of the test above
+/// made at every m).
+pub(crate) fn sphere_limit_errors(kind: tubemem_mesh::ElementKind, ms: &[usize]) -> Vec<f64> {
     use crate::continuation::{follow, ArcEvent, ArcSettings, CriticalKind, MembranePath, Target};
     let lc = 7f64.powf(1.0 / 6.0);
     let pmax = 2.0 * (1.0 / lc - lc.powi(-7));
     let mut errors = Vec::new();
-    for m in [4, 8] {
-        let mesh = sphere(1.0, m, Symmetry::Eighth).unwrap();
+    for &m in ms {
+        let mesh = tubemem_mesh::tube::sphere_of(kind, 1.0, m, Symmetry::Eighth).unwrap();
         let law = tubemem_material::laws::neo_hookean(1.0).unwrap();
         let mut model = Model::new(mesh.clone(), Box::new(law)).unwrap();
         let mut st = model.reference_state();
@@ -662,16 +675,12 @@ fn arc_length_passes_and_locates_the_pressure_maximum_of_a_sphere() {
         assert_eq!((c.negative_before, c.negative_after), (0, 1));
         errors.push((c.load - pmax).abs() / pmax);
         eprintln!(
-            "m = {m}: located ϖmax = {:.10} (Rivlin {pmax:.10}), λ = {:.6}, {} steps, bracket {:.1e}",
+            "{kind:?} m = {m}: located ϖmax = {:.10} (Rivlin {pmax:.10}), λ = {:.6}, {} steps, bracket {:.1e}",
             c.load,
             (mesh.volume_at(&c.state.x) / v0).cbrt(),
             pressures.len(),
             c.bracket
         );
     }
-    let ratio = errors[0] / errors[1];
-    assert!(
-        (3.0..=5.0).contains(&ratio),
-        "limit-pressure errors {errors:?}, ratio {ratio}"
-    );
+    errors
 }

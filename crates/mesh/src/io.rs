@@ -4,7 +4,9 @@
 //! ```json
 //! {
 //!   "nodes": [[x, y, z], ...],          // reference positions, in units of R
-//!   "quads": [[a, b, c, d], ...],       // 0-based, counter-clockwise seen from outside
+//!   "quads": [[a, b, c, d], ...],       // 0-based, counter-clockwise seen from outside; or
+//!                                       // 9 nodes each (corners, mid-sides of 01 12 23 30,
+//!                                       // centre: meshio's quad9 order) for the 9-node element
 //!   "symmetry": "none",                 // optional: "none" | "half" | "quarter" | "eighth"
 //!   "plugs": [[i, j, ...], ...]         // optional: rings tied to rigid end discs
 //! }
@@ -22,7 +24,7 @@ use std::path::Path;
 #[serde(deny_unknown_fields)]
 pub struct MeshFile {
     pub nodes: Vec<[f64; 3]>,
-    pub quads: Vec<[usize; 4]>,
+    pub quads: Vec<Vec<usize>>,
     #[serde(default)]
     pub symmetry: Symmetry,
     #[serde(default)]
@@ -85,11 +87,33 @@ pub fn read_json(path: &Path, radius: f64) -> Result<Mesh, MeshError> {
             f.nodes[i]
         )));
     }
+    let per = f.quads[0].len();
+    if per != 4 && per != 9 {
+        return Err(err(format!(
+            "element 0 has {per} nodes: an element has 4 (bilinear) or 9 (biquadratic) nodes"
+        )));
+    }
+    if let Some((e, q)) = f.quads.iter().enumerate().find(|(_, q)| q.len() != per) {
+        return Err(err(format!(
+            "element {e} has {} nodes but element 0 has {per}: one mesh has one kind of element",
+            q.len()
+        )));
+    }
+    let quads = f.quads.iter().map(|q| [q[0], q[1], q[2], q[3]]).collect();
+    let mid = if per == 9 {
+        f.quads
+            .iter()
+            .map(|q| [q[4], q[5], q[6], q[7], q[8]])
+            .collect()
+    } else {
+        vec![]
+    };
     let mesh = Mesh {
         nodes,
-        quads: f.quads,
+        quads,
         symmetry: f.symmetry,
         plugs: f.plugs,
+        mid,
     };
     mesh.check()?;
     Ok(mesh)
@@ -99,7 +123,9 @@ pub fn read_json(path: &Path, radius: f64) -> Result<Mesh, MeshError> {
 pub fn write_json(path: &Path, mesh: &Mesh) -> Result<(), MeshError> {
     let f = MeshFile {
         nodes: mesh.nodes.clone(),
-        quads: mesh.quads.clone(),
+        quads: (0..mesh.quads.len())
+            .map(|e| mesh.element_nodes(e))
+            .collect(),
         symmetry: mesh.symmetry,
         plugs: mesh.plugs.clone(),
     };

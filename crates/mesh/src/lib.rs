@@ -24,10 +24,12 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod io;
+pub mod shape;
 pub mod tube;
 pub mod volume;
 pub mod vtu;
 
+pub use shape::{shape, ElementKind, GAUSS2};
 pub use volume::quad_volume;
 
 use serde::{Deserialize, Serialize};
@@ -133,6 +135,10 @@ pub struct Mesh {
     /// Rigid end plugs: each is a ring of nodes (sorted by angle) tied to a rigid disc that may
     /// translate axially. The surface may be open along a plug ring; the disc face closes it.
     pub plugs: Vec<Vec<usize>>,
+    /// For a biquadratic (9-node) mesh, the mid-side nodes of edges 0–1, 1–2, 2–3, 3–0 and the
+    /// centre node of each quad (see [`shape`](crate::shape)); empty for a bilinear mesh. The
+    /// corners stay in `quads`, so every topological check reads the corners alone.
+    pub mid: Vec<[usize; 5]>,
 }
 
 /// Distance below which a node counts as lying on a symmetry plane, relative to the mesh size.
@@ -167,16 +173,53 @@ impl Mesh {
             + self
                 .plugs
                 .iter()
-                .map(|r| plug_face(x, r, self.symmetry.rings_closed()).volume())
+                .map(|r| {
+                    plug_face(
+                        x,
+                        r,
+                        self.symmetry.rings_closed(),
+                        self.element() == ElementKind::Quad9,
+                    )
+                    .volume()
+                })
                 .sum::<f64>()
     }
 
     /// (1/3) Σ ∫ x·(g1 × g2) over the membrane elements only.
     pub fn membrane_volume_at(&self, x: &[[f64; 3]]) -> f64 {
-        self.quads
-            .iter()
-            .map(|q| quad_volume(&[x[q[0]], x[q[1]], x[q[2]], x[q[3]]]))
-            .sum()
+        match self.element() {
+            ElementKind::Quad4 => self
+                .quads
+                .iter()
+                .map(|q| quad_volume(&[x[q[0]], x[q[1]], x[q[2]], x[q[3]]]))
+                .sum(),
+            ElementKind::Quad9 => (0..self.quads.len())
+                .map(|e| volume::quad9_volume(&self.nodes9(e).map(|i| x[i])))
+                .sum(),
+        }
+    }
+
+    /// The kind of element: 9-node when the mid-side and centre nodes are given.
+    pub fn element(&self) -> ElementKind {
+        if self.mid.is_empty() {
+            ElementKind::Quad4
+        } else {
+            ElementKind::Quad9
+        }
+    }
+
+    /// The nine nodes of element `e` of a biquadratic mesh (corners, mid-sides, centre).
+    pub fn nodes9(&self, e: usize) -> [usize; 9] {
+        let (q, m) = (self.quads[e], self.mid[e]);
+        [q[0], q[1], q[2], q[3], m[0], m[1], m[2], m[3], m[4]]
+    }
+
+    /// Every node of element `e` (4 or 9).
+    pub fn element_nodes(&self, e: usize) -> Vec<usize> {
+        match self.element() {
+            ElementKind::Quad4 => self.quads[e].to_vec(),
+            ElementKind::Quad9 => self.nodes9(e).to_vec(),
+        }
     }
 
     /// Check connectivity, shape and orientation. A symmetry-reduced mesh may be open only along
@@ -188,6 +231,13 @@ impl Mesh {
                 name: "mesh",
                 value: n as f64,
                 requirement: "a mesh needs nodes and quads",
+            });
+        }
+        if !self.mid.is_empty() && self.mid.len() != self.quads.len() {
+            return Err(MeshError::InvalidParameter {
+                name: "mid",
+                value: self.mid.len() as f64,
+                requirement: "a 9-node mesh gives the mid-side and centre nodes of every quad (as many entries as quads)",
             });
         }
         let mut in_plug = vec![usize::MAX; n];
@@ -215,7 +265,8 @@ impl Mesh {
             }
         }
         for (e, q) in self.quads.iter().enumerate() {
-            for &i in q {
+            let all = self.element_nodes(e);
+            for &i in &all {
                 if i >= n {
                     return Err(MeshError::NodeOutOfRange {
                         element: e,
@@ -224,12 +275,12 @@ impl Mesh {
                     });
                 }
             }
-            for a in 0..4 {
-                for b in a + 1..4 {
-                    if q[a] == q[b] {
+            for a in 0..all.len() {
+                for b in a + 1..all.len() {
+                    if all[a] == all[b] {
                         return Err(MeshError::Degenerate {
                             element: e,
-                            reason: format!("node {} appears twice", q[a]),
+                            reason: format!("node {} appears twice", all[a]),
                         });
                     }
                 }
@@ -245,18 +296,38 @@ impl Mesh {
             }
             // The Jacobian g1 × g2 must keep the direction of the centre normal at every corner
             // (a collapsed edge gives zero there, a bow-tie a reversed one).
-            let xv = x.map(nalgebra::Vector3::from);
-            let [_, c1, c2] = volume::tangents(&xv, 0.0, 0.0);
+            // For the 9-node element the same test runs at its nine nodes: a mid-side node
+            // placed off its edge's middle third folds the element there.
+            let tangents = |xi: f64, eta: f64| match self.element() {
+                ElementKind::Quad4 => volume::tangents(&x.map(nalgebra::Vector3::from), xi, eta),
+                ElementKind::Quad9 => volume::tangents_n::<9>(
+                    &self
+                        .nodes9(e)
+                        .map(|i| nalgebra::Vector3::from(self.nodes[i])),
+                    xi,
+                    eta,
+                ),
+            };
+            let [_, c1, c2] = tangents(0.0, 0.0);
             let n0 = c1.cross(&c2);
-            for (k, (xi, eta)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .into_iter()
-                .enumerate()
-            {
-                let [_, g1, g2] = volume::tangents(&xv, xi, eta);
+            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+            let mids = [(0.0, -1.0), (1.0, 0.0), (0.0, 1.0), (-1.0, 0.0)];
+            let points = corners
+                .iter()
+                .map(|&c| (c, "corner"))
+                .chain(
+                    mids.iter()
+                        .filter(|_| self.element() == ElementKind::Quad9)
+                        .map(|&c| (c, "mid-side node")),
+                )
+                .enumerate();
+            for (k, ((xi, eta), what)) in points {
+                let [_, g1, g2] = tangents(xi, eta);
                 if !(g1.cross(&g2).dot(&n0) > 1e-8 * n0.dot(&n0)) {
+                    let k = if k < 4 { k } else { k - 4 };
                     return Err(MeshError::Degenerate {
                         element: e,
-                        reason: format!("the Jacobian vanishes or reverses at corner {k} (collapsed edge or bow-tie)"),
+                        reason: format!("the Jacobian vanishes or reverses at {what} {k} (collapsed edge, bow-tie or misplaced mid-side node)"),
                     });
                 }
             }
@@ -369,15 +440,26 @@ impl PlugFace {
 }
 
 /// The face of the plug whose ring is `ring` (sorted by angle), at positions `x`; `closed`
-/// when the ring goes all the way round ([`Symmetry::rings_closed`]).
-pub fn plug_face(x: &[[f64; 3]], ring: &[usize], closed: bool) -> PlugFace {
+/// when the ring goes all the way round ([`Symmetry::rings_closed`]); `quadratic` when the ring
+/// runs corner, mid-side, corner, … along the edges of 9-node elements: each such edge is a
+/// parabolic arc, whose area beyond the polygon through its three nodes is a third of their
+/// triangle (Archimedes: the segment is 4/3 of the triangle on its chord), so the face matches
+/// the curved membrane exactly.
+pub fn plug_face(x: &[[f64; 3]], ring: &[usize], closed: bool, quadratic: bool) -> PlugFace {
     let z = ring.iter().map(|&i| x[i][2]).sum::<f64>() / ring.len().max(1) as f64;
     let n = ring.len();
     let segs = if closed { n } else { n.saturating_sub(1) };
+    let cross = |p: [f64; 3], q: [f64; 3]| p[0] * q[1] - p[1] * q[0];
     let mut area = 0.0;
     for k in 0..segs {
         let (p, q) = (x[ring[k]], x[ring[(k + 1) % n]]);
-        area += 0.5 * (p[0] * q[1] - p[1] * q[0]);
+        area += 0.5 * cross(p, q);
+    }
+    if quadratic {
+        for k in (0..segs.saturating_sub(1)).step_by(2) {
+            let (p0, pm, p1) = (x[ring[k]], x[ring[k + 1]], x[ring[(k + 2) % n]]);
+            area += 0.5 * (cross(p0, pm) + cross(pm, p1) + cross(p1, p0)) / 3.0;
+        }
     }
     PlugFace {
         z,
@@ -405,29 +487,6 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// a · b
 pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// 2×2 Gauss points on [−1, 1]².
-pub const GAUSS2: [(f64, f64); 4] = {
-    const G: f64 = 0.577_350_269_189_625_8;
-    [(-G, -G), (G, -G), (G, G), (-G, G)]
-};
-
-/// Bilinear shape functions and their (ξ, η) derivatives.
-pub fn shape(xi: f64, eta: f64) -> ([f64; 4], [[f64; 2]; 4]) {
-    let n = [
-        0.25 * (1.0 - xi) * (1.0 - eta),
-        0.25 * (1.0 + xi) * (1.0 - eta),
-        0.25 * (1.0 + xi) * (1.0 + eta),
-        0.25 * (1.0 - xi) * (1.0 + eta),
-    ];
-    let d = [
-        [-0.25 * (1.0 - eta), -0.25 * (1.0 - xi)],
-        [0.25 * (1.0 - eta), -0.25 * (1.0 + xi)],
-        [0.25 * (1.0 + eta), 0.25 * (1.0 + xi)],
-        [-0.25 * (1.0 + eta), 0.25 * (1.0 - xi)],
-    ];
-    (n, d)
 }
 
 /// Area ∫ |g1 × g2| dξdη (2×2 Gauss).

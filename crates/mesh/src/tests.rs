@@ -290,9 +290,29 @@ fn json_mesh_round_trip_and_rejection() {
     // malformed JSON: line and column
     std::fs::write(
         &p,
-        "{\n  \"nodes\": [[0, 0, 0]],\n  \"quads\": [[0, 1, 2]]\n}",
+        "{\n  \"nodes\": [[0, 0, 0]],\n  \"quads\": [[0, 1, 2,]]\n}",
     )
     .unwrap();
     let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
     assert!(e.contains("line 3"), "{e}");
+    // an element of neither 4 nor 9 nodes, and a mesh mixing the two
+    std::fs::write(&p, "{\"nodes\": [[0, 0, 0]], \"quads\": [[0, 1, 2]]}").unwrap();
+    let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
+    assert!(e.contains("element 0 has 3 nodes"), "{e}");
+    std::fs::write(
+        &p,
+        "{\"nodes\": [[0, 0, 0]], \"quads\": [[0, 1, 2, 3], [0, 1, 2, 3, 4, 5, 6, 7, 8]]}",
+    )
+    .unwrap();
+    let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
+    assert!(
+        e.contains("element 1 has 9 nodes but element 0 has 4"),
+        "{e}"
+    );
+    // a 9-node mesh round-trips
+    let q9 =
+        crate::tube::capped_tube_of(crate::ElementKind::Quad9, 1.0, 4.0, 8, 4, Symmetry::Eighth)
+            .unwrap();
+    crate::io::write_json(&p, &q9).unwrap();
+    assert_eq!(crate::io::read_json(&p, 1.0).unwrap(), q9);
 }

@@ -10,7 +10,7 @@
 //! Elements: `around` = 4m around the cylinder (a multiple of 8, so that x = 0 and y = 0 are
 //! mesh lines), `along` along it (even, so that z = 0 is a mesh line), 3m² per cap.
 
-use crate::{dot, Mesh, MeshError, Symmetry};
+use crate::{dot, ElementKind, Mesh, MeshError, Symmetry};
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_4;
 
@@ -31,8 +31,32 @@ fn unit(c: [f64; 3]) -> [f64; 3] {
     [c[0] / n, c[1] / n, c[2] / n]
 }
 
-/// The lattice points and quads of the whole cube surface (for the sphere).
-fn cube_surface(m: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
+/// A cell of the lattice: its origin and its two edge directions (one lattice step each). The
+/// corners are o, o + s u, o + s u + s v, o + s v with s = `order` lattice steps; a 9-node cell
+/// (order 2) adds the mid-sides o + u, o + 2u + v, o + u + 2v, o + v and the centre o + u + v.
+type Cell = ([usize; 3], [usize; 3], [usize; 3]);
+
+/// The lattice points of a cell, 4 (order 1) or 9 (order 2), in element node order.
+fn cell_points(c: &Cell, order: usize) -> Vec<[usize; 3]> {
+    let (o, u, v) = c;
+    let at = |a: usize, b: usize| {
+        [
+            o[0] + a * u[0] + b * v[0],
+            o[1] + a * u[1] + b * v[1],
+            o[2] + a * u[2] + b * v[2],
+        ]
+    };
+    let s = order;
+    let mut pts = vec![at(0, 0), at(s, 0), at(s, s), at(0, s)];
+    if order == 2 {
+        pts.extend([at(1, 0), at(2, 1), at(1, 2), at(0, 1), at(1, 1)]);
+    }
+    pts
+}
+
+/// The lattice points and cells of the whole cube surface (for the sphere); the lattice has
+/// `m` steps a face edge, the cells `order` steps a side.
+fn cube_surface(m: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
     let mut points = vec![];
     for i in 0..=m {
         for j in 0..=m {
@@ -43,29 +67,30 @@ fn cube_surface(m: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
             }
         }
     }
-    let mut quads = vec![];
+    let (ex, ey, ez) = ([1, 0, 0], [0, 1, 0], [0, 0, 1]);
+    let mut cells = vec![];
     for k in [0, m] {
-        for i in 0..m {
-            for j in 0..m {
-                quads.push([[i, j, k], [i + 1, j, k], [i + 1, j + 1, k], [i, j + 1, k]]);
+        for i in (0..m).step_by(order) {
+            for j in (0..m).step_by(order) {
+                cells.push(([i, j, k], ex, ey));
             }
         }
     }
     for i in [0, m] {
-        for j in 0..m {
-            for k in 0..m {
-                quads.push([[i, j, k], [i, j + 1, k], [i, j + 1, k + 1], [i, j, k + 1]]);
+        for j in (0..m).step_by(order) {
+            for k in (0..m).step_by(order) {
+                cells.push(([i, j, k], ey, ez));
             }
         }
     }
     for j in [0, m] {
-        for i in 0..m {
-            for k in 0..m {
-                quads.push([[i, j, k], [i + 1, j, k], [i + 1, j, k + 1], [i, j, k + 1]]);
+        for i in (0..m).step_by(order) {
+            for k in (0..m).step_by(order) {
+                cells.push(([i, j, k], ex, ez));
             }
         }
     }
-    (points, quads)
+    (points, cells)
 }
 
 /// Cube coordinate of row `k` of `rows` on a side face of the half cube: 0 at the equator,
@@ -81,8 +106,8 @@ fn latitude(k: usize, rows: usize) -> f64 {
 }
 
 /// The upper half of the cube surface for a cap: lattice points (i, j, k) with k the row on the
-/// side faces (0 = equator, `rows` = the top face), and its quads.
-fn half_cube(m: usize, rows: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
+/// side faces (0 = equator, `rows` = the top face), and its cells (`order` steps a side).
+fn half_cube(m: usize, rows: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
     let mut points = vec![];
     for i in 0..=m {
         for j in 0..=m {
@@ -93,42 +118,60 @@ fn half_cube(m: usize, rows: usize) -> (Vec<[usize; 3]>, Vec<[[usize; 3]; 4]>) {
             }
         }
     }
-    let mut quads = vec![];
-    for i in 0..m {
-        for j in 0..m {
-            quads.push([
-                [i, j, rows],
-                [i + 1, j, rows],
-                [i + 1, j + 1, rows],
-                [i, j + 1, rows],
-            ]);
+    let (ex, ey, ez) = ([1, 0, 0], [0, 1, 0], [0, 0, 1]);
+    let mut cells = vec![];
+    for i in (0..m).step_by(order) {
+        for j in (0..m).step_by(order) {
+            cells.push(([i, j, rows], ex, ey));
         }
     }
     for i in [0, m] {
-        for j in 0..m {
-            for k in 0..rows {
-                quads.push([[i, j, k], [i, j + 1, k], [i, j + 1, k + 1], [i, j, k + 1]]);
+        for j in (0..m).step_by(order) {
+            for k in (0..rows).step_by(order) {
+                cells.push(([i, j, k], ey, ez));
             }
         }
     }
     for j in [0, m] {
-        for i in 0..m {
-            for k in 0..rows {
-                quads.push([[i, j, k], [i + 1, j, k], [i + 1, j, k + 1], [i, j, k + 1]]);
+        for i in (0..m).step_by(order) {
+            for k in (0..rows).step_by(order) {
+                cells.push(([i, j, k], ex, ez));
             }
         }
     }
-    (points, quads)
+    (points, cells)
 }
 
-/// Orient every quad so that g1 × g2 at its centre points away from `center(centroid)`.
-fn orient(nodes: &[[f64; 3]], quads: &mut [[usize; 4]], center: impl Fn([f64; 3]) -> [f64; 3]) {
-    for q in quads.iter_mut() {
+/// Split element node lists (4 or 9 each) into corner quads and mid/centre nodes.
+fn split_cells(cells: Vec<Vec<usize>>) -> (Vec<[usize; 4]>, Vec<[usize; 5]>) {
+    let mut quads = Vec::with_capacity(cells.len());
+    let mut mid = Vec::new();
+    for c in cells {
+        quads.push([c[0], c[1], c[2], c[3]]);
+        if c.len() == 9 {
+            mid.push([c[4], c[5], c[6], c[7], c[8]]);
+        }
+    }
+    (quads, mid)
+}
+
+/// Orient every element so that g1 × g2 at its centre points away from `center(centroid)`;
+/// a flipped 9-node element keeps its mid-side nodes on the matching edges.
+fn orient(
+    nodes: &[[f64; 3]],
+    quads: &mut [[usize; 4]],
+    mid: &mut [[usize; 5]],
+    center: impl Fn([f64; 3]) -> [f64; 3],
+) {
+    for (e, q) in quads.iter_mut().enumerate() {
         let x = q.map(|i| nalgebra::Vector3::from(nodes[i]));
         let [p, g1, g2] = crate::volume::tangents(&x, 0.0, 0.0);
         let c = nalgebra::Vector3::from(center(p.into()));
         if g1.cross(&g2).dot(&(p - c)) < 0.0 {
             *q = [q[0], q[3], q[2], q[1]];
+            if let Some(m) = mid.get_mut(e) {
+                *m = [m[3], m[2], m[1], m[0], m[4]];
+            }
         }
     }
 }
@@ -192,6 +235,42 @@ pub fn capped_tube_with_cap_rows(
     cap_rows: usize,
     symmetry: Symmetry,
 ) -> Result<Mesh, MeshError> {
+    capped_tube_with_cap_rows_of(
+        ElementKind::Quad4,
+        radius,
+        length,
+        around,
+        along,
+        cap_rows,
+        symmetry,
+    )
+}
+
+/// [`capped_tube`] with elements of `kind`: for the 9-node element the generator works on the
+/// lattice of twice the resolution (every lattice point is on the exact cylinder or sphere:
+/// equiangular around, uniform along, equiangular on the cube-sphere), and each element takes a
+/// 3 × 3 block of it, so the mid-side and centre nodes lie on the exact surface.
+pub fn capped_tube_of(
+    kind: ElementKind,
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
+    capped_tube_with_cap_rows_of(kind, radius, length, around, along, around / 8, symmetry)
+}
+
+/// [`capped_tube_with_cap_rows`] with elements of `kind` (see [`capped_tube_of`]).
+pub fn capped_tube_with_cap_rows_of(
+    kind: ElementKind,
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    cap_rows: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
     if cap_rows == 0 {
         return Err(MeshError::InvalidParameter {
             name: "cap_rows",
@@ -217,7 +296,9 @@ pub fn capped_tube_with_cap_rows(
                 "elements along must be even (≥ 2), so that the mid-span z = 0 is a mesh line",
         });
     }
-    let m = around / 4;
+    // the node lattice: `order` lattice steps per element side
+    let order = kind.gauss_per_direction() - 1;
+    let (m, lattice_along, rows) = (order * around / 4, order * along, order * cap_rows);
     let per = perimeter(m);
     let ring_dir: Vec<[f64; 3]> = per
         .iter()
@@ -225,34 +306,36 @@ pub fn capped_tube_with_cap_rows(
         .collect();
     let np = per.len();
     let mut nodes = Vec::new();
-    for l in 0..=along {
-        let z = -0.5 * length + length * l as f64 / along as f64;
-        let z = if 2 * l == along { 0.0 } else { z };
+    for l in 0..=lattice_along {
+        let z = -0.5 * length + length * l as f64 / lattice_along as f64;
+        let z = if 2 * l == lattice_along { 0.0 } else { z };
         for d in &ring_dir {
             nodes.push([radius * d[0], radius * d[1], z]);
         }
     }
-    let mut quads = Vec::new();
-    for l in 0..along {
-        for p in 0..np {
-            let q = (p + 1) % np;
-            quads.push([l * np + p, l * np + q, (l + 1) * np + q, (l + 1) * np + p]);
+    let mut cells: Vec<Vec<usize>> = Vec::new();
+    for l in (0..lattice_along).step_by(order) {
+        for p in (0..np).step_by(order) {
+            // (l, p) lattice cell of `order` steps: the same (origin, u, v) rule as the caps
+            let id = |a: usize, b: usize| (l + b) * np + (p + a) % np;
+            cells.push(
+                cell_points(&([0, 0, 0], [1, 0, 0], [0, 1, 0]), order)
+                    .iter()
+                    .map(|pt| id(pt[0], pt[1]))
+                    .collect(),
+            );
         }
     }
     let ring_of: HashMap<(usize, usize), usize> =
         per.iter().enumerate().map(|(p, &ij)| (ij, p)).collect();
-    let (points, cells) = half_cube(m, cap_rows);
-    for (sign, ring) in [(1.0, along), (-1.0, 0)] {
+    let (points, caps) = half_cube(m, rows, order);
+    for (sign, ring) in [(1.0, lattice_along), (-1.0, 0)] {
         let mut id: HashMap<[usize; 3], usize> = HashMap::new();
         for pt in &points {
             if pt[2] == 0 {
                 id.insert(*pt, ring * np + ring_of[&(pt[0], pt[1])]);
             } else {
-                let d = unit([
-                    lattice(pt[0], m),
-                    lattice(pt[1], m),
-                    latitude(pt[2], cap_rows),
-                ]);
+                let d = unit([lattice(pt[0], m), lattice(pt[1], m), latitude(pt[2], rows)]);
                 id.insert(*pt, nodes.len());
                 nodes.push([
                     radius * d[0],
@@ -261,18 +344,22 @@ pub fn capped_tube_with_cap_rows(
                 ]);
             }
         }
-        for c in &cells {
-            quads.push(c.map(|pt| id[&pt]));
+        for c in &caps {
+            cells.push(cell_points(c, order).iter().map(|pt| id[pt]).collect());
         }
     }
+    let (mut quads, mut mid) = split_cells(cells);
     let half = 0.5 * length;
-    orient(&nodes, &mut quads, |p| [0.0, 0.0, p[2].clamp(-half, half)]);
+    orient(&nodes, &mut quads, &mut mid, |p| {
+        [0.0, 0.0, p[2].clamp(-half, half)]
+    });
     let mesh = reduce(
         Mesh {
             nodes,
             quads,
             symmetry: Symmetry::None,
             plugs: vec![],
+            mid,
         },
         symmetry,
     );
@@ -290,17 +377,41 @@ pub fn plugged_tube(
     along: usize,
     symmetry: Symmetry,
 ) -> Result<Mesh, MeshError> {
-    let capped = capped_tube(radius, length, around, along, Symmetry::None)?;
+    plugged_tube_of(ElementKind::Quad4, radius, length, around, along, symmetry)
+}
+
+/// [`plugged_tube`] with elements of `kind` (the plug rings then hold the hoop mid-side nodes
+/// of the end rings too).
+pub fn plugged_tube_of(
+    kind: ElementKind,
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
+    let capped = capped_tube_of(kind, radius, length, around, along, Symmetry::None)?;
     let half = 0.5 * length;
     let tol = 1e-12 * (radius + length);
     // keep the cylinder elements: every node within the cylinder's z range
-    let quads: Vec<[usize; 4]> = capped
-        .quads
-        .iter()
-        .filter(|q| q.iter().all(|&i| capped.nodes[i][2].abs() <= half + tol))
-        .copied()
+    let keep: Vec<usize> = (0..capped.quads.len())
+        .filter(|&e| {
+            capped.quads[e]
+                .iter()
+                .all(|&i| capped.nodes[i][2].abs() <= half + tol)
+        })
         .collect();
-    let mesh = renumber(Mesh { quads, ..capped });
+    let quads = keep.iter().map(|&e| capped.quads[e]).collect();
+    let mid = if capped.mid.is_empty() {
+        vec![]
+    } else {
+        keep.iter().map(|&e| capped.mid[e]).collect()
+    };
+    let mesh = renumber(Mesh {
+        quads,
+        mid,
+        ..capped
+    });
     let ring = |sign: f64| {
         let mut r: Vec<usize> = (0..mesh.nodes.len())
             .filter(|&i| (mesh.nodes[i][2] - sign * half).abs() <= tol)
@@ -323,10 +434,8 @@ pub fn plugged_tube(
 /// plug rings keep their used nodes.
 fn renumber(mesh: Mesh) -> Mesh {
     let mut used = vec![false; mesh.nodes.len()];
-    for q in &mesh.quads {
-        for &i in q {
-            used[i] = true;
-        }
+    for &i in mesh.quads.iter().flatten().chain(mesh.mid.iter().flatten()) {
+        used[i] = true;
     }
     let mut new_id = vec![usize::MAX; mesh.nodes.len()];
     let mut nodes = vec![];
@@ -339,6 +448,7 @@ fn renumber(mesh: Mesh) -> Mesh {
     Mesh {
         nodes,
         quads: mesh.quads.iter().map(|q| q.map(|i| new_id[i])).collect(),
+        mid: mesh.mid.iter().map(|q| q.map(|i| new_id[i])).collect(),
         symmetry: mesh.symmetry,
         plugs: mesh
             .plugs
@@ -351,6 +461,16 @@ fn renumber(mesh: Mesh) -> Mesh {
 /// A sphere of radius `radius` centred at the origin: the equiangular cube-sphere with
 /// `m` × `m` elements per cube face (m even, ≥ 2), 6m² elements in all.
 pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshError> {
+    sphere_of(ElementKind::Quad4, radius, m, symmetry)
+}
+
+/// [`sphere`] with elements of `kind` (9-node: every node on the exact sphere).
+pub fn sphere_of(
+    kind: ElementKind,
+    radius: f64,
+    m: usize,
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
     check_positive("radius", radius)?;
     if m < 2 || !m.is_multiple_of(2) {
         return Err(MeshError::InvalidParameter {
@@ -359,22 +479,30 @@ pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshErr
             requirement: "elements per cube-face edge must be even (≥ 2)",
         });
     }
-    let (points, cells) = cube_surface(m);
+    let order = kind.gauss_per_direction() - 1;
+    let lm = order * m;
+    let (points, cells) = cube_surface(lm, order);
     let mut id = HashMap::new();
     let mut nodes = vec![];
     for pt in &points {
-        let d = unit([lattice(pt[0], m), lattice(pt[1], m), lattice(pt[2], m)]);
+        let d = unit([lattice(pt[0], lm), lattice(pt[1], lm), lattice(pt[2], lm)]);
         id.insert(*pt, nodes.len());
         nodes.push([radius * d[0], radius * d[1], radius * d[2]]);
     }
-    let mut quads: Vec<[usize; 4]> = cells.iter().map(|c| c.map(|pt| id[&pt])).collect();
-    orient(&nodes, &mut quads, |_| [0.0; 3]);
+    let (mut quads, mut mid) = split_cells(
+        cells
+            .iter()
+            .map(|c| cell_points(c, order).iter().map(|pt| id[pt]).collect())
+            .collect(),
+    );
+    orient(&nodes, &mut quads, &mut mid, |_| [0.0; 3]);
     let mesh = reduce(
         Mesh {
             nodes,
             quads,
             symmetry: Symmetry::None,
             plugs: vec![],
+            mid,
         },
         symmetry,
     );
@@ -382,26 +510,30 @@ pub fn sphere(radius: f64, m: usize, symmetry: Symmetry) -> Result<Mesh, MeshErr
     Ok(mesh)
 }
 
-/// Keep the elements whose centroid lies on the positive side of each symmetry plane and
-/// renumber the nodes (in their original order, so numbering is deterministic).
+/// Keep the elements whose centroid (of corners) lies on the positive side of each symmetry
+/// plane and renumber the nodes (in their original order, so numbering is deterministic).
 pub fn reduce(mesh: Mesh, symmetry: Symmetry) -> Mesh {
     if symmetry == Symmetry::None {
         return mesh;
     }
-    let quads: Vec<[usize; 4]> = mesh
-        .quads
-        .iter()
-        .filter(|q| {
-            let c = q.iter().fold([0.0; 3], |s, &i| {
+    let keep: Vec<usize> = (0..mesh.quads.len())
+        .filter(|&e| {
+            let c = mesh.quads[e].iter().fold([0.0; 3], |s, &i| {
                 let p = mesh.nodes[i];
                 [s[0] + p[0], s[1] + p[1], s[2] + p[2]]
             });
             symmetry.planes().iter().all(|&ax| c[ax] > 0.0)
         })
-        .copied()
         .collect();
+    let quads = keep.iter().map(|&e| mesh.quads[e]).collect();
+    let mid = if mesh.mid.is_empty() {
+        vec![]
+    } else {
+        keep.iter().map(|&e| mesh.mid[e]).collect()
+    };
     renumber(Mesh {
         quads,
+        mid,
         symmetry,
         ..mesh
     })

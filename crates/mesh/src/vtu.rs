@@ -116,11 +116,12 @@ fn data_array(out: &mut String, f: &Field, count: usize, encoding: Encoding) -> 
     Ok(())
 }
 
-/// Write a quadrilateral surface with point and cell fields.
-pub fn write_vtu(
+/// Write a quadrilateral surface with point and cell fields: 4-node cells as VTK_QUAD (9),
+/// 9-node cells (corners, mid-sides, centre) as VTK_BIQUADRATIC_QUAD (28).
+pub fn write_vtu<C: AsRef<[usize]>>(
     path: &Path,
     points: &[[f64; 3]],
-    quads: &[[usize; 4]],
+    quads: &[C],
     point_data: &[Field],
     cell_data: &[Field],
     encoding: Encoding,
@@ -148,9 +149,34 @@ pub fn write_vtu(
         |v| v.to_le_bytes().to_vec(),
     );
     s.push_str("      </Points>\n      <Cells>\n");
-    let conn: Vec<i64> = quads.iter().flatten().map(|&i| i as i64).collect();
-    let offsets: Vec<i64> = (1..=quads.len()).map(|i| 4 * i as i64).collect();
-    let types: Vec<u8> = vec![9; quads.len()]; // VTK_QUAD
+    let conn: Vec<i64> = quads
+        .iter()
+        .flat_map(|q| q.as_ref().iter().map(|&i| i as i64))
+        .collect();
+    let mut offsets: Vec<i64> = Vec::with_capacity(quads.len());
+    let mut types: Vec<u8> = Vec::with_capacity(quads.len());
+    let mut end = 0i64;
+    for (e, q) in quads.iter().enumerate() {
+        let q = q.as_ref();
+        end += q.len() as i64;
+        offsets.push(end);
+        types.push(match q.len() {
+            4 => 9,  // VTK_QUAD
+            9 => 28, // VTK_BIQUADRATIC_QUAD
+            n => {
+                return Err(io_err(
+                    path,
+                    format!("cell {e} has {n} nodes: only 4- and 9-node quads are written"),
+                ))
+            }
+        });
+        if let Some(&i) = q.iter().find(|&&i| i >= points.len()) {
+            return Err(io_err(
+                path,
+                format!("cell {e} refers to node {i} of {}", points.len()),
+            ));
+        }
+    }
     let int = |v: i64| v.to_string();
     let int_bytes = |v: i64| v.to_le_bytes().to_vec();
     array(
