@@ -581,7 +581,7 @@ impl RunWriter {
             &[]
         };
         let m = Mirror::new(axes, model.mesh().nodes.len());
-        let (points, quads) = m.geometry(&state.x, &model.mesh().quads);
+        let (points, quads) = m.geometry(&state.x, &model.mesh().cells());
         let disp = m.vector_field(&disp);
         let cellf: Vec<Vec<f64>> = [&hoop, &axial, &n1, &n2, &wrinkled, &pc]
             .iter()
@@ -713,19 +713,23 @@ impl Mirror {
         Self { signs, nodes }
     }
 
-    fn geometry(&self, x: &[[f64; 3]], quads: &[[usize; 4]]) -> (Vec<[f64; 3]>, Vec<[usize; 4]>) {
+    fn geometry(&self, x: &[[f64; 3]], quads: &[Vec<usize>]) -> (Vec<[f64; 3]>, Vec<Vec<usize>>) {
         let mut points = Vec::with_capacity(x.len() * self.signs.len());
         let mut cells = Vec::with_capacity(quads.len() * self.signs.len());
         for (k, s) in self.signs.iter().enumerate() {
             points.extend(x.iter().map(|p| [s[0] * p[0], s[1] * p[1], s[2] * p[2]]));
             let flip = s.iter().filter(|v| **v < 0.0).count() % 2 == 1;
             let o = k * self.nodes;
+            // a reflected 9-node cell keeps its mid-side nodes on the matching edges
+            const FLIP4: [usize; 4] = [0, 3, 2, 1];
+            const FLIP9: [usize; 9] = [0, 3, 2, 1, 7, 6, 5, 4, 8];
             cells.extend(quads.iter().map(|q| {
-                if flip {
-                    [q[0] + o, q[3] + o, q[2] + o, q[1] + o]
-                } else {
-                    [q[0] + o, q[1] + o, q[2] + o, q[3] + o]
-                }
+                let order: &[usize] = match (flip, q.len()) {
+                    (false, _) => &[0, 1, 2, 3, 4, 5, 6, 7, 8][..q.len()],
+                    (true, 4) => &FLIP4,
+                    (true, _) => &FLIP9,
+                };
+                order.iter().map(|&a| q[a] + o).collect::<Vec<usize>>()
             }));
         }
         (points, cells)
@@ -989,7 +993,7 @@ impl Observer for RunWriter {
             write_vtu(
                 &path,
                 &state.x,
-                &model.mesh().quads,
+                &model.mesh().cells(),
                 &[
                     Field {
                         name: "displacement",

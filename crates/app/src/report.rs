@@ -17,6 +17,9 @@ pub struct MeshInfo {
     pub elements: usize,
     pub equations: usize,
     pub symmetry: String,
+    /// "quad4" or "quad9"
+    #[serde(default)]
+    pub element: String,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -12,7 +12,7 @@ use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepInfo, StepSet
 use tubemem_fem::NewtonSettings;
 use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
-use tubemem_mesh::tube::{capped_tube_with_cap_rows, plugged_tube};
+use tubemem_mesh::tube::{capped_tube_with_cap_rows_of, plugged_tube_of};
 use tubemem_mesh::Mesh;
 
 /// The largest penetration of the plates, as a fraction of the plate half-gap ρ, that a squeeze
@@ -238,11 +238,12 @@ pub fn build_mesh(case: &Case) -> Result<Mesh> {
         }
         (None, Some(around), Some(along)) => {
             let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
+            let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
             match g.caps {
                 Caps::Hemisphere => {
-                    capped_tube_with_cap_rows(1.0, ll, around, along, cap_rows, case.mesh.symmetry)
+                    capped_tube_with_cap_rows_of(kind, 1.0, ll, around, along, cap_rows, sym)
                 }
-                Caps::RigidPlug => plugged_tube(1.0, ll, around, along, case.mesh.symmetry),
+                Caps::RigidPlug => plugged_tube_of(kind, 1.0, ll, around, along, sym),
             }
             .map_err(AppError::Mesh)
         }
@@ -820,6 +821,7 @@ pub fn run_with(
             elements: 0,
             equations: 0,
             symmetry: String::new(),
+            element: String::new(),
         },
         material: String::new(),
         material_spec: case.material,
@@ -882,6 +884,7 @@ fn run_inner(
             elements: model.mesh().quads.len(),
             equations: model.n_eq(),
             symmetry: format!("{symmetry:?}").to_lowercase(),
+            element: model.mesh().element().name().into(),
         },
         material: model.law().name(),
         material_spec: case.material,

@@ -214,6 +214,13 @@ impl Mesh {
         [q[0], q[1], q[2], q[3], m[0], m[1], m[2], m[3], m[4]]
     }
 
+    /// Every element's nodes (4 or 9 each), for output.
+    pub fn cells(&self) -> Vec<Vec<usize>> {
+        (0..self.quads.len())
+            .map(|e| self.element_nodes(e))
+            .collect()
+    }
+
     /// Every node of element `e` (4 or 9).
     pub fn element_nodes(&self, e: usize) -> Vec<usize> {
         match self.element() {
