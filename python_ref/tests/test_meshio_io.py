@@ -25,14 +25,17 @@ def run(exe, case_text, folder):
     return subprocess.run([exe, "run", str(case), "--out", str(folder / "out")], capture_output=True, text=True)
 
 
-def test_gmsh_round_trip_reproduces_the_generated_run(tmp_path, tubemem_exe):
-    gen = run(tubemem_exe, GEOMETRY + GENERATED_MESH + STAGE, tmp_path / "gen")
+@pytest.mark.parametrize("element,cell", [("quad4", "quad"), ("quad9", "quad9")])
+def test_gmsh_round_trip_reproduces_the_generated_run(tmp_path, tubemem_exe, element, cell):
+    mesh = GENERATED_MESH + f'element = "{element}"\n'
+    gen = run(tubemem_exe, GEOMETRY + mesh + STAGE, tmp_path / "gen")
     assert gen.returncode == 0, gen.stderr
     ref = meshio.read(tmp_path / "gen/out/vtu/step_00000.vtu")
-    meshio.write(tmp_path / "ref.msh", meshio.Mesh(ref.points, [("quad", ref.cells_dict["quad"])]), file_format="gmsh22")
+    assert list(ref.cells_dict) == [cell]
+    meshio.write(tmp_path / "ref.msh", meshio.Mesh(ref.points, [(cell, ref.cells_dict[cell])]), file_format="gmsh22")
     (tmp_path / "user").mkdir()
     nodes, quads = meshio_io.to_tubemem_json(tmp_path / "ref.msh", tmp_path / "user/mesh.json", symmetry="eighth")
-    assert quads.shape == ref.cells_dict["quad"].shape
+    assert quads.shape == ref.cells_dict[cell].shape
     usr = run(tubemem_exe, GEOMETRY + '[mesh]\nfile = "mesh.json"\n' + STAGE, tmp_path / "user")
     assert usr.returncode == 0, usr.stderr
     a, b = runs.read_steps(tmp_path / "gen/out"), runs.read_steps(tmp_path / "user/out")
@@ -44,6 +47,8 @@ def test_bad_meshes_are_refused(tmp_path, tubemem_exe):
     pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
     with pytest.raises(ValueError, match="triangle"):
         meshio_io.to_tubemem_json(meshio.Mesh(pts, [("triangle", [[0, 1, 2]])]), tmp_path / "t.json")
+    with pytest.raises(ValueError, match="mixes"):
+        meshio_io.to_tubemem_json(meshio.Mesh(np.zeros((9, 3)), [("quad", [[0, 1, 2, 3]]), ("quad9", [list(range(9))])]), tmp_path / "m.json")
     gen = run(tubemem_exe, GEOMETRY + GENERATED_MESH + STAGE, tmp_path / "gen")
     assert gen.returncode == 0, gen.stderr
     ref = meshio.read(tmp_path / "gen/out/vtu/step_00000.vtu")

@@ -3,6 +3,9 @@ that `tubemem run` reads through `[mesh] file = "..."`:
 
     {"nodes": [[x, y, z], ...], "quads": [[a, b, c, d], ...], "symmetry": "none", "plugs": []}
 
+`quad` cells (4-node, bilinear) or `quad9` cells (9-node, biquadratic: corners, mid-sides of
+edges 01 12 23 30, centre, which is meshio's and VTK's order) — one kind per mesh.
+
 The tube axis must be z with the mid-span at z = 0; nodes are in the case's length unit (the run
 divides them by [geometry] radius). Quads must be oriented counter-clockwise seen from outside;
 tubemem checks that (and everything else) and names the offending element.
@@ -20,19 +23,23 @@ SYMMETRIES = ("none", "half", "quarter", "eighth")
 
 
 def quad_mesh(mesh):
-    """(nodes (n, 3), quads (m, 4)) of a meshio.Mesh; any other surface cell type is an error."""
-    quads = []
+    """(nodes (n, 3), cells (m, 4) or (m, 9)) of a meshio.Mesh: its `quad` or its `quad9` cells;
+    any other surface cell type, or both kinds at once, is an error."""
+    blocks = {"quad": [], "quad9": []}
     for block in mesh.cells:
-        if block.type == "quad":
-            quads.append(np.asarray(block.data, dtype=np.int64))
-        elif block.type in ("triangle", "triangle6", "quad8", "quad9", "polygon"):
-            raise ValueError(f"tubemem needs bilinear quadrilaterals; the mesh has '{block.type}' cells")
-    if not quads:
-        raise ValueError("the mesh has no 'quad' cells")
+        if block.type in blocks:
+            blocks[block.type].append(np.asarray(block.data, dtype=np.int64))
+        elif block.type in ("triangle", "triangle6", "quad8", "polygon"):
+            raise ValueError(f"tubemem needs 4-node (quad) or 9-node (quad9) quadrilaterals; the mesh has '{block.type}' cells")
+    kinds = [k for k, v in blocks.items() if v]
+    if not kinds:
+        raise ValueError("the mesh has no 'quad' or 'quad9' cells")
+    if len(kinds) > 1:
+        raise ValueError("the mesh mixes 'quad' and 'quad9' cells: one mesh has one kind of element")
     pts = np.asarray(mesh.points, dtype=float)
     if pts.shape[1] == 2:
         pts = np.column_stack([pts, np.zeros(len(pts))])
-    return pts[:, :3], np.concatenate(quads)
+    return pts[:, :3], np.concatenate(blocks[kinds[0]])
 
 
 def to_tubemem_json(source, out_path, symmetry="none", plugs=()):
