@@ -21,6 +21,7 @@
 
 pub mod case;
 pub mod curves;
+pub mod export;
 pub mod figures;
 pub mod main_job;
 pub mod output;

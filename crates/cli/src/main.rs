@@ -62,6 +62,26 @@ enum Command {
     /// report.md, report.html and junit.xml. Exit code 0: all passed; 1: a check failed; 2: a
     /// usage or setup error.
     Verify(tubemem_cli::verify_cmd::VerifyArgs),
+    /// Write the case's model (mesh, symmetry conditions, neo-Hookean or Mooney–Rivlin
+    /// material, follower pressure and load steps) as an input deck of another code, to run the
+    /// identical model there. Squeeze, confine and arc-length stages and the ABB law are refused
+    /// with the reason.
+    Export {
+        /// The case file (TOML).
+        case: PathBuf,
+        #[arg(long, value_enum, default_value = "abaqus")]
+        format: ExportFormat,
+        /// The deck to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// The element for 4-node meshes (9-node meshes are written as Abaqus M3D9).
+        #[arg(long, value_enum, default_value = "s4")]
+        element: ExportElement,
+        /// The bulk modulus over the small-strain shear modulus, K/μ (D1 = 2/K): the solid
+        /// elements CalculiX expands shells into need one.
+        #[arg(long, default_value_t = 1000.0)]
+        bulk_ratio: f64,
+    },
     /// Write SVG/PNG and CSV reproductions of the paper's Figs. 5, 6, 7 and a λz-vs-λs figure,
     /// for any law, with FE runs overlaid (their points also as CSV, and an FE − GPS panel under
     /// Figs. 6–7).
@@ -82,6 +102,20 @@ enum Command {
         #[arg(long, default_value_t = tubemem_app::figures::BASE_DPI)]
         dpi: f64,
     },
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum ExportFormat {
+    /// an Abaqus/CalculiX input deck (.inp)
+    Abaqus,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum ExportElement {
+    /// S4 shells of the case's thickness (CalculiX and Abaqus)
+    S4,
+    /// M3D4 membranes (CalculiX and Abaqus)
+    M3d4,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -211,6 +245,29 @@ fn run(cli: Cli) -> Result<()> {
             resume,
             log,
         }) => run_case(&case, &out, overwrite, force, resume, log.as_deref()),
+        Some(Command::Export {
+            case,
+            format: ExportFormat::Abaqus,
+            out,
+            element,
+            bulk_ratio,
+        }) => {
+            let c = Case::read(&case).map_err(|e| app(e.into()))?;
+            let shell = match element {
+                ExportElement::S4 => tubemem_app::export::ShellChoice::S4,
+                ExportElement::M3d4 => tubemem_app::export::ShellChoice::M3d4,
+            };
+            let deck = tubemem_app::export::abaqus_deck(
+                &c,
+                &case.display().to_string(),
+                shell,
+                bulk_ratio,
+            )
+            .with_context(|| format!("cannot export {}", case.display()))?;
+            std::fs::write(&out, deck).with_context(|| format!("writing {}", out.display()))?;
+            tubemem_cli::say!("wrote {}", out.display())?;
+            Ok(())
+        }
         Some(Command::Figures {
             out,
             material,
