@@ -206,7 +206,7 @@ pub fn abaqus_deck(
     let dofs = tubemem_fem::dofs::DofMap::new(&mesh);
     let on: Vec<Vec<bool>> = (0..3).map(|ax| mesh.on_plane(ax)).collect();
     s.push_str("*BOUNDARY\n");
-    for i in 0..mesh.nodes.len() {
+    for (i, _) in mesh.nodes.iter().enumerate() {
         for k in 0..3 {
             if dofs.eq(i, k).is_none() {
                 let _ = writeln!(s, "{}, {}, {}", i + 1, k + 1, k + 1);
