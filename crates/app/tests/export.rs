@@ -64,8 +64,8 @@ fn the_deck_is_the_run_model() {
         .skip(1)
         .map(|v| v.trim().parse().unwrap())
         .collect();
-    for k in 0..3 {
-        assert!((first[k] - 2.0 * mesh.nodes[1][k]).abs() < 1e-12);
+    for (v, x) in first.iter().zip(mesh.nodes[1]) {
+        assert!((v - 2.0 * x).abs() < 1e-12);
     }
     let els = block(&d, "*ELEMENT, TYPE=S4, ELSET=EALL");
     assert_eq!(els.len(), mesh.quads.len());
