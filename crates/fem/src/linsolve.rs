@@ -38,6 +38,8 @@ pub struct SparseLdlt {
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
     factorized: bool,
+    /// the parallelism of the numeric factorization and the solves
+    par: Par,
 }
 
 impl SparseLdlt {
@@ -85,7 +87,50 @@ impl SparseLdlt {
             symbolic,
             l_values,
             factorized: false,
+            par: Par::Seq,
         })
+    }
+
+    /// The threads of the numeric factorization: 1 sequential (the default), n on n threads of
+    /// the current rayon pool (0: all of them). faer parallelizes inside each supernode's dense
+    /// kernels (the supernodes are eliminated in a fixed order, and each output block of a
+    /// parallel product is summed by one thread in a fixed order), so the factor does not depend
+    /// on the thread count: `factor_is_bitwise_the_same_on_1_and_2_threads`. The solves stay
+    /// sequential (see [`SparseLdlt::solve`]).
+    pub fn set_threads(&mut self, threads: usize) {
+        self.par = if threads == 1 {
+            Par::Seq
+        } else {
+            Par::rayon(threads)
+        };
+    }
+
+    /// The floating-point operations of one numeric factorization, from the symbolic structure:
+    /// Σ_k c_k (c_k + 2) with c_k the number of entries of column k of L below the diagonal (the
+    /// c_k(c_k + 1)/2 multiply–adds of the rank-one update of column k, multiplications and
+    /// additions counted apart, plus its c_k scalings and c_k products with D). The usual count
+    /// of sparse Cholesky (George & Liu), the one dense LDLᵀ's n³/3 comes from.
+    pub fn factor_flops(&self) -> f64 {
+        let col = |c: f64| c * (c + 2.0);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let p = s.col_ptr();
+                (0..self.n)
+                    .map(|k| col((p[k + 1] - p[k]) as f64 - 1.0))
+                    .sum()
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let (begin, end) = (s.supernode_begin(), s.supernode_end());
+                let val = s.col_ptr_for_val();
+                (0..s.n_supernodes())
+                    .map(|k| {
+                        let ncols = end[k] - begin[k];
+                        let nrows = (val[k + 1] - val[k]) / ncols;
+                        (0..ncols).map(|j| col((nrows - j - 1) as f64)).sum::<f64>()
+                    })
+                    .sum()
+            }
+        }
     }
 
     pub fn dim(&self) -> usize {
@@ -109,7 +154,7 @@ impl SparseLdlt {
             .map_err(|e| FemError::Factorization {
                 reason: format!("cannot fill the matrix: {e:?}"),
             })?;
-        let par = Par::Seq;
+        let par = self.par;
         let req = self
             .symbolic
             .factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
@@ -172,6 +217,9 @@ impl SparseLdlt {
     /// Solve A y = rhs in place with the last factorization.
     pub fn solve(&self, rhs: &mut [f64]) {
         assert!(self.factorized, "solve after a successful factorize");
+        // sequential whatever the factorization's threads: faer's parallel triangular solve
+        // sums in an order that depends on the thread count (measured: the solution differs in
+        // the last bits on 2 threads), and a solve is O(nnz(L)), a small part of an iteration
         let par = Par::Seq;
         let req = self.symbolic.solve_in_place_scratch::<f64>(1, par);
         let mut mem = MemBuffer::new(req);
@@ -266,6 +314,48 @@ mod tests {
         let neg = s.factorize(&vals).unwrap();
         assert_eq!(neg, d.iter().filter(|&&v| v < 0.0).count());
         assert_eq!(s.pivots().len(), n);
+    }
+
+    /// The factor and the solution are bitwise the same on 1 and 2 threads (a supernodal
+    /// factor with large supernodes, where faer's dense kernels do split the work), and the flop
+    /// count of a dense matrix is the dense LDLᵀ's: Σ_k (n−1−k)(n+1−k) = n³/3 + n²/2 − 5n/6.
+    #[test]
+    fn factor_is_bitwise_the_same_on_1_and_2_threads() {
+        let n = 700usize;
+        let mut pairs = vec![];
+        let mut vals = vec![];
+        for j in 0..n {
+            for i in j..n {
+                pairs.push((i, j));
+                vals.push(if i == j {
+                    n as f64
+                } else {
+                    ((i * 31 + j * 17) % 13) as f64 / 13.0 - 0.5
+                });
+            }
+        }
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap()
+                .install(|| {
+                    let mut s = SparseLdlt::with_layout(n, &pairs, Layout::Supernodal).unwrap();
+                    s.set_threads(threads);
+                    s.factorize(&vals).unwrap();
+                    let mut b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+                    s.solve(&mut b);
+                    (s.l_values.clone(), b, s.factor_flops())
+                })
+        };
+        let (l1, b1, f1) = run(1);
+        let (l2, b2, _) = run(2);
+        let bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(p, q)| p.to_bits() == q.to_bits());
+        assert!(bits(&l1, &l2), "the factor depends on the thread count");
+        assert!(bits(&b1, &b2), "the solution depends on the thread count");
+        let nf = n as f64;
+        let dense = nf.powi(3) / 3.0 + nf * nf / 2.0 - 5.0 * nf / 6.0;
+        assert!((f1 - dense).abs() < 1e-9 * dense, "{f1} vs {dense}");
     }
 
     #[test]

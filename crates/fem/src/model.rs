@@ -284,6 +284,16 @@ impl Model {
     pub fn factor_nnz(&self) -> usize {
         self.ldlt.factor_nnz()
     }
+    /// The floating-point operations of one numeric factorization.
+    pub fn factor_flops(&self) -> f64 {
+        self.ldlt.factor_flops()
+    }
+    /// The threads of the numeric factorization (1: sequential, the default; 0: all of the
+    /// current rayon pool). The factor is the same whatever the count
+    /// ([`crate::linsolve::SparseLdlt::set_threads`]).
+    pub fn set_factor_threads(&mut self, threads: usize) {
+        self.ldlt.set_threads(threads);
+    }
 
     /// The symmetry multiplicity (copies of the model in the whole tube).
     pub fn multiplicity(&self) -> f64 {
@@ -486,11 +496,7 @@ impl Model {
             state.p = p;
         }
         let settings = self.settings;
-        let mut problem = MembraneProblem {
-            model: self,
-            load,
-            arc: None,
-        };
+        let mut problem = MembraneProblem::new(self, load, None);
         newton::solve(&mut problem, state, &settings)
     }
 
@@ -511,11 +517,7 @@ impl Model {
             loading: Loading::Pressure(state.p),
             contact: load.contact.clone(),
         };
-        let mut problem = MembraneProblem {
-            model: self,
-            load,
-            arc: Some(arc),
-        };
+        let mut problem = MembraneProblem::new(self, load, Some(arc));
         newton::solve(&mut problem, state, &settings)
     }
 
@@ -688,9 +690,42 @@ struct MembraneProblem<'a> {
     model: &'a mut Model,
     load: &'a Load,
     arc: Option<&'a ArcConstraint<'a>>,
+    /// the assembly (with the tangent) of the last trial state the line search evaluated:
+    /// when that trial is accepted, the next linearization is at the same state and takes it
+    /// instead of assembling again
+    trial: std::cell::RefCell<Option<(Vec<[f64; 3]>, Assembled)>>,
 }
 
 impl MembraneProblem<'_> {
+    fn new<'a>(
+        model: &'a mut Model,
+        load: &'a Load,
+        arc: Option<&'a ArcConstraint<'a>>,
+    ) -> MembraneProblem<'a> {
+        MembraneProblem {
+            model,
+            load,
+            arc,
+            trial: std::cell::RefCell::new(None),
+        }
+    }
+
+    /// The assembly with the tangent at `x`: the cached trial's if it was made at exactly
+    /// these positions (bitwise), a fresh one otherwise.
+    fn assemble_at(&self, x: &[[f64; 3]]) -> Result<Assembled, FemError> {
+        if let Some((xt, a)) = self.trial.borrow_mut().take() {
+            let same = xt.len() == x.len()
+                && xt
+                    .iter()
+                    .zip(x)
+                    .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()));
+            if same {
+                return Ok(a);
+            }
+        }
+        self.model.assemble(x, true, self.load.contact.as_ref())
+    }
+
     fn pressure(&self, state_p: f64, volume: f64) -> f64 {
         match self.load.gas() {
             Some(pv) => pv / (self.model.multiplicity() * volume),
@@ -728,9 +763,7 @@ impl newton::Problem for MembraneProblem<'_> {
             return Err(FemError::Interrupted);
         }
         let m = self.model.multiplicity();
-        let a = self
-            .model
-            .assemble(&state.x, true, self.load.contact.as_ref())?;
+        let a = self.assemble_at(&state.x)?;
         state.p = self.pressure(state.p, a.volume);
         let p = state.p;
         let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
@@ -832,9 +865,11 @@ impl newton::Problem for MembraneProblem<'_> {
     }
 
     fn evaluate(&self, state: &State) -> Result<Evaluation, FemError> {
+        // with the tangent: an accepted trial is where the next iteration linearizes, and it
+        // takes this assembly (`assemble_at`) instead of assembling the same state again
         let trial = self
             .model
-            .assemble(&state.x, false, self.load.contact.as_ref())?;
+            .assemble(&state.x, true, self.load.contact.as_ref())?;
         let pt = self.pressure(state.p, trial.volume);
         let rt: Vec<f64> = trial
             .f_int
@@ -845,10 +880,12 @@ impl newton::Problem for MembraneProblem<'_> {
         let reft = force_scale(&trial, pt);
         let residual = norm(&rt) / reft;
         self.admissible(&trial, pt, residual)?;
-        Ok(Evaluation {
+        let out = Evaluation {
             residual,
             potential: potential(self.load.loading, trial.energy, trial.volume, pt),
-        })
+        };
+        *self.trial.borrow_mut() = Some((state.x.clone(), trial));
+        Ok(out)
     }
 
     fn update(&self, base: &State, step: &Self::Step, t: f64, state: &mut State) {
@@ -937,6 +974,8 @@ pub struct IterationTiming {
     pub solve: f64,
     pub negative_pivots: usize,
     pub factor_nnz: usize,
+    /// floating-point operations of the factorization
+    pub factor_flops: f64,
 }
 
 impl Model {
@@ -961,6 +1000,7 @@ impl Model {
             solve: (t3 - t2).as_secs_f64(),
             negative_pivots: neg,
             factor_nnz: self.ldlt.factor_nnz(),
+            factor_flops: self.ldlt.factor_flops(),
         })
     }
 }
