@@ -26,12 +26,14 @@
 //! rtol = 1e-9           # Newton tolerance on ‖R‖/‖f‖
 //! max_iterations = 30
 //! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
+//! factor_threads = 1    # threads of the sparse factorization (0: all); results do not change
 //!
 //! [output]              # optional
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
 //! vtu_every = 1         # with "every": a frame every N steps (and each stage's last)
 //! vtu_format = "binary" # "binary" (default, exact) | "ascii"
 //! mirror = false        # true: the whole tube in the VTU, reflected from a reduced model
+//! iterations = false    # true: iterations.csv, where each Newton iteration's time went
 //!
 //! [[stage]]
 //! kind = "inflate"
@@ -151,6 +153,10 @@ pub struct OutputSpec {
     /// ring) at every converged step, or at stage ends only
     #[serde(default)]
     pub profiles: ProfileFrames,
+    /// write iterations.csv: per Newton iteration the assembly, line-search, factorization
+    /// and solve times, the residual and the negative pivots
+    #[serde(default)]
+    pub iterations: bool,
 }
 
 /// How VTU arrays are written.
@@ -174,6 +180,7 @@ impl Default for OutputSpec {
             vtu_format: VtuFormat::default(),
             mirror: false,
             profiles: ProfileFrames::default(),
+            iterations: false,
         }
     }
 }
@@ -194,6 +201,14 @@ pub struct SolverSpec {
     /// kept, and `tubemem run --resume` continues from the newest
     #[serde(default = "default_checkpoint_every")]
     pub checkpoint_every: usize,
+    /// threads of the sparse factorization: 1 (default) sequential, 0 all of the machine's;
+    /// the results do not depend on it
+    #[serde(default = "default_factor_threads")]
+    pub factor_threads: usize,
+}
+
+fn default_factor_threads() -> usize {
+    1
 }
 
 fn default_checkpoint_every() -> usize {
@@ -207,6 +222,7 @@ impl Default for SolverSpec {
             rtol: default_rtol(),
             max_iterations: default_max_iterations(),
             checkpoint_every: default_checkpoint_every(),
+            factor_threads: default_factor_threads(),
         }
     }
 }

@@ -110,6 +110,10 @@ pub fn front_rows(row: usize, r: &StepRecord) -> Vec<[f64; 7]> {
 
 /// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
 /// bifurcation, as steps.csv's `critical`).
+/// iterations.csv (`[output] iterations = true`): one row per Newton iteration, seconds.
+pub const ITERATIONS_HEADER: &str =
+    "stage,step,iteration,assembly_s,line_search_s,factorization_s,solve_s,residual,negative_pivots";
+
 pub const CRITICAL_HEADER: &str = "stage,step,kind,arc_length,bracket,w,lambda_s,lambda_z,volume,negative_pivots_before,negative_pivots_after,reference_w,reference_lambda_s,polygon_factor,w_error_over_polygon,mode_eigenvalue";
 
 /// The values of one steps.csv row, `None` for an empty field.
@@ -848,6 +852,30 @@ impl Observer for RunWriter {
     }
 
     fn step(&mut self, view: &StepView) -> Result<(), BoxError> {
+        let iterations = view.model.take_iteration_log();
+        if self.vtu.iterations && !iterations.is_empty() {
+            // the iterations since the last converged step (a cut-back's failed attempts
+            // included), under this step's number
+            let path = self.dir.join("iterations.csv");
+            let rows: Vec<[f64; 9]> = iterations
+                .iter()
+                .enumerate()
+                .map(|(k, it)| {
+                    [
+                        view.record.stage as f64,
+                        view.record.step as f64,
+                        (k + 1) as f64,
+                        it.assembly,
+                        it.line_search,
+                        it.factorization,
+                        it.solve,
+                        it.residual,
+                        it.negative_pivots as f64,
+                    ]
+                })
+                .collect();
+            append_csv(&path, ITERATIONS_HEADER, &rows)?;
+        }
         if let Some(steps) = &mut self.steps {
             writeln!(steps, "{}", format_row(view.record))?;
             steps.flush()?;

@@ -20,6 +20,12 @@ pub struct MeshInfo {
     /// "quad4" or "quad9"
     #[serde(default)]
     pub element: String,
+    /// nonzeros of the sparse LDLᵀ factor
+    #[serde(default)]
+    pub factor_nnz: usize,
+    /// floating-point operations of one numeric factorization
+    #[serde(default)]
+    pub factor_flops: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -822,6 +822,8 @@ pub fn run_with(
             equations: 0,
             symmetry: String::new(),
             element: String::new(),
+            factor_nnz: 0,
+            factor_flops: 0.0,
         },
         material: String::new(),
         material_spec: case.material,
@@ -874,6 +876,8 @@ fn run_inner(
         max_iterations: case.solver.max_iterations,
         ..NewtonSettings::default()
     });
+    model.set_factor_threads(case.solver.factor_threads);
+    model.set_iteration_log(case.output.iterations);
     let mut state = model.reference_state();
     let v0 = model.multiplicity() * model.mesh().volume();
     let node = nearest_node(model.mesh(), [1.0, 0.0, 0.0]);
@@ -885,6 +889,8 @@ fn run_inner(
             equations: model.n_eq(),
             symmetry: format!("{symmetry:?}").to_lowercase(),
             element: model.mesh().element().name().into(),
+            factor_nnz: model.factor_nnz(),
+            factor_flops: model.factor_flops(),
         },
         material: model.law().name(),
         material_spec: case.material,

@@ -202,6 +202,25 @@ pub struct Model {
     pattern: Pattern,
     ldlt: SparseLdlt,
     settings: NewtonSettings,
+    /// per-Newton-iteration timings, when asked for ([`Model::set_iteration_log`])
+    iteration_log: Option<std::sync::Mutex<Vec<IterationRecord>>>,
+}
+
+/// Where one Newton iteration's time went (wall-clock seconds).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationRecord {
+    /// the assembly with the tangent at the iterate (done for the accepted line-search trial
+    /// that led here, or here)
+    pub assembly: f64,
+    /// the assemblies of rejected line-search trials before this iterate
+    pub line_search: f64,
+    /// the numeric factorization (and its shifted retries)
+    pub factorization: f64,
+    /// the triangular solves of the correction (and of the bordered or gas term)
+    pub solve: f64,
+    /// the scaled residual at the iterate
+    pub residual: f64,
+    pub negative_pivots: usize,
 }
 
 impl Model {
@@ -244,6 +263,7 @@ impl Model {
             pattern,
             ldlt,
             settings: NewtonSettings::default(),
+            iteration_log: None,
         })
     }
 
@@ -283,6 +303,23 @@ impl Model {
     /// The number of nonzeros of the sparse factor.
     pub fn factor_nnz(&self) -> usize {
         self.ldlt.factor_nnz()
+    }
+    /// Record where each Newton iteration's time goes ([`IterationRecord`]), to be collected
+    /// with [`Model::take_iteration_log`].
+    pub fn set_iteration_log(&mut self, on: bool) {
+        self.iteration_log = on.then(|| std::sync::Mutex::new(Vec::new()));
+    }
+    /// The iterations recorded since the last call (empty when not recording).
+    pub fn take_iteration_log(&self) -> Vec<IterationRecord> {
+        self.iteration_log
+            .as_ref()
+            .map(|m| std::mem::take(&mut *m.lock().unwrap_or_else(|e| e.into_inner())))
+            .unwrap_or_default()
+    }
+    fn log_iteration(&self, r: IterationRecord) {
+        if let Some(m) = &self.iteration_log {
+            m.lock().unwrap_or_else(|e| e.into_inner()).push(r);
+        }
     }
     /// The floating-point operations of one numeric factorization.
     pub fn factor_flops(&self) -> f64 {
@@ -686,6 +723,9 @@ pub struct ArcConstraint<'a> {
 /// The membrane equilibrium under one load, as a [`newton::Problem`]: the state is (x, p), the
 /// step (Δx on the free dofs, Δp). With `arc`, the pressure is an unknown and the arc-length
 /// constraint closes the system.
+/// A line-search trial's positions, its assembly (with the tangent) and the seconds it took.
+type TrialAssembly = (Vec<[f64; 3]>, Assembled, f64);
+
 struct MembraneProblem<'a> {
     model: &'a mut Model,
     load: &'a Load,
@@ -693,7 +733,10 @@ struct MembraneProblem<'a> {
     /// the assembly (with the tangent) of the last trial state the line search evaluated:
     /// when that trial is accepted, the next linearization is at the same state and takes it
     /// instead of assembling again
-    trial: std::cell::RefCell<Option<(Vec<[f64; 3]>, Assembled)>>,
+    trial: std::cell::RefCell<Option<TrialAssembly>>,
+    /// seconds spent assembling line-search trials that were not taken since the last
+    /// linearization
+    rejected_seconds: std::cell::Cell<f64>,
 }
 
 impl MembraneProblem<'_> {
@@ -707,23 +750,28 @@ impl MembraneProblem<'_> {
             load,
             arc,
             trial: std::cell::RefCell::new(None),
+            rejected_seconds: std::cell::Cell::new(0.0),
         }
     }
 
-    /// The assembly with the tangent at `x`: the cached trial's if it was made at exactly
-    /// these positions (bitwise), a fresh one otherwise.
-    fn assemble_at(&self, x: &[[f64; 3]]) -> Result<Assembled, FemError> {
-        if let Some((xt, a)) = self.trial.borrow_mut().take() {
+    /// The assembly with the tangent at `x` and the seconds it took: the cached trial's if it
+    /// was made at exactly these positions (bitwise), a fresh one otherwise.
+    fn assemble_at(&self, x: &[[f64; 3]]) -> Result<(Assembled, f64), FemError> {
+        if let Some((xt, a, secs)) = self.trial.borrow_mut().take() {
             let same = xt.len() == x.len()
                 && xt
                     .iter()
                     .zip(x)
                     .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()));
             if same {
-                return Ok(a);
+                return Ok((a, secs));
             }
+            self.rejected_seconds
+                .set(self.rejected_seconds.get() + secs);
         }
-        self.model.assemble(x, true, self.load.contact.as_ref())
+        let t = std::time::Instant::now();
+        let a = self.model.assemble(x, true, self.load.contact.as_ref())?;
+        Ok((a, t.elapsed().as_secs_f64()))
     }
 
     fn pressure(&self, state_p: f64, volume: f64) -> f64 {
@@ -763,7 +811,7 @@ impl newton::Problem for MembraneProblem<'_> {
             return Err(FemError::Interrupted);
         }
         let m = self.model.multiplicity();
-        let a = self.assemble_at(&state.x)?;
+        let (a, assembly_seconds) = self.assemble_at(&state.x)?;
         state.p = self.pressure(state.p, a.volume);
         let p = state.p;
         let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
@@ -812,7 +860,10 @@ impl newton::Problem for MembraneProblem<'_> {
             _ => 1.0,
         };
         let merit = res + c.abs() / cscale;
+        let t_factor = std::time::Instant::now();
         let (neg, shift) = self.model.factorize(&a, p)?;
+        let factorization_seconds = t_factor.elapsed().as_secs_f64();
+        let t_solve = std::time::Instant::now();
         let converged = res <= self.model.settings.rtol && c.abs() <= 1e-12 * cscale;
         // the Newton correction
         let ldlt = &self.model.ldlt;
@@ -849,6 +900,14 @@ impl newton::Problem for MembraneProblem<'_> {
             }
         }
         let slope = dot(&r, &dx);
+        self.model.log_iteration(IterationRecord {
+            assembly: assembly_seconds,
+            line_search: self.rejected_seconds.replace(0.0),
+            factorization: factorization_seconds,
+            solve: t_solve.elapsed().as_secs_f64(),
+            residual: res,
+            negative_pivots: negative,
+        });
         Ok(Linearization {
             residual: res,
             merit,
@@ -867,6 +926,12 @@ impl newton::Problem for MembraneProblem<'_> {
     fn evaluate(&self, state: &State) -> Result<Evaluation, FemError> {
         // with the tangent: an accepted trial is where the next iteration linearizes, and it
         // takes this assembly (`assemble_at`) instead of assembling the same state again
+        let t = std::time::Instant::now();
+        if let Some((_, _, secs)) = self.trial.borrow_mut().take() {
+            // an earlier trial of this line search, not taken
+            self.rejected_seconds
+                .set(self.rejected_seconds.get() + secs);
+        }
         let trial = self
             .model
             .assemble(&state.x, true, self.load.contact.as_ref())?;
@@ -884,7 +949,7 @@ impl newton::Problem for MembraneProblem<'_> {
             residual,
             potential: potential(self.load.loading, trial.energy, trial.volume, pt),
         };
-        *self.trial.borrow_mut() = Some((state.x.clone(), trial));
+        *self.trial.borrow_mut() = Some((state.x.clone(), trial, t.elapsed().as_secs_f64()));
         Ok(out)
     }
 

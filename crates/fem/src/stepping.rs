@@ -228,8 +228,25 @@ pub fn prestress<E>(
     let set = &stage.settings;
     let mut p0 = set.prestress;
     loop {
-        let mut trial = state.clone();
-        match model.solve(&mut trial, &Load::pressure(p0)) {
+        // From the stress-free state Newton has no out-of-plane stiffness to work with (it
+        // creeps, its corrections capped, for some twenty iterations); from a uniform dilation
+        // about the origin (the tube's centre, on every symmetry plane) every element is in
+        // equibiaxial tension and it converges at once. The dilation is the small-strain
+        // cylinder's hoop strain under ϖ: N_s = ϖR and N ≈ 12 μH ε for equibiaxial stretch of
+        // an incompressible membrane give ε = ϖ/12 (the caps, as spheres, want half of it);
+        // constrained components (symmetry planes, pins, plug rings) stay where they are.
+        let mut trial = dilated(model, state, p0 / 12.0);
+        let first = model.solve(&mut trial, &Load::pressure(p0));
+        let outcome = match first {
+            Ok(r) => Ok(r),
+            Err(e) if matches!(e.cause(), Some(FemError::Interrupted)) => Err(e),
+            Err(_) => {
+                // the dilation did not help: from the stress-free state, as before
+                trial = state.clone();
+                model.solve(&mut trial, &Load::pressure(p0))
+            }
+        };
+        match outcome {
             Ok(_) => {
                 *state = trial;
                 return Ok(());
@@ -253,6 +270,19 @@ pub fn prestress<E>(
             }
         }
     }
+}
+
+/// `state` dilated by 1 + `eps` about the origin, on the free components only.
+fn dilated(model: &Model, state: &State, eps: f64) -> State {
+    let mut out = state.clone();
+    for (i, x) in out.x.iter_mut().enumerate() {
+        for (k, c) in x.iter_mut().enumerate() {
+            if model.dofs().eq(i, k).is_some() {
+                *c *= 1.0 + eps;
+            }
+        }
+    }
+    out
 }
 
 /// Why a stage stopped.
