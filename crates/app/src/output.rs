@@ -297,6 +297,16 @@ fn write_checkpoint(path: &Path, tmp: &Path, ck: &Checkpoint) -> Result<()> {
         }
     }
     buf.extend_from_slice(&ck.p.to_le_bytes());
+    // the stepping's previous state, same layout, when there is one (an older checkpoint
+    // without it reads as none)
+    if let Some((x, p)) = &ck.previous {
+        for q in x {
+            for v in q {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        buf.extend_from_slice(&p.to_le_bytes());
+    }
     std::fs::write(tmp, &buf).map_err(|e| AppError::io(tmp, e))?;
     std::fs::rename(tmp, path).map_err(|e| AppError::io(path, e))
 }
@@ -313,7 +323,8 @@ fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
     let rest = rest.get(8 + hl..)?;
     let n = usize::try_from(u64_at(rest)?).ok()?;
     let data = rest.get(8..)?;
-    if data.len() != n.checked_mul(24)?.checked_add(8)? {
+    let one = n.checked_mul(24)?.checked_add(8)?;
+    if data.len() != one && data.len() != one.checked_mul(2)? {
         return None;
     }
     // the length is checked above: 3n coordinates and the pressure, 8 bytes each
@@ -325,11 +336,12 @@ fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
             f64::from_le_bytes(b)
         })
         .collect();
-    ck.x = v[..3 * n]
-        .chunks_exact(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
+    let positions =
+        |w: &[f64]| -> Vec<[f64; 3]> { w.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
+    ck.x = positions(&v[..3 * n]);
     ck.p = v[3 * n];
+    ck.previous =
+        (v.len() == 2 * (3 * n + 1)).then(|| (positions(&v[3 * n + 1..6 * n + 1]), v[6 * n + 1]));
     Some(ck)
 }
 
@@ -986,6 +998,7 @@ impl Observer for RunWriter {
             pvd: self.pvd.clone(),
             x: view.state.x.clone(),
             p: view.state.p,
+            previous: view.previous.map(|s| (s.x.clone(), s.p)),
         };
         let name = if (self.rows / self.checkpoint_every).is_multiple_of(2) {
             "ckpt-a.bin"

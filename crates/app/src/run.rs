@@ -43,6 +43,9 @@ pub struct StepView<'a> {
     pub record: &'a StepRecord,
     /// the fraction of the stage done
     pub fraction: f64,
+    /// the converged state before this one in the stage (the stepping's secant predictor
+    /// continues from both after a restart)
+    pub previous: Option<&'a State>,
 }
 
 /// Called by [`run`] as it goes. Every method has a no-op default.
@@ -495,6 +498,9 @@ pub struct Checkpoint {
     pub x: Vec<[f64; 3]>,
     #[serde(skip)]
     pub p: f64,
+    /// the converged state before it in the stage, if any (in binary after the state)
+    #[serde(skip)]
+    pub previous: Option<(Vec<[f64; 3]>, f64)>,
 }
 
 /// How a run is driven from outside.
@@ -946,7 +952,13 @@ fn run_inner(
         let (context, progress, restored, restored_critical) = match resume_here {
             Some(ck) => (
                 ck.context,
-                Some(ck.progress),
+                Some((
+                    ck.progress,
+                    ck.previous.as_ref().map(|(x, p)| State {
+                        x: x.clone(),
+                        p: *p,
+                    }),
+                )),
                 ck.steps.clone(),
                 ck.critical_points.clone(),
             ),
@@ -1183,6 +1195,7 @@ fn run_inner(
                     stages,
                     record: steps.last().expect("just pushed"),
                     fraction: info.fraction,
+                    previous: info.previous,
                 };
                 for o in observers.iter_mut() {
                     o.step(&view)?;
@@ -1205,7 +1218,7 @@ fn run_inner(
                 &mut model,
                 &mut state,
                 &stage,
-                progress,
+                progress.map(|(p, _)| p),
                 None,
                 &*monitor,
                 direction,

@@ -1006,6 +1006,7 @@ pub fn run_arc_stage<E>(
                             dl: s.ds,
                             step: step0 + s.step,
                             cuts: s.cuts,
+                            previous_lambda: None,
                         },
                         step: step0 + s.step,
                         value: s.monitor,
@@ -1022,6 +1023,7 @@ pub fn run_arc_stage<E>(
                         newton: &newton,
                         dw_ds: s.tl,
                         negative_conjugate: Some(s.negative_pivots_conjugate),
+                        previous: None,
                     };
                     *state = s.state.clone();
                     on_step(path.model, s.state, &info)

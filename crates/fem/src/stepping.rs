@@ -4,7 +4,13 @@
 //! ```text
 //! Δλ₀ = 1/initial_steps;  on success: λ ← λ + Δλ, and Δλ ← min(growth·Δλ, max_fraction) when
 //! the step took ≤ easy_iterations; on failure: Δλ ← Δλ/2 (at most max_cuts times per stage).
+//! predictor (from the stage's second step on): the secant through the last two converged
+//! states, x⁰ₙ₊₁ = xₙ + r (xₙ − xₙ₋₁), ϖ⁰ₙ₊₁ = ϖₙ + r (ϖₙ − ϖₙ₋₁), r = Δλₙ₊₁/Δλₙ
 //! ```
+//! The secant predictor places the nodes that a moving plate pushes, and the whole tube of an
+//! inflation, close to where the step ends: a squeeze step from the last state starts with the
+//! plate's whole advance as penetration (residual ≈ 1) and the penalty's active set moving
+//! under Newton; from the prediction the contact zone is already where the step ends.
 
 use crate::model::{Load, Loading, Model, State};
 use crate::newton::NewtonReport;
@@ -68,6 +74,10 @@ pub struct StepState {
     pub step: usize,
     /// cut-backs so far
     pub cuts: usize,
+    /// the fraction of the stage at the converged step before the last (for the secant
+    /// predictor; `None` before the stage's second step)
+    #[serde(default)]
+    pub previous_lambda: Option<f64>,
 }
 
 /// A converged step as the stepping reports it to its caller.
@@ -86,6 +96,9 @@ pub struct StepInfo<'a> {
     /// an arc-length step: the negative pivots under volume control (the closed tube's
     /// stability), beside the pressure-control count of `newton.inertia`
     pub negative_conjugate: Option<usize>,
+    /// the converged state before this one in the stage (the secant predictor's other point,
+    /// at `progress.previous_lambda`), for checkpoints
+    pub previous: Option<&'a State>,
 }
 
 /// Run one stage: the load parameter moves linearly from `stage.from` to `stage.to` (the load
@@ -106,13 +119,27 @@ pub fn run_stage<E>(
     run_stage_from(model, state, stage, None, load, on_step)
 }
 
+/// `state` moved along the secant from `previous` (at fraction `l0`) through it (at `l1`) to
+/// fraction `l2`: x + r (x − x_prev), ϖ + r (ϖ − ϖ_prev), r = (l2 − l1)/(l1 − l0).
+fn secant(state: &State, previous: &State, l0: f64, l1: f64, l2: f64) -> State {
+    let r = (l2 - l1) / (l1 - l0);
+    let mut out = state.clone();
+    for (x, x0) in out.x.iter_mut().zip(&previous.x) {
+        for k in 0..3 {
+            x[k] += r * (x[k] - x0[k]);
+        }
+    }
+    out.p += r * (state.p - previous.p);
+    out
+}
+
 /// [`run_stage`], continued from `resume` (a [`StepInfo::progress`] of an earlier run, with
-/// `state` the state of that step) when given.
+/// `state` the state of that step, and its [`StepInfo::previous`]) when given.
 pub fn run_stage_from<E>(
     model: &mut Model,
     state: &mut State,
     stage: &Stage,
-    resume: Option<StepState>,
+    resume: Option<(StepState, Option<State>)>,
     load: impl Fn(f64) -> Load,
     mut on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
 ) -> Result<(), StageError<E>> {
@@ -127,17 +154,26 @@ pub fn run_stage_from<E>(
             prestress(model, state, stage)?;
         }
     }
+    let (progress, mut previous) = resume.unwrap_or((
+        StepState {
+            lambda: 0.0,
+            dl: 1.0 / set.initial_steps.max(1) as f64,
+            step: 0,
+            cuts: 0,
+            previous_lambda: None,
+        },
+        None,
+    ));
     let StepState {
         mut lambda,
         mut dl,
         mut step,
         mut cuts,
-    } = resume.unwrap_or(StepState {
-        lambda: 0.0,
-        dl: 1.0 / set.initial_steps.max(1) as f64,
-        step: 0,
-        cuts: 0,
-    });
+        mut previous_lambda,
+    } = progress;
+    if previous_lambda.is_none() {
+        previous = None;
+    }
     // the last material error that rejected an attempt at the current step
     let mut material: Option<FemError> = None;
     while lambda < 1.0 {
@@ -155,14 +191,18 @@ pub fn run_stage_from<E>(
             lambda + dl
         };
         let value = from + (to - from) * next;
-        let mut trial = state.clone();
+        let mut trial = match (&previous, previous_lambda) {
+            (Some(prev), Some(l0)) if lambda > l0 => secant(state, prev, l0, lambda, next),
+            _ => state.clone(),
+        };
         let l = load(value);
         match model.solve(&mut trial, &l) {
             Ok(report) => {
                 material = None;
                 step += 1;
+                previous_lambda = Some(lambda);
                 lambda = next;
-                *state = trial;
+                previous = Some(std::mem::replace(state, trial));
                 if report.iterations <= set.easy_iterations {
                     dl = (dl * set.growth).min(set.max_fraction);
                 }
@@ -172,6 +212,7 @@ pub fn run_stage_from<E>(
                         dl,
                         step,
                         cuts,
+                        previous_lambda,
                     },
                     step,
                     value,
@@ -180,6 +221,7 @@ pub fn run_stage_from<E>(
                     newton: &report,
                     dw_ds: f64::NAN,
                     negative_conjugate: None,
+                    previous: previous.as_ref(),
                 };
                 on_step(model, state, &info).map_err(|source| StageError::Observer {
                     stage: stage.index,
