@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# The million-unknown benchmark (issue #11): a full capped tube (no symmetry), 4-node elements,
+# AROUND (448) around × ALONG (560) along, L/R = 20, ABB N = 30, inflated to the mid-span
+# stretch λs* = 1.3 (4 initial steps) and squeezed to ρ = 0.8 with the gas closed in (5 initial
+# steps): 978,432 equations at the default size. The step counts are the run's choice, not the
+# answer's: at a quarter of the size, 6 + 10 initial steps end in the same state to 2.4e-13 and
+# take 103 Newton iterations instead of 66.
+#
+#   bash scripts/bench-million.sh                  # factorization on 1 thread
+#   THREADS=2 bash scripts/bench-million.sh        # … on 2
+#   AROUND=224 ALONG=280 bash scripts/bench-million.sh   # a quarter of the size
+#
+# Prints: the dense peak of this machine (faer's matmul, crates/fem/examples/dense_peak.rs), the
+# run's wall time and peak memory (GNU time's maximum RSS), and from the run's iterations.csv
+# ([output] iterations = true) per Newton iteration the assembly, line-search, factorization and
+# solve times, with the factor's nonzeros and flop count (summary.json) and the factorization's
+# achieved GFLOP/s against the dense peak on the same number of threads. The run folder is kept
+# in OUT (default runs/bench-million-THREADS) with its steps.csv and summary.json; VTU frames are
+# written at stage ends only (binary).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+AROUND=${AROUND:-448}
+ALONG=${ALONG:-560}
+THREADS=${THREADS:-1}
+OUT=${OUT:-runs/bench-million-$THREADS}
+cargo build --release -q -p tubemem-cli
+peak=$(cargo run --release -q -p tubemem-fem --example dense_peak | tail -1)
+echo "dense peak (faer matmul): $peak"
+mkdir -p "$(dirname "$OUT")"
+case_file="$OUT.toml"
+cat >"$case_file" <<EOF
+# written by scripts/bench-million.sh
+[geometry]
+radius = 1.0
+length = 20.0
+thickness = 0.01
+caps = "hemisphere"
+
+[material]
+model = "abb"
+shear_modulus = 1.0
+kuhn = 30
+
+[mesh]
+around = $AROUND
+along = $ALONG
+symmetry = "none"
+
+[solver]
+checkpoint_every = 0
+factor_threads = $THREADS
+
+[output]
+vtu = "stage-end"
+profiles = "stage-end"
+iterations = true
+
+[[stage]]
+kind = "inflate"
+control = "volume"
+target_stretch = 1.3
+steps = 4
+
+[[stage]]
+kind = "squeeze"
+target_rho = 0.8
+steps = 5
+EOF
+/usr/bin/time -v -o "$OUT.time" target/release/tubemem run "$case_file" --out "$OUT" --overwrite --force
+python3 - "$OUT" "$peak" "$THREADS" <<'PY'
+import csv, json, re, statistics, sys
+out, peak, threads = sys.argv[1], json.loads(sys.argv[2]), int(sys.argv[3])
+s = json.load(open(f"{out}/summary.json"))
+rows = list(csv.DictReader(open(f"{out}/iterations.csv")))
+time = open(f"{out}.time").read()
+wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", time).group(1)
+rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", time).group(1)) / 1048576
+col = lambda k: [float(r[k]) for r in rows]
+flops, nnz = s["mesh"]["factor_flops"], s["mesh"]["factor_nnz"]
+fact = col("factorization_s")
+dense = peak["gflops"]["1" if threads == 1 else "all"]
+print(f"\n{s['mesh']['equations']} equations, {s['mesh']['elements']} elements; wall {wall}, peak RSS {rss:.2f} GiB")
+for st in s["stages"]:
+    f = st["final"]
+    print(f"stage {st['index']} ({st['kind']}): {f['stage_steps']} steps, {f['stage_newton_iterations']} Newton iterations; "
+          f"mid-span ϖ {f['w']:.6f}, λs {f['lambda_s']:.6f}, λz {f['lambda_z']:.6f}")
+print(f"{len(rows)} Newton iterations (iterations.csv); per iteration, median [min, max] seconds:")
+for k in ["assembly_s", "line_search_s", "factorization_s", "solve_s"]:
+    v = col(k)
+    print(f"  {k[:-2]:14s} {statistics.median(v):8.3f} [{min(v):.3f}, {max(v):.3f}]   total {sum(v):8.1f} s")
+g = flops / statistics.median(fact) / 1e9
+print(f"factor: {nnz / 1e6:.1f} M nonzeros ({nnz * 8 / 2**30:.2f} GiB), {flops / 1e9:.1f} GFLOP per factorization; "
+      f"achieved {g:.1f} GFLOP/s = {100 * g / dense:.0f} % of the dense peak on {threads} thread(s) ({dense:.1f} GFLOP/s)")
+PY
