@@ -12,7 +12,7 @@ OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 for i in $(seq 1 "$RUNS"); do
   TIMEFORMAT="run $i: %2R s (wall)"
-  time ./target/release/tubemem run "$CASE" --out "$OUT/run" > /dev/null
+  time ./target/release/tubemem run "$CASE" --out "$OUT/run" --overwrite > /dev/null
 done 2>&1
 python3 - "$OUT/run/summary.json" <<'PY'
 import json, sys

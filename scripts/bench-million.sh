@@ -84,7 +84,7 @@ for st in s["stages"]:
     f = st["final"]
     print(f"stage {st['index']} ({st['kind']}): {f['stage_steps']} steps, {f['stage_newton_iterations']} Newton iterations; "
           f"mid-span ϖ {f['w']:.6f}, λs {f['lambda_s']:.6f}, λz {f['lambda_z']:.6f}")
-print(f"{len(rows)} Newton iterations (iterations.csv); per iteration, median [min, max] seconds:")
+print(f"{len(rows)} linearizations (iterations.csv: the Newton iterations and each solve's converged check); per linearization, median [min, max] seconds:")
 for k in ["assembly_s", "line_search_s", "factorization_s", "solve_s"]:
     v = col(k)
     print(f"  {k[:-2]:14s} {statistics.median(v):8.3f} [{min(v):.3f}, {max(v):.3f}]   total {sum(v):8.1f} s")

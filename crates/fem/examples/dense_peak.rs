@@ -38,5 +38,8 @@ fn main() {
         );
         json.push(format!("\"{label}\": {g}"));
     }
-    println!("{{\"threads\": {threads}, \"gflops\": {{{}}}}}", json.join(", "));
+    println!(
+        "{{\"threads\": {threads}, \"gflops\": {{{}}}}}",
+        json.join(", ")
+    );
 }
