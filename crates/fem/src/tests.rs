@@ -302,13 +302,19 @@ pub(crate) fn check_tangent_along(model: &Model, x: &[[f64; 3]], load: &Load, p:
 /// penetrates some Gauss points).
 #[test]
 fn assembled_tangents_match_finite_differences_including_gas() {
-    let mut rng = ChaCha8Rng::seed_from_u64(21);
-    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
-    let mut model = Model::new(
+    check_assembled_tangents(
         capped_tube(1.0, 3.0, 8, 6, Symmetry::Quarter).unwrap(),
-        Box::new(law),
-    )
-    .unwrap();
+        21,
+        3,
+    );
+}
+
+/// The check of [`assembled_tangents_match_finite_differences_including_gas`] on `mesh` (a
+/// capped tube), `directions` random directions per loading.
+pub(crate) fn check_assembled_tangents(mesh: tubemem_mesh::Mesh, seed: u64, directions: usize) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let mut model = Model::new(mesh, Box::new(law)).unwrap();
     let mut st = model.reference_state();
     model.solve(&mut st, &Load::pressure(0.4)).unwrap();
     // move off equilibrium a little, so that every term is exercised
@@ -336,7 +342,7 @@ fn assembled_tangents_match_finite_differences_including_gas() {
     let without = model.assemble(&st.x, false, None).unwrap();
     assert!(with.energy > without.energy, "no contact in the test state");
     for load in [Load::pressure(0.4), Load::new(Loading::Gas { pv }), squeeze] {
-        for _ in 0..3 {
+        for _ in 0..directions {
             let v: Vec<f64> = (0..model.n_eq())
                 .map(|_| rng.random_range(-1.0..1.0))
                 .collect();
@@ -349,13 +355,14 @@ fn assembled_tangents_match_finite_differences_including_gas() {
 /// finite differences, as above.
 #[test]
 fn plugged_tube_tangent_matches_finite_differences() {
-    let mut rng = ChaCha8Rng::seed_from_u64(22);
+    check_plugged_tangents(plugged_tube(1.0, 3.0, 8, 6, Symmetry::None).unwrap(), 22);
+}
+
+/// The check of [`plugged_tube_tangent_matches_finite_differences`] on `mesh` (a plugged tube).
+pub(crate) fn check_plugged_tangents(mesh: tubemem_mesh::Mesh, seed: u64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
-    let mut model = Model::new(
-        plugged_tube(1.0, 3.0, 8, 6, Symmetry::None).unwrap(),
-        Box::new(law),
-    )
-    .unwrap();
+    let mut model = Model::new(mesh, Box::new(law)).unwrap();
     let mut st = model.reference_state();
     model.solve(&mut st, &Load::pressure(0.3)).unwrap();
     let v_total = model.mesh().volume_at(&st.x);

@@ -401,17 +401,7 @@ pub fn plugged_tube_of(
                 .all(|&i| capped.nodes[i][2].abs() <= half + tol)
         })
         .collect();
-    let quads = keep.iter().map(|&e| capped.quads[e]).collect();
-    let mid = if capped.mid.is_empty() {
-        vec![]
-    } else {
-        keep.iter().map(|&e| capped.mid[e]).collect()
-    };
-    let mesh = renumber(Mesh {
-        quads,
-        mid,
-        ..capped
-    });
+    let mesh = renumber(keep_elements(capped, &keep));
     let ring = |sign: f64| {
         let mut r: Vec<usize> = (0..mesh.nodes.len())
             .filter(|&i| (mesh.nodes[i][2] - sign * half).abs() <= tol)
@@ -525,16 +515,20 @@ pub fn reduce(mesh: Mesh, symmetry: Symmetry) -> Mesh {
             symmetry.planes().iter().all(|&ax| c[ax] > 0.0)
         })
         .collect();
+    renumber(Mesh {
+        symmetry,
+        ..keep_elements(mesh, &keep)
+    })
+}
+
+/// `mesh` with the elements `keep` only (corners and, for 9-node meshes, the other nodes);
+/// the nodes are not renumbered.
+fn keep_elements(mesh: Mesh, keep: &[usize]) -> Mesh {
     let quads = keep.iter().map(|&e| mesh.quads[e]).collect();
     let mid = if mesh.mid.is_empty() {
         vec![]
     } else {
         keep.iter().map(|&e| mesh.mid[e]).collect()
     };
-    renumber(Mesh {
-        quads,
-        mid,
-        symmetry,
-        ..mesh
-    })
+    Mesh { quads, mid, ..mesh }
 }
