@@ -110,9 +110,11 @@ pub fn front_rows(row: usize, r: &StepRecord) -> Vec<[f64; 7]> {
 
 /// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
 /// bifurcation, as steps.csv's `critical`).
-/// iterations.csv (`[output] iterations = true`): one row per Newton iteration, seconds.
+/// iterations.csv (`[output] iterations = true`): one row per Newton linearization (the
+/// iterations and each solve's converged check), seconds; `row` is the steps.csv row of the
+/// step they led to (a resumed run trims the rows past its checkpoint).
 pub const ITERATIONS_HEADER: &str =
-    "stage,step,iteration,assembly_s,line_search_s,factorization_s,solve_s,residual,negative_pivots";
+    "row,stage,step,iteration,assembly_s,line_search_s,factorization_s,solve_s,residual,negative_pivots";
 
 pub const CRITICAL_HEADER: &str = "stage,step,kind,arc_length,bracket,w,lambda_s,lambda_z,volume,negative_pivots_before,negative_pivots_after,reference_w,reference_lambda_s,polygon_factor,w_error_over_polygon,mode_eigenvalue";
 
@@ -201,9 +203,10 @@ pub enum FolderMode {
 }
 
 /// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
-pub const RUN_ENTRIES: [&str; 12] = [
+pub const RUN_ENTRIES: [&str; 13] = [
     "checkpoints",
     "fronts.csv",
+    "iterations.csv",
     "critical_points.csv",
     "steps.csv",
     "walls.csv",
@@ -457,8 +460,10 @@ impl RunWriter {
                 .map_err(|e| AppError::io(&path, e))?;
             w.profiles = Some(BufWriter::new(f));
         }
-        // fronts.csv: the rows of the kept steps; critical_points.csv: the checkpoint's points
+        // fronts.csv, iterations.csv: the rows of the kept steps; critical_points.csv: the
+        // checkpoint's points
         trim_rows(&dir.join("fronts.csv"), ck.rows)?;
+        trim_rows(&dir.join("iterations.csv"), ck.rows)?;
         let path = dir.join("critical_points.csv");
         let points: Vec<[f64; 16]> = ck
             .report
@@ -869,11 +874,12 @@ impl Observer for RunWriter {
             // the iterations since the last converged step (a cut-back's failed attempts
             // included), under this step's number
             let path = self.dir.join("iterations.csv");
-            let rows: Vec<[f64; 9]> = iterations
+            let rows: Vec<[f64; 10]> = iterations
                 .iter()
                 .enumerate()
                 .map(|(k, it)| {
                     [
+                        (self.rows + 1) as f64,
                         view.record.stage as f64,
                         view.record.step as f64,
                         (k + 1) as f64,

@@ -554,3 +554,48 @@ fn a_target_past_the_maximum_marks_gps_not_applicable() {
     let last_inflation = report.stages[0].steps.last().unwrap();
     assert_eq!(last_inflation.gps_applicable, Some(false));
 }
+
+/// `[output] iterations = true`: one iterations.csv row per Newton linearization, under the
+/// steps.csv row of the step it led to. Every step has its iterations plus the converged check
+/// (`newton_iterations` + 1 rows; the first step after a fresh start also carries the prestress
+/// solve), the residual of each step's last row is below the tolerance, and a second run into the
+/// same folder with `Overwrite` starts the file afresh.
+#[test]
+fn iterations_csv_accounts_for_every_newton_iteration() {
+    let case = Case::parse(&format!("{SMALL}{SQUEEZE}\n[output]\niterations = true\n")).unwrap();
+    let out = tmp("iterations");
+    for mode in [FolderMode::Fresh, FolderMode::Overwrite] {
+        let mut writer = RunWriter::create(&out, mode, case.hash())
+            .unwrap()
+            .frames_of(case.output);
+        let report = run(&case, "small", &mut [&mut writer])
+            .into_result()
+            .unwrap();
+        let text = std::fs::read_to_string(out.join("iterations.csv")).unwrap();
+        let rows: Vec<Vec<f64>> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        let steps: Vec<_> = report.steps().collect();
+        for (k, rec) in steps.iter().enumerate() {
+            let mine: Vec<&Vec<f64>> = rows.iter().filter(|r| r[0] == (k + 1) as f64).collect();
+            assert!(!mine.is_empty(), "no iterations for row {}", k + 1);
+            assert!(mine
+                .iter()
+                .all(|r| r[1] == rec.stage as f64 && r[2] == rec.step as f64));
+            let after_start = k == 0 || (rec.step == 1 && rec.stage == 1);
+            if !after_start {
+                assert_eq!(mine.len(), rec.newton_iterations + 1, "row {}", k + 1);
+            }
+            let last = mine.last().unwrap();
+            assert!(last[8] <= 1e-9, "row {}: residual {}", k + 1, last[8]);
+            // the times are non-negative seconds
+            assert!(last[4..8].iter().all(|t| *t >= 0.0));
+        }
+        assert_eq!(
+            rows.len(),
+            rows.iter().filter(|r| r[0] as usize <= steps.len()).count()
+        );
+    }
+}
