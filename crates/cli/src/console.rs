@@ -207,9 +207,14 @@ impl Observer for Console {
             // counted in the stage's closing lines; each is in critical_points.csv
             return Ok(());
         }
+        // the 4-node mesh's polygon factor 1/cos(π/n); the 9-node element has none (factor 1)
+        let factor = match r.polygon_factor {
+            Some(f) if f != 1.0 => " × 1/cos(π/n)",
+            _ => "",
+        };
         let gps = match (&r.reference, r.w_error_over_polygon) {
             (Some(g), Some(e)) => format!(
-                " (vs {} ϖ = {:.7} at λs = {:.5}: FE/(closed form × 1/cos(π/n)) − 1 = {e:+.2e})",
+                " (vs {} ϖ = {:.7} at λs = {:.5}: FE/(closed form{factor}) − 1 = {e:+.2e})",
                 g.what, g.w, g.lambda_s
             ),
             (Some(g), None) => format!(" ({} ϖ = {:.6} at λs = {:.5})", g.what, g.w, g.lambda_s),
