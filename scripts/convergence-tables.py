@@ -162,7 +162,7 @@ def main(argv=None):
     results = {"reference_profile_self_difference": ref_err, "elements": {}}
     lines = [f"Convergence tables (`{' '.join(['scripts/convergence-tables.py'] + (argv or sys.argv[1:]))}`): "
              f"L/R = {LENGTH:g}, eighth model, along = 2.5 × around, ABB N = 30.",
-             "Errors are relative (FE/reference − 1) except the profile's, which is max |Δλs| over the cylinder;",
+             "Errors are relative (FE/reference − 1) except the profile's, which is the largest Δλs over the cylinder;",
              "p is the observed order between a mesh and the one before it.",
              f"The axisymmetric reference (640 + 128 P2 elements) differs from itself at half resolution by {ref_err:.1e} in λs.", ""]
     for element, arounds in fams.items():
@@ -183,7 +183,7 @@ def main(argv=None):
         cols = ["w", "lambda_z", "n_z", "sq_lambda_s", "sq_lambda_z", "sq_chi", "sq_force", "profile"]
         ps = {c: orders([r[c] for r in rows], arounds) for c in cols}
         results["elements"][element] = {"rows": rows, "orders": ps}
-        names = ["ϖ", "λz", "N_z", "sq. λs", "sq. λz", "sq. χ", "sq. force", "profile |Δλs|"]
+        names = ["ϖ", "λz", "N_z", "sq. λs", "sq. λz", "sq. χ", "sq. force", "profile max Δλs"]
         lines.append(f"**{element}**")
         lines.append("")
         lines.append("| around | equations | wall s | " + " | ".join(f"{nm} | p" for nm in names) + " |")
