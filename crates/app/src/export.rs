@@ -107,11 +107,11 @@ pub fn abaqus_deck(
     for (i, plan) in case.plan().iter().enumerate() {
         let stage = i + 1;
         let kind = match case.stages[i].kind {
-            Kind::Inflate => "inflate",
-            Kind::Squeeze => "squeeze",
-            Kind::Confine => "confine",
+            Kind::Inflate => None,
+            Kind::Squeeze => Some("squeeze"),
+            Kind::Confine => Some("confine"),
         };
-        if kind != "inflate" {
+        if let Some(kind) = kind {
             return unsupported(format!(
                 "stage {stage} ({kind}): closed gas and rigid planes are not exported (CalculiX has no fluid cavity); export the inflation stages alone"
             ));
@@ -133,7 +133,11 @@ pub fn abaqus_deck(
                     "stage {stage}: a volume-ratio target is not exported (neither code's pressure-controlled *STATIC can hold a volume); give target_pressure or target_stretch"
                 ))
             }
-            _ => unreachable_target(stage)?,
+            Target::Rho(_) | Target::Confine(_) => {
+                return unsupported(format!(
+                    "stage {stage}: only inflation targets are exported"
+                ))
+            }
         };
         pressures.push((w, plan.steps));
     }
@@ -235,12 +239,6 @@ pub fn abaqus_deck(
         s.push_str("*NODE PRINT, NSET=MIDSPAN\nU\n*NODE PRINT, NSET=NEXT\nU\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n");
     }
     Ok(s)
-}
-
-fn unreachable_target(stage: usize) -> Result<f64, ExportError> {
-    Err(ExportError::Unsupported(format!(
-        "stage {stage}: only inflation targets are exported"
-    )))
 }
 
 /// The reference height of the first ring of element corners above z = 0 on the cylinder.

@@ -11,7 +11,7 @@
 use crate::geometry::{RefElement, Vec3};
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector};
 use tubemem_material::{MaterialError, MembraneLaw};
-pub use tubemem_mesh::volume::{Matrix12, Matrix27, Vector12, Vector27};
+pub use tubemem_mesh::volume::{Matrix12, Vector12};
 
 /// The right Cauchy–Green components (C11, C22, C12) of the gradient columns f_1, f_2.
 pub fn cauchy_green(f: &[Vec3; 2]) -> [f64; 3] {

@@ -124,10 +124,6 @@ impl Elements {
         let n = self.nodes(e);
         [n[0], n[1], n[2], n[3]]
     }
-    /// The number of Gauss points of element `e`.
-    pub fn gauss_points(&self, e: usize) -> usize {
-        with_elements!(self, v => v[e].gauss.len())
-    }
     pub fn kind(&self) -> ElementKind {
         match self {
             Elements::Quad4(_) => ElementKind::Quad4,

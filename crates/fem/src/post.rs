@@ -124,9 +124,15 @@ impl Ring {
             let ang = |i: usize| mesh.nodes[i][1].atan2(mesh.nodes[i][0]);
             ang(a).total_cmp(&ang(b))
         });
+        Self::of(model, nodes)
+    }
+
+    /// The ring of `nodes` (sorted by angle) of `model`'s mesh: closed or not by its symmetry,
+    /// quadratic for 9-node elements.
+    fn of(model: &Model, nodes: Vec<usize>) -> Self {
         Self {
             nodes,
-            closed: mesh.symmetry.rings_closed(),
+            closed: model.mesh().symmetry.rings_closed(),
             quadratic: model.elements().kind() == tubemem_mesh::ElementKind::Quad9,
         }
     }
@@ -447,7 +453,6 @@ pub fn ring_profile(
         }
     }
     let half_gap = contact.and_then(Contact::half_gap);
-    let closed = mesh.symmetry.rings_closed();
     // every element's projected resultants once (in parallel; collected in element order, so
     // the result does not depend on the thread count), and the volume once
     let projected = {
@@ -477,11 +482,7 @@ pub fn ring_profile(
                 let ang = |i: usize| mesh.nodes[i][1].atan2(mesh.nodes[i][0]);
                 ang(a).total_cmp(&ang(b))
             });
-            let ring = Ring {
-                nodes: ring_nodes,
-                closed,
-                quadratic: model.elements().kind() == tubemem_mesh::ElementKind::Quad9,
-            };
+            let ring = Ring::of(model, ring_nodes);
             let n = ring.nodes.len() as f64;
             Ok(RingValues {
                 z_ref: z,

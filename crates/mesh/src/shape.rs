@@ -67,13 +67,6 @@ pub enum ElementKind {
 }
 
 impl ElementKind {
-    /// Nodes per element.
-    pub fn nodes(self) -> usize {
-        match self {
-            ElementKind::Quad4 => 4,
-            ElementKind::Quad9 => 9,
-        }
-    }
     /// Gauss points per direction of the full rule.
     pub fn gauss_per_direction(self) -> usize {
         match self {

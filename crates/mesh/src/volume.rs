@@ -22,10 +22,6 @@ use nalgebra::{SMatrix, SVector, Vector3};
 pub type Vector12 = SVector<f64, 12>;
 /// 12 × 12 element matrix.
 pub type Matrix12 = SMatrix<f64, 12, 12>;
-/// 27 element dofs of the 9-node element.
-pub type Vector27 = SVector<f64, 27>;
-/// 27 × 27 element matrix.
-pub type Matrix27 = SMatrix<f64, 27, 27>;
 
 /// Position and tangent vectors g1 = ∂x/∂ξ, g2 = ∂x/∂η of a bilinear quad at (ξ, η).
 pub fn tangents(x: &[Vector3<f64>; 4], xi: f64, eta: f64) -> [Vector3<f64>; 3] {
