@@ -196,7 +196,7 @@ pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, 
     let touching = ring.touching(model);
     let projected = touching
         .iter()
-        .map(|&e| projected_resultants(model, state, e))
+        .map(|&e| projected_resultants(model, e, &gauss_samples(model, e, &state.x)))
         .collect::<Result<Vec<_>, _>>()?;
     let pr = &projected;
     ring_state_of(
@@ -212,11 +212,14 @@ pub fn ring_state(model: &Model, state: &State, ring: &Ring) -> Result<MidSpan, 
 /// (t·Nt, a·Na, t·Na) at the Gauss points of element `e`: the resultants projected on the
 /// current hoop tangent t (image of the reference hoop direction, made horizontal) and the axial
 /// direction a in the tangent plane. They do not depend on the ring, so a profile computes them
-/// once per element.
-fn projected_resultants(model: &Model, state: &State, e: usize) -> Result<Vec<[f64; 3]>, FemError> {
-    let samples = gauss_samples(model, e, &state.x);
+/// once per element (from its Gauss points `samples`).
+fn projected_resultants(
+    model: &Model,
+    e: usize,
+    samples: &[GaussSample],
+) -> Result<Vec<[f64; 3]>, FemError> {
     let mut out = vec![[0.0; 3]; samples.len()];
-    for (g, (o, sp)) in out.iter_mut().zip(&samples).enumerate() {
+    for (g, (o, sp)) in out.iter_mut().zip(samples).enumerate() {
         let f = sp.f;
         let ps = point_state_of(model.law(), &f).map_err(|source| FemError::Material {
             element: e,
@@ -455,24 +458,29 @@ pub fn ring_profile(
     let half_gap = contact.and_then(Contact::half_gap);
     // every element's projected resultants once (in parallel; collected in element order, so
     // the result does not depend on the thread count), and the volume once
-    let projected = {
+    // each element's Gauss points once: its projected resultants and, against plates, its
+    // contact force
+    let per_element = {
         use rayon::prelude::*;
         (0..model.elements().len())
             .into_par_iter()
-            .map(|e| projected_resultants(model, state, e))
-            .collect::<Result<Vec<_>, _>>()?
+            .map(|e| {
+                let samples = gauss_samples(model, e, &state.x);
+                let force = match (contact, half_gap) {
+                    (Some(c), Some(h)) => element_contact_force(&samples, c, h),
+                    _ => 0.0,
+                };
+                Ok((projected_resultants(model, e, &samples)?, force))
+            })
+            .collect::<Result<Vec<_>, FemError>>()?
+    };
+    let (projected, forces): (Vec<Vec<[f64; 3]>>, Vec<f64>) = per_element.into_iter().unzip();
+    let forces = if half_gap.is_some() && contact.is_some() {
+        forces
+    } else {
+        vec![]
     };
     let volume = model.total_volume(&state.x);
-    let forces: Vec<f64> = match (contact, half_gap) {
-        (Some(c), Some(h)) => {
-            use rayon::prelude::*;
-            (0..model.elements().len())
-                .into_par_iter()
-                .map(|e| element_contact_force(&gauss_samples(model, e, &state.x), c, h))
-                .collect()
-        }
-        _ => vec![],
-    };
     heights
         .iter()
         .zip(nodes)
