@@ -63,7 +63,7 @@ fn bulge(length: f64) -> BulgeRun {
         &mut state,
         &stage,
         None,
-        None,
+        tubemem_fem::continuation::ArcLoading::Pressure(None),
         &monitor,
         1.0,
         None,

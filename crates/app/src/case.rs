@@ -43,6 +43,12 @@
 //!                       # switch to the branch along the critical mode (default "stay")
 //! target_stretch = 1.3  # mid-span hoop stretch λs*
 //! steps = 6             # initial number of load steps (adaptive afterwards)
+//!
+//! [[stage]]
+//! kind = "squeeze"      # the gas closed (Boyle); plates y = ±ρR
+//! target_rho = 0.8
+//! control = "arc-length" # optional (squeeze and confine): continue the plates' travel by arc
+//!                       # length in (x, plate position), critical points located on the way
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -336,7 +342,8 @@ pub enum ControlKind {
 #[serde(deny_unknown_fields)]
 pub struct StageSpec {
     pub kind: Kind,
-    /// inflate only: "pressure" or "volume" (a squeeze keeps the gas closed)
+    /// inflate: "pressure", "volume" or "arc-length"; squeeze and confine (the gas closed):
+    /// none (load steps in the planes' travel) or "arc-length"
     pub control: Option<ControlKind>,
     /// squeeze only: the final half-gap ρ = r/R between the plates
     pub target_rho: Option<f64>,
@@ -409,7 +416,12 @@ impl StagePlan {
             Target::Pressure(p) => format!("inflate, arc-length continuation to ϖ = {p}"),
             Target::Stretch(s) => format!("inflate, arc-length continuation to mid-span λs = {s}"),
             Target::VolumeRatio(r) => format!("inflate, arc-length continuation to V/V0 = {r}"),
-            _ => self.target.describe(),
+            Target::Rho(r) => {
+                format!("squeeze, closed gas, arc-length continuation of the plates to ρ = {r}")
+            }
+            Target::Confine(n) => format!(
+                "confine, closed gas, arc-length continuation of {n} planes to their targets"
+            ),
         }
     }
 }
@@ -499,18 +511,18 @@ impl StageSpec {
                 "[[stage]] {}: control = \"volume\" takes exactly one target, `target_stretch` (mid-span λs*) or `target_volume_ratio`",
                 i + 1
             ),
-            (Kind::Squeeze, Some(_), _) => invalid!(
-                "[[stage]] {}: a squeeze keeps the gas closed (Boyle); it takes no `control`",
+            (Kind::Squeeze, Some(ControlKind::Pressure | ControlKind::Volume), _) => invalid!(
+                "[[stage]] {}: a squeeze keeps the gas closed (Boyle); its only `control` is \"arc-length\" (the plates' travel continued along the path)",
                 i + 1
             ),
-            (Kind::Squeeze, None, (None, None, None, Some(r))) => Target::Rho(r),
-            (Kind::Squeeze, None, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
-            (Kind::Confine, Some(_), _) => invalid!(
-                "[[stage]] {}: a confine stage keeps the gas closed (Boyle); it takes no `control`",
+            (Kind::Squeeze, None | Some(ControlKind::ArcLength), (None, None, None, Some(r))) => Target::Rho(r),
+            (Kind::Squeeze, _, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
+            (Kind::Confine, Some(ControlKind::Pressure | ControlKind::Volume), _) => invalid!(
+                "[[stage]] {}: a confine stage keeps the gas closed (Boyle); its only `control` is \"arc-length\" (the planes' travel continued along the path)",
                 i + 1
             ),
-            (Kind::Confine, None, (None, None, None, None)) => Target::Confine(self.plane.len()),
-            (Kind::Confine, None, _) => invalid!(
+            (Kind::Confine, None | Some(ControlKind::ArcLength), (None, None, None, None)) => Target::Confine(self.plane.len()),
+            (Kind::Confine, _, _) => invalid!(
                 "[[stage]] {}: kind = \"confine\" moves its [[stage.plane]]s to their `target`s; it takes no target_pressure, target_stretch, target_volume_ratio or target_rho",
                 i + 1
             ),

@@ -4,8 +4,8 @@
 use crate::case::{Caps, Case, PenaltySpec, StagePlan, Target};
 use crate::report::*;
 use crate::{AppError, Result};
-use tubemem_fem::contact::{penalty_for, Contact};
-use tubemem_fem::continuation::{run_arc_stage, Critical, CriticalKind};
+use tubemem_fem::contact::{penalty_for, Contact, MovingPlanes};
+use tubemem_fem::continuation::{run_arc_stage, ArcLoading, Critical, CriticalKind};
 use tubemem_fem::model::{nearest_node, Load, Loading, Model, State};
 use tubemem_fem::post::{cell_values, midspan, midspan_contact, ring_profile, Regime};
 use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepInfo, StepSettings};
@@ -100,7 +100,7 @@ fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Opti
     };
     let mut path = MembranePath {
         model,
-        load: Load::pressure(state.p),
+        loading: ArcLoading::Pressure(None),
         last: None,
     };
     let mut found = None;
@@ -141,6 +141,7 @@ struct PendingCritical {
 fn critical_record(
     model: &mut Model,
     c: &Critical<State>,
+    load: &Load,
     stage: usize,
     limits: Option<&tubemem_gps::limits::Limits>,
     polygon: Option<f64>,
@@ -171,9 +172,8 @@ fn critical_record(
         }),
     });
     let (mode, mode_eigenvalue) = if c.kind == CriticalKind::Bifurcation {
-        let load = Load::pressure(c.state.p);
         let (v, mu) =
-            model.smallest_mode(&c.state, &load, tubemem_fem::continuation::MODE_ITERATIONS)?;
+            model.smallest_mode(&c.state, load, tubemem_fem::continuation::MODE_ITERATIONS)?;
         let mut x = vec![[0.0; 3]; c.state.x.len()];
         model.free_update(&mut x, &v, 1.0);
         (Some(x), Some(mu))
@@ -785,6 +785,18 @@ fn setup_stage(
     })
 }
 
+/// The planes of a confine stage as functions of its load parameter t (for arc length):
+/// [`fe_planes`] at t, the offsets linear in t.
+pub fn fe_moving_planes(planes: &[crate::case::PlaneSpec], penalty: f64) -> MovingPlanes {
+    MovingPlanes {
+        at_zero: fe_planes(planes, 0.0, penalty),
+        rates: planes
+            .iter()
+            .map(|p| -(p.target - p.offset) / p.normal[0].hypot(p.normal[1]))
+            .collect(),
+    }
+}
+
 /// The FE contact of a confine stage at load parameter `t`: each wall n·x ≤ d as the kernel's
 /// plane with gap −n·x + d ≥ 0 (unit normal, in the cross-section plane).
 pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Contact {
@@ -957,6 +969,7 @@ fn run_inner(
                     ck.previous.as_ref().map(|(x, p)| State {
                         x: x.clone(),
                         p: *p,
+                        planes: 0.0,
                     }),
                 )),
                 ck.steps.clone(),
@@ -1029,12 +1042,18 @@ fn run_inner(
             }
             _ => None,
         };
-        // a resumed arc-length stage goes on in the direction its last two steps went
+        // a resumed arc-length stage goes on in the direction its last two steps went (in ϖ,
+        // or in the planes' parameter with the gas closed)
+        let closed_gas = matches!(plan.target, Target::Rho(_) | Target::Confine(_));
         let direction = match steps.as_slice() {
-            [.., a, b] if b.midspan.w < a.midspan.w => -1.0,
+            [.., a, b] if closed_gas && b.load < a.load => -1.0,
+            [.., a, b] if !closed_gas && b.midspan.w < a.midspan.w => -1.0,
             _ => 1.0,
         };
         let mut criticals: Vec<CriticalRecord> = restored_critical;
+        // a closed-gas arc-length stage: the planes where the stage starts, or where its last
+        // converged step left them
+        let planes_start = steps.last().map_or(context.from, |r| r.load);
         // the last limit point before a restart, for the ripple test of the next one
         let last_limit_w0 = criticals
             .iter()
@@ -1209,8 +1228,24 @@ fn run_inner(
             let monitor: Box<dyn Fn(&State) -> f64> = match plan.target {
                 Target::Pressure(_) => Box::new(|s: &State| s.p),
                 Target::Stretch(_) => Box::new(move |s: &State| s.x[node][0]),
-                _ => Box::new(move |s: &State| mult * mesh.volume_at(&s.x)),
+                Target::VolumeRatio(_) => Box::new(move |s: &State| mult * mesh.volume_at(&s.x)),
+                // closed gas: the planes' own parameter (the half-gap h, or t of a confine)
+                Target::Rho(_) | Target::Confine(_) => Box::new(|s: &State| s.planes),
             };
+            let loading = match plan.target {
+                Target::Rho(_) => ArcLoading::ClosedGas {
+                    pv,
+                    planes: MovingPlanes::plates(penalty),
+                },
+                Target::Confine(_) => ArcLoading::ClosedGas {
+                    pv,
+                    planes: fe_moving_planes(&case.stages[i - 1].plane, penalty),
+                },
+                _ => ArcLoading::Pressure(None),
+            };
+            if let ArcLoading::ClosedGas { .. } = loading {
+                state.planes = planes_start;
+            }
             let limits = gps_limits.as_ref();
             let polygon = case.mesh.polygon_factor();
             let last_limit = std::cell::Cell::new(last_limit_w0);
@@ -1219,7 +1254,7 @@ fn run_inner(
                 &mut state,
                 &stage,
                 progress.map(|(p, _)| p),
-                None,
+                loading.clone(),
                 &*monitor,
                 direction,
                 plan.follow_stable.then_some(BRANCH_SWITCH_FRACTION),
@@ -1228,6 +1263,7 @@ fn run_inner(
                     critical_record(
                         m,
                         c,
+                        &loading.load_at(&c.state),
                         i,
                         limits,
                         polygon,

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use tubemem_app::case::Case;
 use tubemem_app::output::{ring_row, step_row, FolderMode, RunWriter, PROFILES_HEADER};
-use tubemem_app::report::StageOutcome;
+use tubemem_app::report::{StageOutcome, StepRecord};
 use tubemem_app::run::run;
 
 /// The small tube shared with the CLI and Python tests.
@@ -598,4 +598,70 @@ fn iterations_csv_accounts_for_every_newton_iteration() {
             rows.iter().filter(|r| r[0] as usize <= steps.len()).count()
         );
     }
+}
+
+/// Squeeze and confine stages continued by arc length (`control = "arc-length"`: the plates'
+/// travel and the state as one path, the gas closed) end where their load-stepped runs end: ϖ,
+/// λs, λz and the plate force to 1e-7 (both stop Newton at 1e-9 of the residual, as in
+/// `a_confine_stage_with_two_plates_is_the_squeeze`); the last step lies on the target (the
+/// plates' position located to 1e-10 of it), steps.csv carries the arc length, and the path has
+/// no negative pivot (a squeeze of a pressurized tube is stable). Pressure or volume control on
+/// a closed-gas stage is refused with the stage.
+#[test]
+fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
+    let arc =
+        |stage: &str| stage.replacen("steps = 4\n", "steps = 4\ncontrol = \"arc-length\"\n", 1);
+    let plates = "\n[[stage]]\nkind = \"confine\"\nsteps = 4\n[[stage.plane]]\nnormal = [0, 1]\noffset = 1.21\ntarget = 1.0\n[[stage.plane]]\nnormal = [0, -1]\noffset = 1.21\ntarget = 1.0\n";
+    for (stage, target) in [(SQUEEZE, 1.0), (plates, 1.0)] {
+        let stepped = Case::parse(&format!("{SMALL}{stage}")).unwrap();
+        let continued = Case::parse(&format!("{SMALL}{}", arc(stage))).unwrap();
+        assert!(continued.plan()[1].arc_length);
+        let out = tmp("closed-gas-arc");
+        let mut writer = RunWriter::create(&out, FolderMode::Fresh, continued.hash()).unwrap();
+        let rs = run(&stepped, "stepped", &mut []).into_result().unwrap();
+        let rc = run(&continued, "arc", &mut [&mut writer])
+            .into_result()
+            .unwrap();
+        let (a, b) = (rs.steps().last().unwrap(), rc.steps().last().unwrap());
+        let rel = |x: f64, y: f64| (x / y - 1.0).abs();
+        for (x, y) in [
+            (b.midspan.w, a.midspan.w),
+            (b.midspan.lambda_s, a.midspan.lambda_s),
+            (b.midspan.lambda_z, a.midspan.lambda_z),
+        ] {
+            assert!(rel(x, y) < 1e-7, "{x} vs {y}");
+        }
+        let force = |r: &StepRecord| match &r.contact {
+            Some(c) => c.values.force,
+            None => r.walls[0].force,
+        };
+        assert!(rel(force(b), force(a)) < 1e-6, "{} {}", force(b), force(a));
+        // the load is the plates' half-gap (squeeze) or the planes' parameter t (confine)
+        let end = if stage == SQUEEZE { target } else { 1.0 };
+        assert!((b.load - end).abs() <= 1e-10, "{}", b.load);
+        let stage2: Vec<_> = rc.steps().filter(|s| s.stage == 2).collect();
+        assert!(stage2
+            .iter()
+            .all(|s| s.negative_pivots == 0 && s.arc.is_some()));
+        let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+        assert!(
+            column(&csv, "arc_length")
+                .last()
+                .unwrap()
+                .parse::<f64>()
+                .unwrap()
+                > 0.0
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    let err = Case::parse(&format!(
+        "{SMALL}{}",
+        SQUEEZE.replacen("steps = 4\n", "steps = 4\ncontrol = \"volume\"\n", 1)
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("[[stage]] 2") && err.contains("only `control` is \"arc-length\""),
+        "{err}"
+    );
 }

@@ -108,6 +108,29 @@ impl Contact {
         energy
     }
 
+    /// Add one element's ∂r/∂λ for planes whose offsets move as d_k(λ) with dd_k/dλ =
+    /// `rates[k]`: the gap g = n·x − d_k falls by dd_k, so ∂r_a/∂d_k = −w N_a n where g < 0.
+    pub fn rate_kernel<const N: usize, const D: usize>(
+        &self,
+        re: &RefElement<N>,
+        xe: &[Vec3; N],
+        rates: &[f64],
+        q: &mut SVector<f64, D>,
+    ) {
+        for (g, gp) in re.gauss.iter().enumerate() {
+            let n = &gp.n;
+            let p = re.position(g, xe);
+            for (plane, rate) in self.planes.iter().zip(rates) {
+                if plane.gap_at(&p) >= 0.0 || *rate == 0.0 {
+                    continue;
+                }
+                let w = gp.w * self.penalty;
+                let u = SVector::<f64, D>::from_fn(|row, _| n[row / 3] * plane.normal[row % 3]);
+                q.axpy(-w * rate, &u, 1.0);
+            }
+        }
+    }
+
     /// Mean contact pressure per current area of an element (for output).
     pub fn element_pressure<const N: usize>(&self, re: &RefElement<N>, xe: &[Vec3; N]) -> f64 {
         let mut s = 0.0;
@@ -120,6 +143,36 @@ impl Contact {
             }
         }
         s
+    }
+}
+
+/// Planes moved by one load parameter λ: plane k's offset is d_k(0) + `rates[k]`·λ (the plates
+/// of a squeeze with λ the half-gap h, or the planes of a confine stage with λ ∈ [0, 1]). The
+/// load parameter of a closed-gas arc-length path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MovingPlanes {
+    /// the planes at λ = 0
+    pub at_zero: Contact,
+    /// dd_k/dλ, one per plane
+    pub rates: Vec<f64>,
+}
+
+impl MovingPlanes {
+    /// The two plates y = ±h of [`Contact::plates`], λ = h.
+    pub fn plates(penalty: f64) -> Self {
+        Self {
+            at_zero: Contact::plates(0.0, penalty),
+            rates: vec![-1.0, -1.0],
+        }
+    }
+
+    /// The planes at λ.
+    pub fn at(&self, lambda: f64) -> Contact {
+        let mut c = self.at_zero.clone();
+        for (p, r) in c.planes.iter_mut().zip(&self.rates) {
+            p.offset += r * lambda;
+        }
+        c
     }
 }
 

@@ -859,22 +859,67 @@ mod tests;
 /// eigenvalues, which is tiny; 8 solves leave the mode converged to rounding.
 pub const MODE_ITERATIONS: usize = 8;
 
-/// The membrane model as a [`Path`]: u the free dofs, λ the reduced pressure ϖ, under the
-/// planes of `load` (its own control is replaced by the arc-length constraint). The weight of
-/// the displacements is 1/n_eq, so that ‖Δu‖ is their root mean square (in R), of the same order
-/// as Δϖ.
+/// What a membrane arc-length path varies as its load parameter λ.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ArcLoading {
+    /// λ = ϖ, the reduced pressure, under fixed planes (if any)
+    Pressure(Option<crate::contact::Contact>),
+    /// λ = the planes' parameter (`State::planes`), the gas closed in with Boyle's constant
+    /// `pv`: a squeeze or confine stage continued by arc length
+    ClosedGas {
+        pv: f64,
+        planes: crate::contact::MovingPlanes,
+    },
+}
+
+/// The membrane model as a [`Path`]: u the free dofs, λ the reduced pressure ϖ or the planes'
+/// parameter ([`ArcLoading`]). The weight of the displacements is 1/n_eq, so that ‖Δu‖ is their
+/// root mean square (in R), of the same order as Δϖ and as a plate's travel.
 pub struct MembranePath<'a> {
     pub model: &'a mut crate::model::Model,
-    pub load: crate::model::Load,
+    pub loading: ArcLoading,
     /// the report of the last successful corrector
     pub last: Option<crate::newton::NewtonReport>,
+}
+
+impl ArcLoading {
+    /// The load at the state `s` of the path (the planes where λ puts them).
+    pub fn load_at(&self, s: &crate::model::State) -> crate::model::Load {
+        use crate::model::{Load, Loading};
+        match self {
+            ArcLoading::Pressure(contact) => Load {
+                loading: Loading::Pressure(s.p),
+                contact: contact.clone(),
+            },
+            ArcLoading::ClosedGas { pv, planes } => {
+                Load::with_contact(Loading::Gas { pv: *pv }, planes.at(s.planes))
+            }
+        }
+    }
+}
+
+impl MembranePath<'_> {
+    /// The load at the state `s` of the path.
+    pub fn load_at(&self, s: &crate::model::State) -> crate::model::Load {
+        self.loading.load_at(s)
+    }
+}
+
+fn problem_error(source: crate::FemError) -> crate::newton::NewtonError<crate::FemError> {
+    crate::newton::NewtonError::Problem {
+        iteration: 0,
+        source,
+    }
 }
 
 impl Path for MembranePath<'_> {
     type State = crate::model::State;
     type Error = crate::newton::NewtonError<crate::FemError>;
     fn load(&self, s: &Self::State) -> f64 {
-        s.p
+        match self.loading {
+            ArcLoading::Pressure(_) => s.p,
+            ArcLoading::ClosedGas { .. } => s.planes,
+        }
     }
     fn weight(&self) -> f64 {
         1.0 / self.model.n_eq().max(1) as f64
@@ -885,31 +930,29 @@ impl Path for MembranePath<'_> {
     fn predict(&self, base: &Self::State, tu: &[f64], tl: f64, ds: f64) -> Self::State {
         let mut s = base.clone();
         self.model.free_update(&mut s.x, tu, ds);
-        s.p += ds * tl;
+        match self.loading {
+            ArcLoading::Pressure(_) => s.p += ds * tl,
+            ArcLoading::ClosedGas { .. } => s.planes += ds * tl,
+        }
         s
     }
     fn tangent(&mut self, s: &Self::State) -> Result<Tangent, Self::Error> {
-        let (b, g, negative) = self
-            .model
-            .pressure_tangent(s, &self.load)
-            .map_err(|source| crate::newton::NewtonError::Problem {
-                iteration: 0,
-                source,
-            })?;
+        let (b, g, negative) = match &self.loading {
+            ArcLoading::Pressure(_) => {
+                let load = self.load_at(s);
+                self.model.pressure_tangent(s, &load)
+            }
+            ArcLoading::ClosedGas { pv, planes } => self.model.plane_tangent(s, *pv, planes),
+        }
+        .map_err(problem_error)?;
         Ok(Tangent::new(b, &g, negative))
     }
     fn critical_mode(&mut self, s: &Self::State) -> Result<Option<Vec<f64>>, Self::Error> {
-        let load = crate::model::Load {
-            loading: crate::model::Loading::Pressure(s.p),
-            contact: self.load.contact.clone(),
-        };
+        let load = self.load_at(s);
         self.model
             .smallest_mode(s, &load, MODE_ITERATIONS)
             .map(|(v, _)| Some(v))
-            .map_err(|source| crate::newton::NewtonError::Problem {
-                iteration: 0,
-                source,
-            })
+            .map_err(problem_error)
     }
     fn correct(
         &mut self,
@@ -918,13 +961,22 @@ impl Path for MembranePath<'_> {
     ) -> Result<usize, Self::Error> {
         let c = crate::model::ArcConstraint {
             x0: &arc.base.x,
-            p0: arc.base.p,
+            p0: self.load(arc.base),
             tx: arc.tu,
             tp: arc.tl,
             w: arc.w,
             ds: arc.ds,
         };
-        let r = self.model.solve_arc(s, &self.load, &c)?;
+        let r = match &self.loading {
+            ArcLoading::Pressure(contact) => {
+                let load = crate::model::Load {
+                    loading: crate::model::Loading::Pressure(s.p),
+                    contact: contact.clone(),
+                };
+                self.model.solve_arc(s, &load, &c)?
+            }
+            ArcLoading::ClosedGas { pv, planes } => self.model.solve_arc_gas(s, *pv, planes, &c)?,
+        };
         let it = r.iterations;
         self.last = Some(r);
         Ok(it)
@@ -946,7 +998,7 @@ pub fn run_arc_stage<E>(
     state: &mut crate::model::State,
     stage: &Stage,
     resume: Option<StepState>,
-    contact: Option<crate::contact::Contact>,
+    loading: ArcLoading,
     monitor: &dyn Fn(&crate::model::State) -> f64,
     first_direction: f64,
     switch_fraction: Option<f64>,
@@ -956,7 +1008,6 @@ pub fn run_arc_stage<E>(
         &Critical<crate::model::State>,
     ) -> Result<(), E>,
 ) -> Result<Vec<Critical<crate::model::State>>, StageError<E>> {
-    use crate::model::{Load, Loading};
     use crate::FemError;
     let settings = ArcSettings {
         initial_steps: stage.settings.initial_steps,
@@ -967,13 +1018,9 @@ pub fn run_arc_stage<E>(
         switch_fraction,
         ..ArcSettings::default()
     };
-    let load = Load {
-        loading: Loading::Pressure(state.p),
-        contact,
-    };
     let mut path = MembranePath {
         model,
-        load,
+        loading,
         last: None,
     };
     let target = Target {
@@ -1016,10 +1063,7 @@ pub fn run_arc_stage<E>(
                         } else {
                             ((s.monitor - stage.from) / span).min(1.0 - 1e-12)
                         },
-                        load: &Load {
-                            loading: Loading::Pressure(s.load),
-                            contact: path.load.contact.clone(),
-                        },
+                        load: &path.load_at(s.state),
                         newton: &newton,
                         dw_ds: s.tl,
                         negative_conjugate: Some(s.negative_pivots_conjugate),
@@ -1057,21 +1101,23 @@ pub fn run_arc_stage<E>(
             step,
             ds,
             cuts,
-            load,
+            load: _,
             source,
         } => StageError::Solve(FemError::Arc {
             stage: index,
             step: step0 + step,
-            p: load,
+            // the pressure of the last converged state (the path's load parameter may be a
+            // plate position)
+            p: state.p,
             what: format!(
                 "no convergence after {cuts} halvings of the arc length (last Δs = {ds:.3e})"
             ),
             source: Some(Box::new(source)),
         }),
-        ArcError::Turn { step, ds, load } => StageError::Solve(FemError::Arc {
+        ArcError::Turn { step, ds, load: _ } => StageError::Solve(FemError::Arc {
             stage: index,
             step: step0 + step,
-            p: load,
+            p: state.p,
             what: format!(
                 "the path turns by more than {:.0}° even within Δs = {ds:.3e}",
                 ArcSettings::default().min_turn_cos.acos().to_degrees()

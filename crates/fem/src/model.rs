@@ -18,7 +18,7 @@
 //! #neg(K + c ggᵀ) = #neg(K) − [1 + c gᵀK⁻¹g < 0], and on the constraint subspace
 //! #neg = #neg(K) − [hᵀK⁻¹g < 0].
 
-use crate::contact::Contact;
+use crate::contact::{Contact, MovingPlanes};
 use crate::dofs::DofMap;
 use crate::element::membrane_kernel;
 use crate::geometry::{RefElement, Vec3};
@@ -87,6 +87,9 @@ pub struct State {
     pub x: Vec<[f64; 3]>,
     /// reduced pressure ϖ
     pub p: f64,
+    /// the planes' load parameter λ of a closed-gas arc-length path ([`MovingPlanes`]);
+    /// unused (0) elsewhere
+    pub planes: f64,
 }
 
 /// The reference elements of a model: all 4-node or all 9-node.
@@ -338,6 +341,7 @@ impl Model {
         State {
             x: self.mesh.nodes.clone(),
             p: 0.0,
+            planes: 0.0,
         }
     }
 
@@ -554,6 +558,94 @@ impl Model {
         newton::solve(&mut problem, state, &settings)
     }
 
+    /// Newton iterations on equilibrium of the closed gas (Boyle's constant `pv`) pressed by
+    /// `planes` at the parameter `state.planes` (a free unknown), together with the arc-length
+    /// constraint `arc` in (x, λ); `state` is the predictor and, on success, the converged point
+    /// (its `p` the gas pressure there).
+    pub fn solve_arc_gas(
+        &mut self,
+        state: &mut State,
+        pv: f64,
+        planes: &MovingPlanes,
+        arc: &ArcConstraint<'_>,
+    ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
+        let settings = self.settings;
+        let load = &Load::new(Loading::Gas { pv });
+        let mut problem = MembraneProblem::new(self, load, Some(arc));
+        problem.planes = Some(planes);
+        newton::solve(&mut problem, state, &settings)
+    }
+
+    /// ∂R/∂λ on the free dofs for the planes `planes` at λ, at the positions `x` (the load
+    /// column of a closed-gas arc-length path).
+    pub fn plane_rate(&self, x: &[[f64; 3]], planes: &MovingPlanes, lambda: f64) -> Vec<f64> {
+        let contact = planes.at(lambda);
+        match &self.elements {
+            Elements::Quad4(els) => self.plane_rate_with::<4, 12>(els, x, &contact, &planes.rates),
+            Elements::Quad9(els) => self.plane_rate_with::<9, 27>(els, x, &contact, &planes.rates),
+        }
+    }
+
+    /// [`Model::plane_rate`] for elements of N nodes (D = 3N dofs), summed in element order.
+    fn plane_rate_with<const N: usize, const D: usize>(
+        &self,
+        elements: &[RefElement<N>],
+        x: &[[f64; 3]],
+        contact: &Contact,
+        rates: &[f64],
+    ) -> Vec<f64> {
+        let mut q = vec![0.0; self.n_eq()];
+        for el in elements {
+            let mut qe = SVector::<f64, D>::zeros();
+            contact.rate_kernel(el, &el.gather(x), rates, &mut qe);
+            for (i, v) in qe.iter().enumerate() {
+                if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {
+                    q[a] += v;
+                }
+            }
+        }
+        q
+    }
+
+    /// The path tangent of a closed-gas arc-length path at the equilibrium `state`: b =
+    /// K_gas⁻¹(−∂R/∂λ) (dx/dλ with the gas closed, K_gas = K_int − ϖH + K_c + (ϖ/V_part) g gᵀ),
+    /// −∂R/∂λ, and the negative pivots of K_gas. Factorizes K at `state`.
+    pub fn plane_tangent(
+        &mut self,
+        state: &State,
+        pv: f64,
+        planes: &MovingPlanes,
+    ) -> Result<(Vec<f64>, Vec<f64>, usize), FemError> {
+        let contact = planes.at(state.planes);
+        let a = self.assemble(&state.x, true, Some(&contact))?;
+        let p = pv / (self.multiplicity() * a.volume);
+        let (neg, _) = self.factorize(&a, p)?;
+        let minus_q: Vec<f64> = self
+            .plane_rate(&state.x, planes, state.planes)
+            .into_iter()
+            .map(|v| -v)
+            .collect();
+        let mut b = minus_q.clone();
+        let negative = self.solve_gas(&a, p, &mut b);
+        Ok((b, minus_q, neg - negative))
+    }
+
+    /// Solve K_gas y = v in place with the factor of K = K_int − ϖH (+ K_c) by Sherman–Morrison
+    /// for the closed gas's rank-one term (ϖ/V_part) g gᵀ; returns 1 when that term takes one
+    /// negative pivot away from K's count (1 + (ϖ/V) gᵀK⁻¹g < 0), else 0.
+    fn solve_gas(&self, a: &Assembled, p: f64, v: &mut [f64]) -> usize {
+        let cc = p / a.volume;
+        let mut b = a.g.clone();
+        self.ldlt.solve(&mut b);
+        self.ldlt.solve(v);
+        let denom = 1.0 + cc * dot(&a.g, &b);
+        let gv = dot(&a.g, v);
+        for (y, bb) in v.iter_mut().zip(&b) {
+            *y -= cc * bb * gv / denom;
+        }
+        usize::from(denom < 0.0)
+    }
+
     /// The path tangent under pressure as the load parameter at the equilibrium `state`:
     /// b = K⁻¹ g (dx/dϖ on the free dofs, K = K_int − ϖ H the pressure-control stiffness), g
     /// (∂V_part/∂x) and the number of negative pivots of K. Factorizes K at `state`.
@@ -569,8 +661,8 @@ impl Model {
         Ok((b, a.g, neg))
     }
 
-    /// Inverse iteration with the factor of K = K_int − ϖ H at `state`: the eigenvector of K of
-    /// smallest |eigenvalue| (unit Euclidean norm on the free dofs) and its Rayleigh quotient.
+    /// Inverse iteration with the factor of K = K_int − ϖ H at `state` (with the load's planes;
+    /// for closed gas, of K + (ϖ/V_part) g gᵀ): the eigenvector of smallest |eigenvalue| (unit Euclidean norm on the free dofs) and its Rayleigh quotient.
     /// `iterations` solves, from a start vector of ones.
     pub fn smallest_mode(
         &mut self,
@@ -579,7 +671,9 @@ impl Model {
         iterations: usize,
     ) -> Result<(Vec<f64>, f64), FemError> {
         let a = self.assemble(&state.x, true, load.contact.as_ref())?;
-        self.factorize(&a, state.p)?;
+        // closed gas: the stiffness is K + (ϖ/V) g gᵀ, solved by Sherman–Morrison
+        let gas = load.gas().map(|pv| pv / (self.multiplicity() * a.volume));
+        self.factorize(&a, gas.unwrap_or(state.p))?;
         let n = self.n_eq();
         // a start vector with a component along every mode: ones plus a deterministic ramp
         let mut v: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 / n as f64)).collect();
@@ -588,7 +682,12 @@ impl Model {
             let nv = norm(&v);
             v.iter_mut().for_each(|x| *x /= nv);
             let mut w = v.clone();
-            self.ldlt.solve(&mut w);
+            match gas {
+                Some(p) => {
+                    self.solve_gas(&a, p, &mut w);
+                }
+                None => self.ldlt.solve(&mut w),
+            }
             // Rayleigh quotient of K⁻¹: vᵀK⁻¹v, so μ(K) ≈ 1/(vᵀw)
             let vw = dot(&v, &w);
             mu = if vw != 0.0 { 1.0 / vw } else { 0.0 };
@@ -720,12 +819,15 @@ pub struct ArcConstraint<'a> {
 /// step (Δx on the free dofs, Δp). With `arc`, the pressure is an unknown and the arc-length
 /// constraint closes the system.
 /// A line-search trial's positions, its assembly (with the tangent) and the seconds it took.
-type TrialAssembly = (Vec<[f64; 3]>, Assembled, f64);
+type TrialAssembly = (State, Assembled, f64);
 
 struct MembraneProblem<'a> {
     model: &'a mut Model,
     load: &'a Load,
     arc: Option<&'a ArcConstraint<'a>>,
+    /// closed gas pressed by planes that move with `State::planes`, the arc's load parameter
+    /// (then `load.contact` is unused)
+    planes: Option<&'a MovingPlanes>,
     /// the assembly (with the tangent) of the last trial state the line search evaluated:
     /// when that trial is accepted, the next linearization is at the same state and takes it
     /// instead of assembling again
@@ -745,17 +847,29 @@ impl MembraneProblem<'_> {
             model,
             load,
             arc,
+            planes: None,
             trial: std::cell::RefCell::new(None),
             rejected_seconds: std::cell::Cell::new(0.0),
         }
     }
 
-    /// The assembly with the tangent at `x` and the seconds it took: the cached trial's if it
-    /// was made at exactly these positions (bitwise), a fresh one otherwise.
-    fn assemble_at(&self, x: &[[f64; 3]]) -> Result<(Assembled, f64), FemError> {
+    /// The planes at `state`: the load's, or the moving planes at the state's parameter.
+    fn contact(&self, state: &State) -> Option<std::borrow::Cow<'_, Contact>> {
+        match self.planes {
+            Some(m) => Some(std::borrow::Cow::Owned(m.at(state.planes))),
+            None => self.load.contact.as_ref().map(std::borrow::Cow::Borrowed),
+        }
+    }
+
+    /// The assembly with the tangent at `state` and the seconds it took: the cached trial's if
+    /// it was made at exactly these positions and planes (bitwise), a fresh one otherwise.
+    fn assemble_at(&self, state: &State) -> Result<(Assembled, f64), FemError> {
+        let x = &state.x;
         if let Some((xt, a, secs)) = self.trial.borrow_mut().take() {
-            let same = xt.len() == x.len()
+            let same = xt.x.len() == x.len()
+                && xt.planes.to_bits() == state.planes.to_bits()
                 && xt
+                    .x
                     .iter()
                     .zip(x)
                     .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()));
@@ -766,7 +880,9 @@ impl MembraneProblem<'_> {
                 .set(self.rejected_seconds.get() + secs);
         }
         let t = std::time::Instant::now();
-        let a = self.model.assemble(x, true, self.load.contact.as_ref())?;
+        let a = self
+            .model
+            .assemble(x, true, self.contact(state).as_deref())?;
         Ok((a, t.elapsed().as_secs_f64()))
     }
 
@@ -807,7 +923,7 @@ impl newton::Problem for MembraneProblem<'_> {
             return Err(FemError::Interrupted);
         }
         let m = self.model.multiplicity();
-        let (a, assembly_seconds) = self.assemble_at(&state.x)?;
+        let (a, assembly_seconds) = self.assemble_at(state)?;
         state.p = self.pressure(state.p, a.volume);
         let p = state.p;
         let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
@@ -817,8 +933,13 @@ impl newton::Problem for MembraneProblem<'_> {
             (Some(arc), _) => {
                 let d = self.model.dofs.difference(&state.x, arc.x0);
                 cp = arc.tp;
+                let lambda = if self.planes.is_some() {
+                    state.planes
+                } else {
+                    p
+                };
                 (
-                    arc.w * dot(arc.tx, &d) + arc.tp * (p - arc.p0) - arc.ds,
+                    arc.w * dot(arc.tx, &d) + arc.tp * (lambda - arc.p0) - arc.ds,
                     Some(arc.tx.iter().map(|t| arc.w * t).collect()),
                 )
             }
@@ -864,10 +985,30 @@ impl newton::Problem for MembraneProblem<'_> {
         // the Newton correction
         let ldlt = &self.model.ldlt;
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
-        ldlt.solve(&mut dx);
+        let moving = self.planes.zip(self.arc);
+        if moving.is_none() {
+            ldlt.solve(&mut dx);
+        }
         let mut dp = 0.0;
         let mut negative = neg;
-        if self.load.gas().is_some() && self.arc.is_none() {
+        if let Some((planes, arc)) = moving {
+            // closed gas with moving planes: K_gas [dx; dλ] bordered by ∂R/∂λ and the arc
+            // constraint, K_gas⁻¹ by Sherman–Morrison on the factor of K
+            negative -= self.model.solve_gas(&a, p, &mut dx);
+            let mut bq: Vec<f64> = self
+                .model
+                .plane_rate(&state.x, planes, state.planes)
+                .into_iter()
+                .map(|v| -v)
+                .collect();
+            self.model.solve_gas(&a, p, &mut bq);
+            let h: Vec<f64> = arc.tx.iter().map(|t| arc.w * t).collect();
+            let hb = dot(&h, &bq) + cp;
+            dp = (-c - dot(&h, &dx)) / hb;
+            for (d, bb) in dx.iter_mut().zip(&bq) {
+                *d += dp * bb;
+            }
+        } else if self.load.gas().is_some() && self.arc.is_none() {
             let cc = p / a.volume;
             let mut b = a.g.clone();
             ldlt.solve(&mut b);
@@ -930,7 +1071,7 @@ impl newton::Problem for MembraneProblem<'_> {
         }
         let trial = self
             .model
-            .assemble(&state.x, true, self.load.contact.as_ref())?;
+            .assemble(&state.x, true, self.contact(state).as_deref())?;
         let pt = self.pressure(state.p, trial.volume);
         let rt: Vec<f64> = trial
             .f_int
@@ -945,14 +1086,20 @@ impl newton::Problem for MembraneProblem<'_> {
             residual,
             potential: potential(self.load.loading, trial.energy, trial.volume, pt),
         };
-        *self.trial.borrow_mut() = Some((state.x.clone(), trial, t.elapsed().as_secs_f64()));
+        *self.trial.borrow_mut() = Some((state.clone(), trial, t.elapsed().as_secs_f64()));
         Ok(out)
     }
 
     fn update(&self, base: &State, step: &Self::Step, t: f64, state: &mut State) {
         state.x.clone_from(&base.x);
         self.model.dofs.apply(&mut state.x, &step.0, t);
-        state.p = base.p + t * step.1;
+        if self.planes.is_some() {
+            // the planes move; the gas pressure follows the volume (set at evaluation)
+            state.planes = base.planes + t * step.1;
+            state.p = base.p;
+        } else {
+            state.p = base.p + t * step.1;
+        }
     }
 
     fn step_size(&self, step: &Self::Step) -> f64 {
