@@ -1311,6 +1311,75 @@ fn a_killed_arc_length_run_resumes_with_its_critical_points() {
     );
 }
 
+/// A squeeze continued by arc length (the gas closed, the plates' position the path's load
+/// parameter), killed in the middle of the squeeze and resumed, ends where the uninterrupted run
+/// ends (ϖ, λs, λz and the plate force to 1e-8: the resumed continuation restarts its step
+/// lengths, so the states differ by the Newton tolerance, 1e-9 relative, not bitwise) with the
+/// plates at the target and every step of the squeeze once in steps.csv.
+#[test]
+fn a_killed_closed_gas_arc_length_run_resumes_at_its_plates() {
+    let d = tmp("resume-gas-arc");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        include_str!("../../../cases/squeeze_abb30_ls1.3_lr80.toml").replacen(
+            "kind = \"squeeze\"\n",
+            "kind = \"squeeze\"\ncontrol = \"arc-length\"\n",
+            1,
+        ),
+    )
+    .unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    let o = run_in(&case, &reference, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // killed after the third squeeze step
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("2,")).count() >= 3
+    });
+    let squeeze_rows = |dir: &std::path::Path| -> Vec<String> {
+        std::fs::read_to_string(dir.join("steps.csv"))
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("2,"))
+            .map(str::to_string)
+            .collect()
+    };
+    // killed inside the squeeze, not after it
+    let before = squeeze_rows(&killed).len();
+    assert!(before >= 3 && before < squeeze_rows(&reference).len());
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |dir: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+    };
+    // the resumed path goes on from the plates where the kill left them: ρ falls at every
+    // step (a resume that forgot them would start again from the tube's top)
+    let csv = std::fs::read_to_string(killed.join("steps.csv")).unwrap();
+    let col = csv
+        .lines()
+        .next()
+        .and_then(|h| h.split(',').position(|c| c == "rho"))
+        .unwrap();
+    let rho: Vec<f64> = squeeze_rows(&killed)
+        .iter()
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect();
+    assert!(rho.windows(2).all(|w| w[1] < w[0]), "{rho:?}");
+    let (a, b) = (read(&reference), read(&killed));
+    let (fa, fb) = (&a["stages"][1]["final"], &b["stages"][1]["final"]);
+    for k in ["w", "lambda_s", "lambda_z", "force", "rho"] {
+        let (x, y) = (fa[k].as_f64().unwrap(), fb[k].as_f64().unwrap());
+        assert!((x / y - 1.0).abs() < 1e-8, "{k}: {x} vs {y}");
+    }
+    assert!((fb["rho"].as_f64().unwrap() - 0.8).abs() < 1e-10);
+    // the squeeze's steps are numbered 1, 2, … without a gap or a repeat
+    let numbers: Vec<usize> = squeeze_rows(&killed)
+        .iter()
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(numbers, (1..=numbers.len()).collect::<Vec<_>>());
+}
+
 /// Resource guards: the 6.6 M-equation full tube is refused before anything is built (well
 /// within a second), with its estimate; a case file that is /dev/zero is read through the size
 /// limit; an overlay whose steps.csv holds NaN or NUL bytes is refused.
