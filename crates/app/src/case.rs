@@ -562,6 +562,14 @@ impl StageSpec {
                 invalid!("[[stage]] {}: the planes at their targets: {e}", i + 1);
             }
         }
+        if let Target::Rho(r) = t {
+            if r.is_finite() && r <= 0.0 {
+                invalid!(
+                    "[[stage]] {}: `target_rho` = {r}: no equilibrium there — the plates would have to pass through the tube (ρ → 0 presses it flat, its two walls meeting at y = 0; give ρ > 0)",
+                    i + 1
+                );
+            }
+        }
         let (name, v, ok) = match t {
             Target::Pressure(p) => ("target_pressure", p, p.is_finite() && p >= 0.0),
             Target::Stretch(s) => ("target_stretch", s, s.is_finite() && s >= 1.0),

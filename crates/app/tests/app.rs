@@ -606,7 +606,8 @@ fn iterations_csv_accounts_for_every_newton_iteration() {
 /// `a_confine_stage_with_two_plates_is_the_squeeze`); the last step lies on the target (the
 /// plates' position located to 1e-10 of it), steps.csv carries the arc length, and the path has
 /// no negative pivot (a squeeze of a pressurized tube is stable). Pressure or volume control on
-/// a closed-gas stage is refused with the stage.
+/// a closed-gas stage is refused with the stage, and so is a target the plates could reach only
+/// by passing through the tube (ρ ≤ 0), with "no equilibrium" and why.
 #[test]
 fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
     let arc =
@@ -653,6 +654,21 @@ fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
                 > 0.0
         );
         let _ = std::fs::remove_dir_all(&out);
+    }
+    // plates that would have to pass through the tube: refused before anything runs
+    for rho in ["0.0", "-0.5"] {
+        let err = Case::parse(&format!(
+            "{SMALL}{}",
+            SQUEEZE.replace("target_rho = 1.0", &format!("target_rho = {rho}"))
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("[[stage]] 2")
+                && err.contains("no equilibrium")
+                && err.contains("pass through the tube"),
+            "{err}"
+        );
     }
     let err = Case::parse(&format!(
         "{SMALL}{}",
