@@ -1380,6 +1380,46 @@ fn a_killed_closed_gas_arc_length_run_resumes_at_its_plates() {
     assert_eq!(numbers, (1..=numbers.len()).collect::<Vec<_>>());
 }
 
+/// The whole tube (no symmetry plane) inflated by arc length at 8 elements per R along: once
+/// the bulge has formed, sliding it along the tube costs nothing to round-off (the stiffness's
+/// smallest eigenvalue falls to 1e-17 of its diagonal, README "The whole tube and branch
+/// switching"), the path tangent is then noise and the continuation stops. The run says why —
+/// a neutral mode, mostly axial, that does not change the volume — and what to do, and keeps
+/// every converged step.
+#[test]
+fn a_whole_tube_stopped_by_its_neutral_bulge_translation_says_so() {
+    let d = tmp("neutral");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        "[geometry]\nradius = 1.0\nlength = 40.0\ncaps = \"hemisphere\"\n\n[material]\nmodel = \"abb\"\nshear_modulus = 1.0\nkuhn = 30\n\n[mesh]\naround = 8\nalong = 320\nsymmetry = \"none\"\n\n[output]\nvtu = \"none\"\n\n[[stage]]\nkind = \"inflate\"\ncontrol = \"arc-length\"\ntarget_stretch = 6.0\nsteps = 8\n",
+    )
+    .unwrap();
+    let out = d.join("out");
+    let o = run_in(&case, &out, &[]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("neutral mode")
+            && err.contains("% axial")
+            && err.contains("a bulge that can sit anywhere along the tube")
+            && err.contains("symmetry = \"half\""),
+        "{err}"
+    );
+    // measured 2026-11-30: 49 converged steps before the stop, the eigenvalue 1e-17..1e-16 of
+    // the diagonal (NEUTRAL is 1e-8)
+    let rows = std::fs::read_to_string(out.join("steps.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert!(rows >= 10, "{rows} steps kept");
+    assert!(
+        err.contains(&format!("its {rows} converged steps are in")),
+        "{err}"
+    );
+}
+
 /// Resource guards: the 6.6 M-equation full tube is refused before anything is built (well
 /// within a second), with its estimate; a case file that is /dev/zero is read through the size
 /// limit; an overlay whose steps.csv holds NaN or NUL bytes is refused.

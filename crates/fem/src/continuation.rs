@@ -859,6 +859,12 @@ mod tests;
 /// eigenvalues, which is tiny; 8 solves leave the mode converged to rounding.
 pub const MODE_ITERATIONS: usize = 8;
 
+/// Inverse iterations for the diagnosis of a stalled path ([`crate::model::Model::mode_report`]):
+/// away from a located point the two smallest eigenvalues need not be far apart, and 30 solves
+/// converge the mode of a neutral translation (eigenvalue 1e-12 of the stiffness and below) to
+/// a few digits.
+pub const NEUTRAL_ITERATIONS: usize = 30;
+
 /// What a membrane arc-length path varies as its load parameter λ.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ArcLoading {
@@ -1081,6 +1087,29 @@ pub fn run_arc_stage<E>(
             }
         },
     );
+    // a path that stalls or turns where the stiffness has a neutral mode: say so (the
+    // equilibria there form a family, and no tangent picks one member)
+    let neutral = match &result {
+        Err(ArcError::Turn { .. } | ArcError::Stalled { .. }) => {
+            let load = path.load_at(state);
+            path.model
+                .mode_report(state, &load, NEUTRAL_ITERATIONS)
+                .ok()
+                .filter(|m| m.is_neutral())
+        }
+        _ => None,
+    };
+    let why = |what: String| {
+        match neutral {
+        Some(m) => format!(
+            "{what}. At the last converged step the stiffness has a neutral mode (eigenvalue {:.1e} of its largest diagonal entry; {:.0} % axial; volume change gᵀφ/‖g‖ = {:.1e}): the equilibria there form a family — a bulge that can sit anywhere along the tube — and no path tangent picks one. Model half the tube (symmetry = \"half\" or finer) to hold the bulge at mid-span",
+            m.relative_eigenvalue,
+            100.0 * m.axial_share,
+            m.volume_change
+        ),
+        None => what,
+    }
+    };
     result.map_err(|e| match e {
         ArcError::Observer { step, source } => StageError::Observer {
             stage: index,
@@ -1109,19 +1138,19 @@ pub fn run_arc_stage<E>(
             // the pressure of the last converged state (the path's load parameter may be a
             // plate position)
             p: state.p,
-            what: format!(
+            what: why(format!(
                 "no convergence after {cuts} halvings of the arc length (last Δs = {ds:.3e})"
-            ),
+            )),
             source: Some(Box::new(source)),
         }),
         ArcError::Turn { step, ds, load: _ } => StageError::Solve(FemError::Arc {
             stage: index,
             step: step0 + step,
             p: state.p,
-            what: format!(
+            what: why(format!(
                 "the path turns by more than {:.0}° even within Δs = {ds:.3e}",
                 ArcSettings::default().min_turn_cos.acos().to_degrees()
-            ),
+            )),
             source: None,
         }),
         ArcError::Tangent { step, source } => StageError::Solve(FemError::Arc {

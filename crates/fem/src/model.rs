@@ -698,6 +698,39 @@ impl Model {
         Ok((v, mu))
     }
 
+    /// The eigenvector of smallest |eigenvalue| of the stiffness at `state` under `load` (by
+    /// `iterations` inverse iterations, [`Model::smallest_mode`]), described: μ relative to K's
+    /// largest diagonal entry, the share of the mode's squared norm in axial (z) displacements,
+    /// and gᵀφ/‖g‖ (0 for a mode that keeps the volume). [`ModeReport::is_neutral`] below
+    /// [`NEUTRAL`].
+    pub fn mode_report(
+        &mut self,
+        state: &State,
+        load: &Load,
+        iterations: usize,
+    ) -> Result<ModeReport, FemError> {
+        let (phi, mu) = self.smallest_mode(state, load, iterations)?;
+        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
+        let p = match load.gas() {
+            Some(pv) => pv / (self.multiplicity() * a.volume),
+            None => state.p,
+        };
+        let diag = self
+            .pattern
+            .diagonal()
+            .iter()
+            .map(|&d| (a.k_int[d] - p * a.k_vol[d]).abs())
+            .fold(0.0, f64::max)
+            .max(1e-300);
+        let mut u = vec![[0.0; 3]; state.x.len()];
+        self.dofs.apply(&mut u, &phi, 1.0);
+        Ok(ModeReport {
+            relative_eigenvalue: mu / diag,
+            axial_share: u.iter().map(|v| v[2] * v[2]).sum(),
+            volume_change: dot(&a.g, &phi) / norm(&a.g).max(1e-300),
+        })
+    }
+
     /// x − x0 on the free dofs.
     pub fn free_difference(&self, x: &[[f64; 3]], x0: &[[f64; 3]]) -> Vec<f64> {
         self.dofs.difference(x, x0)
@@ -761,6 +794,33 @@ impl Model {
             }
         }
         Ok(out)
+    }
+}
+
+/// The relative eigenvalue (|μ| over K's largest diagonal entry) below which a mode counts as
+/// neutral: 1e-8. Measured on the whole tube's bulging path (L/R = 40, 16 around; `cargo run
+/// --release -p tubemem-fem --example neutral_mode -- 40 PER_R 16 3`, 2026-11-30): the uniform
+/// tube's softest mode is 3e-7 (8 per R along) to 2e-6 (2 per R) of the diagonal; once the bulge
+/// has formed, its translation is 1e-10 to 1e-6 at 2 per R (the discretization's ripple, changing
+/// sign), 3e-14 to 2e-10 at 4 per R and 1e-17 to 1e-14 (round-off) at 8 per R. The bound lies
+/// below the physical modes and above the translation on the meshes where it stops the path.
+pub const NEUTRAL: f64 = 1e-8;
+
+/// The stiffness's mode of smallest |eigenvalue|, described ([`Model::mode_report`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeReport {
+    /// μ over K's largest diagonal entry
+    pub relative_eigenvalue: f64,
+    /// the share of the unit mode's squared norm in axial (z) displacements
+    pub axial_share: f64,
+    /// gᵀφ/‖g‖: how much the mode changes the enclosed volume (0: not at all)
+    pub volume_change: f64,
+}
+
+impl ModeReport {
+    /// |μ| at most [`NEUTRAL`] of the stiffness.
+    pub fn is_neutral(&self) -> bool {
+        self.relative_eigenvalue.abs() <= NEUTRAL
     }
 }
 

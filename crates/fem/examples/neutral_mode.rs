@@ -1,0 +1,101 @@
+//! The smallest eigenvalue of the pressure-control stiffness along the whole tube's symmetric
+//! bulging path, and what its mode is: the evidence behind README "The whole tube and branch
+//! switching".
+//!
+//! ```text
+//! cargo run --release -p tubemem-fem --example neutral_mode -- LENGTH PER_R AROUND [EVERY]
+//! ```
+//!
+//! The whole capped tube (no symmetry plane), ABB 𝒩 = 30, `AROUND` elements around and `PER_R`
+//! per R along, is inflated by arc length towards mid-span λs = 6 (as `tubemem run` does for an
+//! arc-length stage). At every `EVERY`-th converged step (default 1) it prints ϖ, the mid-span
+//! λs, the negative pivots of K = K_int − ϖH, and, by 30 inverse iterations on K's LDLᵀ, the
+//! eigenvalue μ of smallest magnitude over K's largest diagonal entry (unit mode φ), the share of φ's squared norm in axial
+//! displacements, gᵀφ/‖g‖ (g = ∂V/∂x: zero for a mode that does not change the volume, such as
+//! a translation of a symmetric bulge) and ‖K⁻¹g‖. The run's own end (the target, or why the
+//! continuation stopped) comes last.
+use tubemem_fem::continuation::{run_arc_stage, ArcLoading};
+use tubemem_fem::model::{nearest_node, Load, Model};
+use tubemem_fem::post::midspan;
+use tubemem_fem::stepping::{prestress, Stage, StepSettings};
+use tubemem_mesh::tube::capped_tube;
+use tubemem_mesh::Symmetry;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let usage = "usage: neutral_mode LENGTH PER_R AROUND [EVERY]";
+    let num = |i: usize| -> f64 {
+        args.get(i).and_then(|a| a.parse().ok()).unwrap_or_else(|| {
+            eprintln!("{usage}");
+            std::process::exit(2)
+        })
+    };
+    let (length, per, around) = (num(0), num(1), num(2) as usize);
+    let every = if args.len() > 3 { num(3) as usize } else { 1 }.max(1);
+    let mesh = capped_tube(1.0, length, around, (per * length) as usize, Symmetry::None)
+        .unwrap_or_else(|e| {
+            eprintln!("{e}");
+            std::process::exit(2)
+        });
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).expect("ABB 30");
+    let mut model = Model::new(mesh, Box::new(law)).expect("a checked mesh");
+    println!(
+        "L/R = {length}, {per} per R along, {around} around, {} equations",
+        model.n_eq()
+    );
+    let node = nearest_node(model.mesh(), [1.0, 0.0, 0.0]);
+    let mut state = model.reference_state();
+    let stage = Stage {
+        index: 1,
+        from: 1.0,
+        to: 6.0,
+        settings: StepSettings::default(),
+    };
+    prestress::<()>(&mut model, &mut state, &stage).expect("pre-stress");
+    let monitor = move |s: &tubemem_fem::model::State| s.x[node][0];
+    let mut states = vec![];
+    let t0 = std::time::Instant::now();
+    let end = run_arc_stage(
+        &mut model,
+        &mut state,
+        &stage,
+        None,
+        ArcLoading::Pressure(None),
+        &monitor,
+        1.0,
+        None,
+        |_, s, info| {
+            if info.step % every == 0 || info.fraction >= 1.0 {
+                states.push((info.step, s.clone(), info.newton.inertia.negative_pivots));
+            }
+            Ok::<(), ()>(())
+        },
+        |_, _| Ok(()),
+    );
+    let seconds = t0.elapsed().as_secs_f64();
+    println!("step ϖ λs negative_pivots μ/max(diag K) axial_share gᵀφ/‖g‖ ‖K⁻¹g‖");
+    for (step, s, neg) in &states {
+        let ms = midspan(&model, s).expect("mid-span");
+        let load = Load::pressure(s.p);
+        let m = model
+            .mode_report(s, &load, tubemem_fem::continuation::NEUTRAL_ITERATIONS)
+            .expect("inverse iteration");
+        let (b, _, _) = model.pressure_tangent(s, &load).expect("tangent");
+        println!(
+            "{step} {:.8} {:.5} {neg} {:.3e} {:.3} {:.2e} {:.3e}",
+            s.p,
+            ms.lambda_s,
+            m.relative_eigenvalue,
+            m.axial_share,
+            m.volume_change,
+            b.iter().map(|a| a * a).sum::<f64>().sqrt()
+        );
+    }
+    match end {
+        Ok(_) => println!("reached λs = 6 ({seconds:.1} s)"),
+        Err(tubemem_fem::stepping::StageError::Solve(e)) => {
+            println!("stopped after {seconds:.1} s: {e}")
+        }
+        Err(_) => println!("stopped after {seconds:.1} s"),
+    }
+}
