@@ -41,6 +41,7 @@ pub fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
         K::LimitMax => 1.0,
         K::LimitMin => -1.0,
         K::Bifurcation => 2.0,
+        K::Neutral => 3.0,
     }
 }
 

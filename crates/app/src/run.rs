@@ -98,11 +98,7 @@ fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Opti
         monitor: &monitor,
         value: target,
     };
-    let mut path = MembranePath {
-        model,
-        loading: ArcLoading::Pressure(None),
-        last: None,
-    };
+    let mut path = MembranePath::new(model, ArcLoading::Pressure(None));
     let mut found = None;
     let _ = follow(
         &mut path,
@@ -152,7 +148,7 @@ fn critical_record(
     let reference = limits.and_then(|l| match c.kind {
         // a mid-span past the uniform curve's minimum (λs beyond it) is in the upper phase of a
         // bulge, whose pressure is Maxwell's (a uniform tube cannot be there at a limit point)
-        CriticalKind::Bifurcation => None,
+        CriticalKind::Bifurcation | CriticalKind::Neutral => None,
         _ if l.min.is_some_and(|mn| ms.lambda_s > mn.lambda_s) && l.maxwell.is_some() => {
             l.maxwell.map(|mw| CriticalReference {
                 what: "Maxwell pressure".into(),
@@ -171,15 +167,16 @@ fn critical_record(
             lambda_s: m.lambda_s,
         }),
     });
-    let (mode, mode_eigenvalue) = if c.kind == CriticalKind::Bifurcation {
-        let (v, mu) =
-            model.smallest_mode(&c.state, load, tubemem_fem::continuation::MODE_ITERATIONS)?;
-        let mut x = vec![[0.0; 3]; c.state.x.len()];
-        model.free_update(&mut x, &v, 1.0);
-        (Some(x), Some(mu))
-    } else {
-        (None, None)
-    };
+    let (mode, mode_eigenvalue) =
+        if matches!(c.kind, CriticalKind::Bifurcation | CriticalKind::Neutral) {
+            let (v, mu) =
+                model.smallest_mode(&c.state, load, tubemem_fem::continuation::MODE_ITERATIONS)?;
+            let mut x = vec![[0.0; 3]; c.state.x.len()];
+            model.free_update(&mut x, &v, 1.0);
+            (Some(x), Some(mu))
+        } else {
+            (None, None)
+        };
     let record = CriticalRecord {
         stage,
         step: c.step,
@@ -196,7 +193,7 @@ fn critical_record(
         reference,
         polygon_factor: polygon,
         mode_eigenvalue,
-        ripple: c.kind != CriticalKind::Bifurcation
+        ripple: matches!(c.kind, CriticalKind::LimitMax | CriticalKind::LimitMin)
             && last_limit
                 .replace(Some(ms.w))
                 .is_some_and(|w0| (ms.w - w0).abs() <= RIPPLE * w0.abs()),
@@ -1058,7 +1055,7 @@ fn run_inner(
         let last_limit_w0 = criticals
             .iter()
             .rev()
-            .find(|c| c.kind != CriticalKind::Bifurcation)
+            .find(|c| matches!(c.kind, CriticalKind::LimitMax | CriticalKind::LimitMin))
             .map(|c| c.midspan.w);
         let mut on_step = |m: &Model, st: &State, info: &StepInfo| {
             let mut critical_here = None;

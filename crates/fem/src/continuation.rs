@@ -98,6 +98,13 @@ pub trait Path {
     fn is_final(&self, _e: &Self::Error) -> bool {
         false
     }
+    /// When even the shortest step turns too far at `s`: if the stiffness there has a neutral
+    /// mode that the load does not drive (an eigenvalue at round-off, orthogonal to g — the
+    /// equilibria form a family along it), hold it out of the tangent and the corrector from
+    /// now on and say so (`true`); the driver then retries the step.
+    fn hold_neutral(&mut self, _s: &Self::State) -> Result<bool, Self::Error> {
+        Ok(false)
+    }
 }
 
 /// The arc-length constraint of one corrector: w t_uᵀ(u − u_base) + t_λ(λ − λ_base) = ds.
@@ -188,6 +195,11 @@ pub enum CriticalKind {
     LimitMin,
     /// an eigenvalue of K crossed zero with no turn of the load
     Bifurcation,
+    /// an eigenvalue of K at round-off whose mode the load does not drive: the equilibria form
+    /// a family along it (a bulge that can slide along a whole tube); from here on the mode is
+    /// held out of the path ([`Path::hold_neutral`]). Found where the path would otherwise
+    /// turn within any step, not located on the arc length
+    Neutral,
 }
 
 impl fmt::Display for CriticalKind {
@@ -196,6 +208,7 @@ impl fmt::Display for CriticalKind {
             Self::LimitMax => "limit point (load maximum)",
             Self::LimitMin => "limit point (load minimum)",
             Self::Bifurcation => "bifurcation point",
+            Self::Neutral => "neutral mode (a family of equilibria, held out of the path)",
         })
     }
 }
@@ -408,6 +421,7 @@ pub fn follow<P: Path, O>(
         // turns by more than the settings allow within it (a corrector that lands on a part of
         // the path folded back across the hyperplane would otherwise reverse the continuation)
         let mut cuts = 0;
+        let ds_start = ds;
         let (next, iterations, t, tu, tl) = loop {
             let attempt = corrector(path, &point, w, ds).and_then(|(st, it)| {
                 let t = path.tangent(&st)?;
@@ -459,6 +473,48 @@ pub fn follow<P: Path, O>(
             };
             cuts += 1;
             if cuts > settings.max_cuts || ds * 0.5 < min_ds {
+                // a path that turns within any step where the stiffness has a neutral mode:
+                // hold the mode out and take the step again, once
+                if failure.is_none() {
+                    let held =
+                        path.hold_neutral(&point.state)
+                            .map_err(|source| ArcError::Tangent {
+                                step: step + 1,
+                                source,
+                            })?;
+                    if held {
+                        let t = path
+                            .tangent(&point.state)
+                            .map_err(|source| ArcError::Tangent {
+                                step: step + 1,
+                                source,
+                            })?;
+                        let cp = Critical {
+                            kind: CriticalKind::Neutral,
+                            step: step + 1,
+                            s: point.s,
+                            bracket: 0.0,
+                            state: point.state.clone(),
+                            load: path.load(&point.state),
+                            negative_before: point.negative,
+                            negative_after: t.negative,
+                            switched: None,
+                        };
+                        on_event(path, ArcEvent::Critical(&cp)).map_err(|source| {
+                            ArcError::Observer {
+                                step: step + 1,
+                                source,
+                            }
+                        })?;
+                        criticals.push(cp);
+                        (point.tu, point.tl) =
+                            unit_tangent(t.b, w, Some((&point.tu, point.tl)), 1.0);
+                        point.negative = t.negative;
+                        ds = ds_start;
+                        cuts = 0;
+                        continue;
+                    }
+                }
                 return Err(match failure {
                     Some(e) => ArcError::Stalled {
                         step: step + 1,
@@ -886,6 +942,8 @@ pub struct MembranePath<'a> {
     pub loading: ArcLoading,
     /// the report of the last successful corrector
     pub last: Option<crate::newton::NewtonReport>,
+    /// a neutral mode held out of the tangent and the corrector ([`Path::hold_neutral`])
+    pub neutral: Option<Vec<f64>>,
 }
 
 impl ArcLoading {
@@ -904,7 +962,17 @@ impl ArcLoading {
     }
 }
 
-impl MembranePath<'_> {
+impl<'a> MembranePath<'a> {
+    /// The path of `model` under `loading`.
+    pub fn new(model: &'a mut crate::model::Model, loading: ArcLoading) -> Self {
+        Self {
+            model,
+            loading,
+            last: None,
+            neutral: None,
+        }
+    }
+
     /// The load at the state `s` of the path.
     pub fn load_at(&self, s: &crate::model::State) -> crate::model::Load {
         self.loading.load_at(s)
@@ -946,7 +1014,16 @@ impl Path for MembranePath<'_> {
         let (b, g, negative) = match &self.loading {
             ArcLoading::Pressure(_) => {
                 let load = self.load_at(s);
-                self.model.pressure_tangent(s, &load)
+                match &self.neutral {
+                    Some(phi0) => self.model.pressure_tangent_deflated(s, &load, phi0).map(
+                        |(b, g, n, phi)| {
+                            // released once the mode is no longer neutral
+                            self.neutral = phi;
+                            (b, g, n)
+                        },
+                    ),
+                    None => self.model.pressure_tangent(s, &load),
+                }
             }
             ArcLoading::ClosedGas { pv, planes } => self.model.plane_tangent(s, *pv, planes),
         }
@@ -972,6 +1049,7 @@ impl Path for MembranePath<'_> {
             tp: arc.tl,
             w: arc.w,
             ds: arc.ds,
+            neutral: self.neutral.as_deref(),
         };
         let r = match &self.loading {
             ArcLoading::Pressure(contact) => {
@@ -989,6 +1067,36 @@ impl Path for MembranePath<'_> {
     }
     fn is_final(&self, e: &Self::Error) -> bool {
         matches!(e.cause(), Some(crate::FemError::Interrupted))
+    }
+    fn hold_neutral(&mut self, s: &Self::State) -> Result<bool, Self::Error> {
+        // under pressure only (a closed gas's stiffness has no such family here), once
+        if self.neutral.is_some() || !matches!(self.loading, ArcLoading::Pressure(_)) {
+            return Ok(false);
+        }
+        let load = self.load_at(s);
+        let report = self
+            .model
+            .mode_report(s, &load, NEUTRAL_ITERATIONS)
+            .map_err(problem_error)?;
+        if !report.is_neutral() {
+            return Ok(false);
+        }
+        // the smallest mode, made free of the load where a second nearly neutral mode (the
+        // fronts' advance on a plateau) mixes with it; held only if what remains is neutral
+        let (smallest, _) = self
+            .model
+            .smallest_mode(s, &load, NEUTRAL_ITERATIONS)
+            .map_err(problem_error)?;
+        let Some(phi) = self
+            .model
+            .pressure_tangent_deflated(s, &load, &smallest)
+            .map_err(problem_error)?
+            .3
+        else {
+            return Ok(false);
+        };
+        self.neutral = Some(phi);
+        Ok(true)
     }
 }
 
@@ -1024,11 +1132,7 @@ pub fn run_arc_stage<E>(
         switch_fraction,
         ..ArcSettings::default()
     };
-    let mut path = MembranePath {
-        model,
-        loading,
-        last: None,
-    };
+    let mut path = MembranePath::new(model, loading);
     let target = Target {
         name: "target",
         monitor,

@@ -661,6 +661,92 @@ impl Model {
         Ok((b, a.g, neg))
     }
 
+    /// [`Model::pressure_tangent`] with the neutral mode `phi0` held out (see [`Model::deflate`]):
+    /// b projected off the refreshed mode, the mode's pivot out of the count; returns the
+    /// refreshed mode too, or `None` — and the plain tangent — once the mode is no longer
+    /// neutral (|μ| above [`NEUTRAL`] of the diagonal: e.g. the bulge's fronts have reached
+    /// the caps and nothing can slide any more).
+    #[allow(clippy::type_complexity)]
+    pub fn pressure_tangent_deflated(
+        &mut self,
+        state: &State,
+        load: &Load,
+        phi0: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>, usize, Option<Vec<f64>>), FemError> {
+        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
+        let (neg, _) = self.factorize(&a, state.p)?;
+        let mut b = a.g.clone();
+        self.ldlt.solve(&mut b);
+        let (phi, negative_mode) = self.deflate(phi0, &a.g, &b);
+        // held while it is neutral and the load does not drive it (a mode along the load is
+        // the path itself)
+        let driven = dot(&a.g, &phi).abs() > NEUTRAL * norm(&a.g);
+        if driven || self.relative_rayleigh(&a, state.p, &phi).abs() > NEUTRAL {
+            return Ok((b, a.g, neg, None));
+        }
+        project_out(&mut b, &phi);
+        Ok((
+            b,
+            a.g,
+            neg - usize::from(negative_mode && neg > 0),
+            Some(phi),
+        ))
+    }
+
+    /// One inverse iteration on the current factor of K from the stored neutral mode `phi0`,
+    /// kept free of the load: the refreshed unit mode, and whether K's negative-pivot count
+    /// includes it (φᵀK⁻¹φ < 0).
+    ///
+    /// A neutral mode (eigenvalue at round-off, e.g. the translation of a bulge far from the
+    /// caps of a whole tube) leaves K⁻¹ undefined along it: the continuation holds it out of
+    /// the tangent and of the corrector (the state keeps its component along the mode, so the
+    /// bulge stays where it is), and out of the pivot count, whose sign for it is noise. One
+    /// solve converges it (the gap to the next eigenvalue is many orders) — except on a
+    /// propagation plateau, where the fronts' advance (which changes the volume, the path
+    /// itself) is nearly neutral too: K⁻¹φ0 and `b` = K⁻¹g then span the two, and the held mode
+    /// is their combination that does not change the volume (gᵀφ = 0).
+    pub fn deflate(&self, phi0: &[f64], g: &[f64], b: &[f64]) -> (Vec<f64>, bool) {
+        let mut u = phi0.to_vec();
+        self.ldlt.solve(&mut u);
+        let nu = norm(&u).max(1e-300);
+        u.iter_mut().for_each(|v| *v /= nu);
+        // the part of b = K⁻¹g off u: a second direction of the near-null space when it is
+        // not negligible
+        let nb = norm(b).max(1e-300);
+        let mut q: Vec<f64> = b.iter().map(|v| v / nb).collect();
+        project_out(&mut q, &u);
+        let nq = norm(&q);
+        let phi = if nq > 1e-3 {
+            q.iter_mut().for_each(|v| *v /= nq);
+            let (gu, gq) = (dot(g, &u), dot(g, &q));
+            let mut phi: Vec<f64> = u.iter().zip(&q).map(|(a, c)| gq * a - gu * c).collect();
+            let n = norm(&phi).max(1e-300);
+            phi.iter_mut().for_each(|v| *v /= n);
+            phi
+        } else {
+            u
+        };
+        let mut w = phi.clone();
+        self.ldlt.solve(&mut w);
+        let negative = dot(&phi, &w) < 0.0;
+        (phi, negative)
+    }
+
+    /// The Rayleigh quotient 1/(φᵀK⁻¹φ) of a unit φ on the current factor, over K's largest
+    /// diagonal entry in `a` at the pressure `p`.
+    fn relative_rayleigh(&self, a: &Assembled, p: f64, phi: &[f64]) -> f64 {
+        let mut w = phi.to_vec();
+        self.ldlt.solve(&mut w);
+        let diag = self
+            .pattern
+            .diagonal()
+            .iter()
+            .map(|&d| (a.k_int[d] - p * a.k_vol[d]).abs())
+            .fold(0.0, f64::max)
+            .max(1e-300);
+        1.0 / dot(phi, &w) / diag
+    }
+
     /// Inverse iteration with the factor of K = K_int − ϖ H at `state` (with the load's planes;
     /// for closed gas, of K + (ϖ/V_part) g gᵀ): the eigenvector of smallest |eigenvalue| (unit Euclidean norm on the free dofs) and its Rayleigh quotient.
     /// `iterations` solves, from a start vector of ones.
@@ -843,6 +929,12 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|a| a * a).sum::<f64>().sqrt()
 }
 
+/// v − (φᵀv) φ for a unit φ.
+fn project_out(v: &mut [f64], phi: &[f64]) {
+    let c = dot(v, phi);
+    v.iter_mut().zip(phi).for_each(|(x, p)| *x -= c * p);
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -873,6 +965,9 @@ pub struct ArcConstraint<'a> {
     pub tp: f64,
     pub w: f64,
     pub ds: f64,
+    /// a neutral mode of K held out of the corrector (unit, free dofs; refreshed by one inverse
+    /// iteration at every linearization): see [`Model::deflate`]
+    pub neutral: Option<&'a [f64]>,
 }
 
 /// The membrane equilibrium under one load, as a [`newton::Problem`]: the state is (x, p), the
@@ -1084,6 +1179,13 @@ impl newton::Problem for MembraneProblem<'_> {
         } else if let Some(h) = &h {
             let mut b = a.g.clone();
             ldlt.solve(&mut b);
+            if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
+                // the neutral mode out of the correction and of the load column; its pivot out
+                // of the count (its sign is round-off)
+                let (phi, negative_mode) = self.model.deflate(phi0, &a.g, &b);
+                project_out(&mut b, &phi);
+                negative -= usize::from(negative_mode && negative > 0);
+            }
             let hb = dot(h, &b) + cp;
             let ha = dot(h, &dx);
             // the bordered operator's inertia (volume or stretch control); an arc-length step

@@ -671,11 +671,8 @@ pub(crate) fn sphere_limit_errors(kind: tubemem_mesh::ElementKind, ms: &[usize])
         // the volume ratio of the discrete sphere (the monitored target)
         let v0 = mesh.volume();
         let volume = |s: &crate::model::State| mesh.volume_at(&s.x) / v0;
-        let mut path = MembranePath {
-            model: &mut model,
-            loading: crate::continuation::ArcLoading::Pressure(None),
-            last: None,
-        };
+        let mut path =
+            MembranePath::new(&mut model, crate::continuation::ArcLoading::Pressure(None));
         let target = Target {
             name: "volume ratio",
             monitor: &volume,
@@ -763,14 +760,13 @@ fn a_closed_gas_squeeze_by_arc_length_is_the_load_stepped_squeeze() {
         monitor: &monitor,
         value: target,
     };
-    let mut path = MembranePath {
-        model: &mut model,
-        loading: ArcLoading::ClosedGas {
+    let mut path = MembranePath::new(
+        &mut model,
+        ArcLoading::ClosedGas {
             pv,
             planes: planes.clone(),
         },
-        last: None,
-    };
+    );
     let mut end = None;
     let mut steps = 0;
     follow(&mut path, start, &goal, &ArcSettings::default(), |_, e| {
