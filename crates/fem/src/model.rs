@@ -732,24 +732,29 @@ impl Model {
         (phi, negative)
     }
 
+    /// The largest |diagonal entry| of K = K_int − p H in `a` (the scale of the stiffness).
+    fn largest_diagonal(&self, a: &Assembled, p: f64) -> f64 {
+        self.pattern
+            .diagonal()
+            .iter()
+            .map(|&d| (a.k_int[d] - p * a.k_vol[d]).abs())
+            .fold(0.0, f64::max)
+            .max(1e-300)
+    }
+
     /// The Rayleigh quotient 1/(φᵀK⁻¹φ) of a unit φ on the current factor, over K's largest
     /// diagonal entry in `a` at the pressure `p`.
     fn relative_rayleigh(&self, a: &Assembled, p: f64, phi: &[f64]) -> f64 {
         let mut w = phi.to_vec();
         self.ldlt.solve(&mut w);
-        let diag = self
-            .pattern
-            .diagonal()
-            .iter()
-            .map(|&d| (a.k_int[d] - p * a.k_vol[d]).abs())
-            .fold(0.0, f64::max)
-            .max(1e-300);
+        let diag = self.largest_diagonal(a, p);
         1.0 / dot(phi, &w) / diag
     }
 
     /// Inverse iteration with the factor of K = K_int − ϖ H at `state` (with the load's planes;
-    /// for closed gas, of K + (ϖ/V_part) g gᵀ): the eigenvector of smallest |eigenvalue| (unit Euclidean norm on the free dofs) and its Rayleigh quotient.
-    /// `iterations` solves, from a start vector of ones.
+    /// for closed gas, of K + (ϖ/V_part) g gᵀ): the eigenvector of smallest |eigenvalue| (unit
+    /// Euclidean norm on the free dofs) and its Rayleigh quotient. `iterations` solves, from a
+    /// start vector of ones.
     pub fn smallest_mode(
         &mut self,
         state: &State,
@@ -801,13 +806,7 @@ impl Model {
             Some(pv) => pv / (self.multiplicity() * a.volume),
             None => state.p,
         };
-        let diag = self
-            .pattern
-            .diagonal()
-            .iter()
-            .map(|&d| (a.k_int[d] - p * a.k_vol[d]).abs())
-            .fold(0.0, f64::max)
-            .max(1e-300);
+        let diag = self.largest_diagonal(&a, p);
         let mut u = vec![[0.0; 3]; state.x.len()];
         self.dofs.apply(&mut u, &phi, 1.0);
         Ok(ModeReport {
