@@ -456,7 +456,11 @@ pub fn follow<P: Path, O>(
                     } else {
                         settings.min_turn_cos
                     };
-                    if cos >= needed {
+                    // a tangent with no displacement part (the load does not act on the state
+                    // yet: plates that only touch the tube) says nothing about where the path
+                    // turns once it does; the corner there is the path's, not a fold
+                    let blind = point.tu.iter().all(|v| *v == 0.0);
+                    if cos >= needed || (blind && tl * point.tl > 0.0) {
                         break (st, it, t, tu, tl);
                     }
                     None
