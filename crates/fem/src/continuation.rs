@@ -100,8 +100,9 @@ pub trait Path {
     }
     /// When even the shortest step turns too far at `s`: if the stiffness there has a neutral
     /// mode that the load does not drive (an eigenvalue at round-off, orthogonal to g — the
-    /// equilibria form a family along it), hold it out of the tangent and the corrector from
-    /// now on and say so (`true`); the driver then retries the step.
+    /// equilibria form a family along it), hold it out of the path tangent (and out of the
+    /// corrector's load column) until it stiffens, and say so (`true`); the driver then retries
+    /// the step.
     fn hold_neutral(&mut self, _s: &Self::State) -> Result<bool, Self::Error> {
         Ok(false)
     }
@@ -946,7 +947,8 @@ pub struct MembranePath<'a> {
     pub loading: ArcLoading,
     /// the report of the last successful corrector
     pub last: Option<crate::newton::NewtonReport>,
-    /// a neutral mode held out of the tangent and the corrector ([`Path::hold_neutral`])
+    /// a neutral mode held out of the tangent and the corrector's load column
+    /// ([`Path::hold_neutral`])
     pub neutral: Option<Vec<f64>>,
 }
 
