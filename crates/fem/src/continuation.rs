@@ -1080,7 +1080,7 @@ impl Path for MembranePath<'_> {
             return Ok(false);
         }
         let load = self.load_at(s);
-        let report = self
+        let (report, smallest) = self
             .model
             .mode_report(s, &load, NEUTRAL_ITERATIONS)
             .map_err(problem_error)?;
@@ -1089,10 +1089,6 @@ impl Path for MembranePath<'_> {
         }
         // the smallest mode, made free of the load where a second nearly neutral mode (the
         // fronts' advance on a plateau) mixes with it; held only if what remains is neutral
-        let (smallest, _) = self
-            .model
-            .smallest_mode(s, &load, NEUTRAL_ITERATIONS)
-            .map_err(problem_error)?;
         let Some(phi) = self
             .model
             .pressure_tangent_deflated(s, &load, &smallest)
@@ -1205,6 +1201,7 @@ pub fn run_arc_stage<E>(
             path.model
                 .mode_report(state, &load, NEUTRAL_ITERATIONS)
                 .ok()
+                .map(|(m, _)| m)
                 .filter(|m| m.is_neutral())
         }
         _ => None,

@@ -627,7 +627,7 @@ impl Model {
             .collect();
         let mut b = minus_q.clone();
         let negative = self.solve_gas(&a, p, &mut b);
-        Ok((b, minus_q, neg - negative))
+        Ok((b, minus_q, neg.saturating_sub(negative)))
     }
 
     /// Solve K_gas y = v in place with the factor of K = K_int − ϖH (+ K_c) by Sherman–Morrison
@@ -654,11 +654,21 @@ impl Model {
         state: &State,
         load: &Load,
     ) -> Result<(Vec<f64>, Vec<f64>, usize), FemError> {
+        let (a, b, neg) = self.pressure_tangent_with(state, load)?;
+        Ok((b, a.g, neg))
+    }
+
+    /// [`Model::pressure_tangent`] with the assembly it factorized.
+    fn pressure_tangent_with(
+        &mut self,
+        state: &State,
+        load: &Load,
+    ) -> Result<(Assembled, Vec<f64>, usize), FemError> {
         let a = self.assemble(&state.x, true, load.contact.as_ref())?;
         let (neg, _) = self.factorize(&a, state.p)?;
         let mut b = a.g.clone();
         self.ldlt.solve(&mut b);
-        Ok((b, a.g, neg))
+        Ok((a, b, neg))
     }
 
     /// [`Model::pressure_tangent`] with the neutral mode `phi0` held out (see [`Model::deflate`]):
@@ -673,29 +683,21 @@ impl Model {
         load: &Load,
         phi0: &[f64],
     ) -> Result<(Vec<f64>, Vec<f64>, usize, Option<Vec<f64>>), FemError> {
-        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
-        let (neg, _) = self.factorize(&a, state.p)?;
-        let mut b = a.g.clone();
-        self.ldlt.solve(&mut b);
-        let (phi, negative_mode) = self.deflate(phi0, &a.g, &b);
+        let (a, mut b, neg) = self.pressure_tangent_with(state, load)?;
+        let (phi, mu) = self.deflate(phi0, &a.g, &b);
         // held while it is neutral and the load does not drive it (a mode along the load is
         // the path itself)
         let driven = dot(&a.g, &phi).abs() > NEUTRAL * norm(&a.g);
-        if driven || self.relative_rayleigh(&a, state.p, &phi).abs() > NEUTRAL {
+        if driven || (mu / self.largest_diagonal(&a, state.p)).abs() > NEUTRAL {
             return Ok((b, a.g, neg, None));
         }
         project_out(&mut b, &phi);
-        Ok((
-            b,
-            a.g,
-            neg - usize::from(negative_mode && neg > 0),
-            Some(phi),
-        ))
+        Ok((b, a.g, neg - usize::from(mu < 0.0 && neg > 0), Some(phi)))
     }
 
     /// One inverse iteration on the current factor of K from the stored neutral mode `phi0`,
-    /// kept free of the load: the refreshed unit mode, and whether K's negative-pivot count
-    /// includes it (φᵀK⁻¹φ < 0).
+    /// kept free of the load: the refreshed unit mode and its Rayleigh quotient
+    /// μ = 1/(φᵀK⁻¹φ) (negative: K's negative-pivot count includes it).
     ///
     /// A neutral mode (eigenvalue at round-off, e.g. the translation of a bulge far from the
     /// caps of a whole tube) leaves K⁻¹ undefined along it: the continuation holds it out of
@@ -705,7 +707,7 @@ impl Model {
     /// propagation plateau, where the fronts' advance (which changes the volume, the path
     /// itself) is nearly neutral too: K⁻¹φ0 and `b` = K⁻¹g then span the two, and the held mode
     /// is their combination that does not change the volume (gᵀφ = 0).
-    pub fn deflate(&self, phi0: &[f64], g: &[f64], b: &[f64]) -> (Vec<f64>, bool) {
+    pub fn deflate(&self, phi0: &[f64], g: &[f64], b: &[f64]) -> (Vec<f64>, f64) {
         let mut u = phi0.to_vec();
         self.ldlt.solve(&mut u);
         let nu = norm(&u).max(1e-300);
@@ -728,8 +730,8 @@ impl Model {
         };
         let mut w = phi.clone();
         self.ldlt.solve(&mut w);
-        let negative = dot(&phi, &w) < 0.0;
-        (phi, negative)
+        let mu = 1.0 / dot(&phi, &w);
+        (phi, mu)
     }
 
     /// The largest |diagonal entry| of K = K_int − p H in `a` (the scale of the stiffness).
@@ -742,15 +744,6 @@ impl Model {
             .max(1e-300)
     }
 
-    /// The Rayleigh quotient 1/(φᵀK⁻¹φ) of a unit φ on the current factor, over K's largest
-    /// diagonal entry in `a` at the pressure `p`.
-    fn relative_rayleigh(&self, a: &Assembled, p: f64, phi: &[f64]) -> f64 {
-        let mut w = phi.to_vec();
-        self.ldlt.solve(&mut w);
-        let diag = self.largest_diagonal(a, p);
-        1.0 / dot(phi, &w) / diag
-    }
-
     /// Inverse iteration with the factor of K = K_int − ϖ H at `state` (with the load's planes;
     /// for closed gas, of K + (ϖ/V_part) g gᵀ): the eigenvector of smallest |eigenvalue| (unit
     /// Euclidean norm on the free dofs) and its Rayleigh quotient. `iterations` solves, from a
@@ -761,6 +754,17 @@ impl Model {
         load: &Load,
         iterations: usize,
     ) -> Result<(Vec<f64>, f64), FemError> {
+        self.smallest_mode_with(state, load, iterations)
+            .map(|(v, mu, _, _)| (v, mu))
+    }
+
+    /// [`Model::smallest_mode`] with the assembly it factorized and the pressure it used.
+    fn smallest_mode_with(
+        &mut self,
+        state: &State,
+        load: &Load,
+        iterations: usize,
+    ) -> Result<(Vec<f64>, f64, Assembled, f64), FemError> {
         let a = self.assemble(&state.x, true, load.contact.as_ref())?;
         // closed gas: the stiffness is K + (ϖ/V) g gᵀ, solved by Sherman–Morrison
         let gas = load.gas().map(|pv| pv / (self.multiplicity() * a.volume));
@@ -786,34 +790,30 @@ impl Model {
         }
         let nv = norm(&v);
         v.iter_mut().for_each(|x| *x /= nv);
-        Ok((v, mu))
+        Ok((v, mu, a, gas.unwrap_or(state.p)))
     }
 
     /// The eigenvector of smallest |eigenvalue| of the stiffness at `state` under `load` (by
     /// `iterations` inverse iterations, [`Model::smallest_mode`]), described: μ relative to K's
     /// largest diagonal entry, the share of the mode's squared norm in axial (z) displacements,
     /// and gᵀφ/‖g‖ (0 for a mode that keeps the volume). [`ModeReport::is_neutral`] below
-    /// [`NEUTRAL`].
+    /// [`NEUTRAL`]. Returned with the mode.
     pub fn mode_report(
         &mut self,
         state: &State,
         load: &Load,
         iterations: usize,
-    ) -> Result<ModeReport, FemError> {
-        let (phi, mu) = self.smallest_mode(state, load, iterations)?;
-        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
-        let p = match load.gas() {
-            Some(pv) => pv / (self.multiplicity() * a.volume),
-            None => state.p,
-        };
+    ) -> Result<(ModeReport, Vec<f64>), FemError> {
+        let (phi, mu, a, p) = self.smallest_mode_with(state, load, iterations)?;
         let diag = self.largest_diagonal(&a, p);
         let mut u = vec![[0.0; 3]; state.x.len()];
         self.dofs.apply(&mut u, &phi, 1.0);
-        Ok(ModeReport {
+        let report = ModeReport {
             relative_eigenvalue: mu / diag,
             axial_share: u.iter().map(|v| v[2] * v[2]).sum(),
             volume_change: dot(&a.g, &phi) / norm(&a.g).max(1e-300),
-        })
+        };
+        Ok((report, phi))
     }
 
     /// x − x0 on the free dofs.
@@ -1140,7 +1140,9 @@ impl newton::Problem for MembraneProblem<'_> {
         let ldlt = &self.model.ldlt;
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
         let moving = self.planes.zip(self.arc);
-        if moving.is_none() {
+        // closed gas: K_gas = K + (ϖ/V) g gᵀ, applied by Sherman–Morrison (`solve_gas`)
+        let gas_newton = self.load.gas().is_some() && self.arc.is_none();
+        if moving.is_none() && !gas_newton {
             ldlt.solve(&mut dx);
         }
         let mut dp = 0.0;
@@ -1148,7 +1150,7 @@ impl newton::Problem for MembraneProblem<'_> {
         if let Some((planes, arc)) = moving {
             // closed gas with moving planes: K_gas [dx; dλ] bordered by ∂R/∂λ and the arc
             // constraint, K_gas⁻¹ by Sherman–Morrison on the factor of K
-            negative -= self.model.solve_gas(&a, p, &mut dx);
+            negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
             let mut bq: Vec<f64> = self
                 .model
                 .plane_rate(&state.x, planes, state.planes)
@@ -1162,28 +1164,18 @@ impl newton::Problem for MembraneProblem<'_> {
             for (d, bb) in dx.iter_mut().zip(&bq) {
                 *d += dp * bb;
             }
-        } else if self.load.gas().is_some() && self.arc.is_none() {
-            let cc = p / a.volume;
-            let mut b = a.g.clone();
-            ldlt.solve(&mut b);
-            let gb = dot(&a.g, &b);
-            let gdx = dot(&a.g, &dx);
-            let denom = 1.0 + cc * gb;
-            if denom < 0.0 {
-                negative = negative.saturating_sub(1);
-            }
-            for (d, bb) in dx.iter_mut().zip(&b) {
-                *d -= cc * bb * gdx / denom;
-            }
+        } else if gas_newton {
+            negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
         } else if let Some(h) = &h {
             let mut b = a.g.clone();
             ldlt.solve(&mut b);
             if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
-                // the neutral mode out of the correction and of the load column; its pivot out
-                // of the count (its sign is round-off)
-                let (phi, negative_mode) = self.model.deflate(phi0, &a.g, &b);
+                // the neutral mode out of the load column (not out of the correction: the
+                // residual along it must still go); its pivot out of the count (its sign is
+                // round-off)
+                let (phi, mu) = self.model.deflate(phi0, &a.g, &b);
                 project_out(&mut b, &phi);
-                negative -= usize::from(negative_mode && negative > 0);
+                negative -= usize::from(mu < 0.0 && negative > 0);
             }
             let hb = dot(h, &b) + cp;
             let ha = dot(h, &dx);
