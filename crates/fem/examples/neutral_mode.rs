@@ -21,24 +21,52 @@ use tubemem_fem::stepping::{prestress, Stage, StepSettings};
 use tubemem_mesh::tube::capped_tube;
 use tubemem_mesh::Symmetry;
 
-fn main() {
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("neutral_mode: {e}\nusage: neutral_mode LENGTH PER_R AROUND [EVERY]");
+            std::process::ExitCode::from(2)
+        }
+    }
+}
+
+/// The largest mesh this example builds: 2 million nodes (the CLI's own resource guards do not
+/// apply here).
+const MAX_NODES: f64 = 2e6;
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: neutral_mode LENGTH PER_R AROUND [EVERY]";
-    let num = |i: usize| -> f64 {
-        args.get(i).and_then(|a| a.parse().ok()).unwrap_or_else(|| {
-            eprintln!("{usage}");
-            std::process::exit(2)
-        })
+    let arg = |i: usize, name: &str| -> Result<f64, String> {
+        let a = args.get(i).ok_or(format!("missing {name}"))?;
+        a.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .ok_or(format!("{name} = {a:?}: a positive number"))
     };
-    let (length, per, around) = (num(0), num(1), num(2) as usize);
-    let every = if args.len() > 3 { num(3) as usize } else { 1 }.max(1);
-    let mesh = capped_tube(1.0, length, around, (per * length) as usize, Symmetry::None)
-        .unwrap_or_else(|e| {
-            eprintln!("{e}");
-            std::process::exit(2)
-        });
-    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).expect("ABB 30");
-    let mut model = Model::new(mesh, Box::new(law)).expect("a checked mesh");
+    let (length, per, around) = (arg(0, "LENGTH")?, arg(1, "PER_R")?, arg(2, "AROUND")?);
+    let every = if args.len() > 3 {
+        arg(3, "EVERY")? as usize
+    } else {
+        1
+    }
+    .max(1);
+    if around * per * length > MAX_NODES {
+        return Err(format!(
+            "{around} around × {} along is more than {MAX_NODES} nodes",
+            per * length
+        )
+        .into());
+    }
+    let mesh = capped_tube(
+        1.0,
+        length,
+        around as usize,
+        (per * length) as usize,
+        Symmetry::None,
+    )?;
+    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0)?;
+    let mut model = Model::new(mesh, Box::new(law))?;
     println!(
         "L/R = {length}, {per} per R along, {around} around, {} equations",
         model.n_eq()
@@ -51,7 +79,10 @@ fn main() {
         to: 6.0,
         settings: StepSettings::default(),
     };
-    prestress::<()>(&mut model, &mut state, &stage).expect("pre-stress");
+    prestress::<()>(&mut model, &mut state, &stage).map_err(|e| match e {
+        tubemem_fem::stepping::StageError::Solve(e) => format!("pre-stress: {e}"),
+        _ => "pre-stress".to_string(),
+    })?;
     let monitor = move |s: &tubemem_fem::model::State| s.x[node][0];
     let mut states = vec![];
     let t0 = std::time::Instant::now();
@@ -75,12 +106,10 @@ fn main() {
     let seconds = t0.elapsed().as_secs_f64();
     println!("step ϖ λs negative_pivots μ/max(diag K) axial_share gᵀφ/‖g‖ ‖K⁻¹g‖");
     for (step, s, neg) in &states {
-        let ms = midspan(&model, s).expect("mid-span");
+        let ms = midspan(&model, s)?;
         let load = Load::pressure(s.p);
-        let m = model
-            .mode_report(s, &load, tubemem_fem::continuation::NEUTRAL_ITERATIONS)
-            .expect("inverse iteration");
-        let (b, _, _) = model.pressure_tangent(s, &load).expect("tangent");
+        let (m, _) = model.mode_report(s, &load, tubemem_fem::continuation::NEUTRAL_ITERATIONS)?;
+        let (b, _, _) = model.pressure_tangent(s, &load)?;
         println!(
             "{step} {:.8} {:.5} {neg} {:.3e} {:.3} {:.2e} {:.3e}",
             s.p,
@@ -98,4 +127,5 @@ fn main() {
         }
         Err(_) => println!("stopped after {seconds:.1} s"),
     }
+    Ok(())
 }
