@@ -15,6 +15,7 @@
 //! | [`newton`] | a damped Newton driver that knows nothing of membranes |
 //! | [`stepping`] | load stepping with cut-back and growth |
 //! | [`post`] | mid-span values, profiles, contact values, cell values |
+//! | [`slide`] | moving a whole tube's bulge by whole rows (the neutral family's members) |
 //!
 //! The enclosed volume with its gradient and Hessian is `tubemem_mesh::volume` (one
 //! implementation for the mesh checks, the loading and the output).
@@ -34,6 +35,7 @@ pub mod model;
 pub mod newton;
 pub mod pattern;
 pub mod post;
+pub mod slide;
 pub mod stepping;
 
 pub use newton::NewtonSettings;

@@ -537,6 +537,55 @@ impl Model {
         newton::solve(&mut problem, state, &settings)
     }
 
+    /// Newton iterations at the prescribed total volume `volume` with the unit direction `phi0`
+    /// held (a bulge held where it sits, `phi0` its translation): the correction and the volume
+    /// column are projected off the mode φ = K⁻¹φ0/‖K⁻¹φ0‖ at every linearization (one inverse
+    /// iteration, so Kφ lies along φ0); at the fixed point the residual R = f_int − ϖg lies along `phi0`,
+    /// and convergence is on the residual off it. `state` is the initial guess and, on success,
+    /// the converged state. Returns the Newton report and the [`Held`] values there: the
+    /// refreshed mode, its eigenvalue and the reaction f = φ0ᵀR (f > 0: the energy at fixed
+    /// volume grows along +φ0, so the state, let go, would move along −φ0).
+    pub fn solve_held(
+        &mut self,
+        state: &mut State,
+        volume: f64,
+        phi0: &[f64],
+    ) -> Result<(newton::NewtonReport, Held), NewtonError<FemError>> {
+        let settings = self.settings;
+        let load = Load::new(Loading::Volume(volume));
+        let mut problem = MembraneProblem::new(self, &load, None);
+        problem.hold = Some(phi0);
+        let report = newton::solve(&mut problem, state, &settings)?;
+        let held = self
+            .held_at(state, phi0)
+            .map_err(|source| NewtonError::Problem {
+                iteration: report.iterations,
+                source,
+            })?;
+        Ok((report, held))
+    }
+
+    /// The held mode at the equilibrium `state` (pressure `state.p`): refreshed from `phi0`
+    /// by one inverse iteration, with its eigenvalue relative to K's largest diagonal entry and
+    /// the reaction φ0ᵀR.
+    fn held_at(&mut self, state: &State, phi0: &[f64]) -> Result<Held, FemError> {
+        let load = Load::pressure(state.p);
+        let (a, _, _) = self.pressure_tangent_with(state, &load)?;
+        let (phi, mu) = self.inverse_iteration(phi0);
+        let r: Vec<f64> = a
+            .f_int
+            .iter()
+            .zip(&a.g)
+            .map(|(f, g)| f - state.p * g)
+            .collect();
+        Ok(Held {
+            force: dot(phi0, &r),
+            relative_eigenvalue: mu / self.largest_diagonal(&a, state.p),
+            energy: a.energy,
+            mode: phi,
+        })
+    }
+
     /// Newton iterations on equilibrium under the pressure `state.p` (a free unknown) together
     /// with the arc-length constraint `arc` (see [`ArcConstraint`]); `state` is the predictor
     /// and, on success, the converged point. `load.loading` must be a pressure (its value is
@@ -734,6 +783,19 @@ impl Model {
         (phi, mu)
     }
 
+    /// One inverse iteration on the current factor of K from the unit vector `phi0`:
+    /// φ = K⁻¹φ0/‖K⁻¹φ0‖ (so Kφ lies along φ0) and its Rayleigh quotient μ = 1/(φᵀK⁻¹φ).
+    fn inverse_iteration(&self, phi0: &[f64]) -> (Vec<f64>, f64) {
+        let mut phi = phi0.to_vec();
+        self.ldlt.solve(&mut phi);
+        let n = norm(&phi).max(1e-300);
+        phi.iter_mut().for_each(|v| *v /= n);
+        let mut w = phi.clone();
+        self.ldlt.solve(&mut w);
+        let mu = 1.0 / dot(&phi, &w);
+        (phi, mu)
+    }
+
     /// The largest |diagonal entry| of K = K_int − p H in `a` (the scale of the stiffness).
     fn largest_diagonal(&self, a: &Assembled, p: f64) -> f64 {
         self.pattern
@@ -882,6 +944,19 @@ impl Model {
     }
 }
 
+/// A held equilibrium's mode ([`Model::solve_held`]).
+#[derive(Clone, Debug)]
+pub struct Held {
+    /// the refreshed unit mode (free dofs)
+    pub mode: Vec<f64>,
+    /// its eigenvalue over K's largest diagonal entry
+    pub relative_eigenvalue: f64,
+    /// the reaction φ0ᵀR of the hold (R = f_int − ϖ g on the free dofs, φ0 the held direction)
+    pub force: f64,
+    /// the membrane energy (over μH, whole model)
+    pub energy: f64,
+}
+
 /// The relative eigenvalue (|μ| over K's largest diagonal entry) below which a mode counts as
 /// neutral: 1e-8. Measured on the whole tube's bulging path (L/R = 40, 16 around; `cargo run
 /// --release -p tubemem-fem --example neutral_mode -- 40 PER_R 16 3`, 2026-11-30): the uniform
@@ -982,6 +1057,12 @@ struct MembraneProblem<'a> {
     /// closed gas pressed by planes that move with `State::planes`, the arc's load parameter
     /// (then `load.contact` is unused)
     planes: Option<&'a MovingPlanes>,
+    /// a direction φ0 held in a volume-control Newton (unit, free dofs): the correction is
+    /// projected off φ = K⁻¹φ0/‖K⁻¹φ0‖ (one inverse iteration: the neutral mode near φ0), so the
+    /// state keeps its coordinate along the mode, and the residual along φ0 — the generalized
+    /// force that would move the state along the mode — is left as the hold's reaction (see
+    /// [`Model::solve_held`])
+    hold: Option<&'a [f64]>,
     /// the assembly (with the tangent) of the last trial state the line search evaluated:
     /// when that trial is accepted, the next linearization is at the same state and takes it
     /// instead of assembling again
@@ -1002,6 +1083,7 @@ impl MembraneProblem<'_> {
             load,
             arc,
             planes: None,
+            hold: None,
             trial: std::cell::RefCell::new(None),
             rejected_seconds: std::cell::Cell::new(0.0),
         }
@@ -1135,7 +1217,7 @@ impl newton::Problem for MembraneProblem<'_> {
         let (neg, shift) = self.model.factorize(&a, p)?;
         let factorization_seconds = t_factor.elapsed().as_secs_f64();
         let t_solve = std::time::Instant::now();
-        let converged = res <= self.model.settings.rtol && c.abs() <= 1e-12 * cscale;
+        let mut converged = res <= self.model.settings.rtol && c.abs() <= 1e-12 * cscale;
         // the Newton correction
         let ldlt = &self.model.ldlt;
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
@@ -1169,7 +1251,20 @@ impl newton::Problem for MembraneProblem<'_> {
         } else if let Some(h) = &h {
             let mut b = a.g.clone();
             ldlt.solve(&mut b);
-            if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
+            if let Some(phi0) = self.hold {
+                // the held mode out of the load column and the correction, and its force out of
+                // the convergence test (it is the reaction of the hold)
+                let (phi, mu) = self.model.inverse_iteration(phi0);
+                project_out(&mut b, &phi);
+                project_out(&mut dx, &phi);
+                negative -= usize::from(mu < 0.0 && negative > 0);
+                // deflating from φ0 makes Kφ lie along φ0 (one inverse iteration), so at the
+                // fixed point R is along φ0: the reaction
+                let mut r_off = r.clone();
+                project_out(&mut r_off, phi0);
+                converged = norm(&r_off) / reference <= self.model.settings.rtol
+                    && c.abs() <= 1e-12 * cscale;
+            } else if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
                 // the neutral mode out of the load column (not out of the correction: the
                 // residual along it must still go); its pivot out of the count (its sign is
                 // round-off)
