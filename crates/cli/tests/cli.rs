@@ -1393,7 +1393,7 @@ fn a_killed_closed_gas_arc_length_run_resumes_at_its_plates() {
 /// mode in a VTU), and the path is still the bulge's: the located maximum carries the
 /// axisymmetric tube's end effect (+1.11733e-4 at L/R = 40, python_ref) and the plateau is
 /// Maxwell's pressure, both to issue 12's 1e-4 once the 8-gon factor is out (measured
-/// 2026-11-30: +9.64e-5 and +2.4e-11).
+/// 2026-11-30: +9.64e-5 and +5.2e-10; +2.4e-11 before the hold began at the first sign flip).
 #[test]
 fn a_whole_tube_holds_its_neutral_bulge_translation_and_reaches_the_target() {
     let d = tmp("neutral");
@@ -1418,6 +1418,14 @@ fn a_whole_tube_holds_its_neutral_bulge_translation_and_reaches_the_target() {
     assert!(neutral[0]["mode_eigenvalue"].as_f64().unwrap().abs() < 1e-8);
     let vtu = neutral[0]["mode_vtu"].as_str().unwrap();
     assert!(out.join(vtu).exists(), "{vtu}");
+    // and its PNG along the tube
+    let png = neutral[0]["mode_png"].as_str().unwrap();
+    let bytes = std::fs::read(out.join(png)).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{png}");
+    // no bifurcation: the sign flips of the translation's round-off eigenvalue are the
+    // neutral point itself (found where the count first changed, λs 5.099; before the fix of
+    // 2026-11-30 two "bifurcations" were reported there)
+    assert_eq!(kind("bifurcation").count(), 0, "{points:?}");
     let csv = std::fs::read_to_string(out.join("critical_points.csv")).unwrap();
     assert!(
         csv.lines().any(|l| l.split(',').nth(2) == Some("3")),

@@ -198,8 +198,9 @@ pub enum CriticalKind {
     Bifurcation,
     /// an eigenvalue of K at round-off whose mode the load does not drive: the equilibria form
     /// a family along it (a bulge that can slide along a whole tube); from here on the mode is
-    /// held out of the path ([`Path::hold_neutral`]). Found where the path would otherwise
-    /// turn within any step, not located on the arc length
+    /// held out of the path ([`Path::hold_neutral`]). Found where the negative-pivot count
+    /// first changes by such a mode (its sign is round-off: no branch leaves there), or where
+    /// the path would otherwise turn within any step; not located on the arc length
     Neutral,
 }
 
@@ -596,6 +597,44 @@ pub fn follow<P: Path, O>(
             if c.0 <= sigma_target {
                 let load = path.load(&c.2);
                 let cp = Critical::at(kind, step + 1, &point, c, load, negative);
+                on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
+                    step: step + 1,
+                    source,
+                })?;
+                criticals.push(cp);
+            }
+        } else if negative != point.negative
+            && path
+                .hold_neutral(&next)
+                .map_err(|source| ArcError::Tangent {
+                    step: step + 1,
+                    source,
+                })?
+        {
+            // the count changed by a mode that is neutral at the step's end (eigenvalue at
+            // round-off, free of the load: a bulge's translation in a long tube, which flips
+            // sign with the rounding): not a bifurcation — no branch leaves here, and every
+            // perturbation along it is another member of the same family. Held from here on,
+            // and reported once as the neutral point
+            let t = path.tangent(&next).map_err(|source| ArcError::Tangent {
+                step: step + 1,
+                source,
+            })?;
+            negative = t.negative;
+            negative_conjugate = t.negative_conjugate;
+            (tu, tl) = unit_tangent(t.b, w, Some((&tu, tl)), 1.0);
+            if target_end.is_none() {
+                let cp = Critical {
+                    kind: CriticalKind::Neutral,
+                    step: step + 1,
+                    s: s_next,
+                    bracket: 0.0,
+                    state: next.clone(),
+                    load: path.load(&next),
+                    negative_before: point.negative,
+                    negative_after: negative,
+                    switched: None,
+                };
                 on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
                     step: step + 1,
                     source,
