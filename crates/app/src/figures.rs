@@ -1017,3 +1017,76 @@ pub fn write_all(
     )?);
     Ok(written)
 }
+
+/// A critical mode along the tube: the means over each ring of nodes at the reference radius
+/// (the cylinder and the caps' equators) of the mode's radial and axial components, against
+/// the reference Z, scaled so that the largest is 1 (a mode's size is arbitrary).
+pub fn mode_figure(
+    mesh: &tubemem_mesh::Mesh,
+    mode: &[[f64; 3]],
+    title: &str,
+    notes: Vec<String>,
+) -> Figure {
+    let radius = mesh
+        .nodes
+        .iter()
+        .map(|p| p[0].hypot(p[1]))
+        .fold(0.0, f64::max);
+    let tol = 1e-9 * mesh.scale();
+    let mut nodes: Vec<usize> = (0..mesh.nodes.len().min(mode.len()))
+        .filter(|&i| (mesh.nodes[i][0].hypot(mesh.nodes[i][1]) - radius).abs() <= tol)
+        .collect();
+    nodes.sort_by(|&a, &b| mesh.nodes[a][2].total_cmp(&mesh.nodes[b][2]));
+    // (Z, mean u_r, mean u_z) per ring
+    let mut rings: Vec<(f64, f64, f64, usize)> = vec![];
+    for i in nodes {
+        let p = mesh.nodes[i];
+        let ur = (mode[i][0] * p[0] + mode[i][1] * p[1]) / radius;
+        match rings.last_mut() {
+            Some(r) if (r.0 - p[2]).abs() <= tol => {
+                r.1 += ur;
+                r.2 += mode[i][2];
+                r.3 += 1;
+            }
+            _ => rings.push((p[2], ur, mode[i][2], 1)),
+        }
+    }
+    let rings: Vec<(f64, f64, f64)> = rings
+        .into_iter()
+        .map(|(z, a, b, n)| (z, a / n as f64, b / n as f64))
+        .collect();
+    let scale = rings
+        .iter()
+        .map(|r| r.1.abs().max(r.2.abs()))
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    let series = |label: &str, pick: fn(&(f64, f64, f64)) -> f64, color, stroke| Series {
+        label: label.into(),
+        points: rings.iter().map(|r| (r.0, pick(r) / scale)).collect(),
+        color,
+        stroke,
+        width: 2,
+    };
+    let mut fig = Figure::new(
+        title,
+        "reference axial position Z / R",
+        "mode (ring mean, largest = 1)",
+        vec![
+            series(
+                "radial component u_r",
+                |r| r.1,
+                RGBColor(200, 30, 30),
+                Stroke::Solid,
+            ),
+            series(
+                "axial component u_z",
+                |r| r.2,
+                RGBColor(30, 60, 200),
+                Stroke::Dashed,
+            ),
+        ],
+    );
+    fig.y_from_zero = false;
+    fig.notes = notes;
+    fig
+}

@@ -1058,6 +1058,39 @@ impl Observer for RunWriter {
                 tubemem_mesh::vtu::Encoding::Binary,
             )?;
         }
+        if let (Some(mode), Some(name)) = (mode, &record.mode_png) {
+            let fig = crate::figures::mode_figure(
+                model.mesh(),
+                mode,
+                &format!(
+                    "Critical mode of stage {}, between steps {} and {}",
+                    record.stage,
+                    record.step - 1,
+                    record.step
+                ),
+                match record.kind {
+                    tubemem_fem::continuation::CriticalKind::Neutral => vec![format!(
+                        "neutral (eigenvalue {:.1e}): a family of equilibria along this mode, e.g. a bulge's translation (u_z uniform in each straight end, u_r antisymmetric about the bulge)",
+                        record.mode_eigenvalue.unwrap_or(f64::NAN)
+                    )],
+                    _ => vec![format!(
+                        "{} — eigenvalue of K nearest zero: {:.1e}",
+                        record.kind,
+                        record.mode_eigenvalue.unwrap_or(f64::NAN)
+                    )],
+                },
+            );
+            let stem = self.dir.join(name.trim_end_matches(".png"));
+            crate::figures::save(
+                &fig,
+                &stem,
+                &crate::figures::FigureOptions {
+                    png: true,
+                    svg: false,
+                    ..Default::default()
+                },
+            )?;
+        }
         Ok(())
     }
 

@@ -372,6 +372,10 @@ pub struct CriticalRecord {
     pub mode_eigenvalue: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mode_vtu: Option<String>,
+    /// the same mode along the tube as a PNG (the ring means of its radial and axial
+    /// components against the reference Z), relative to the run folder
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode_png: Option<String>,
 }
 
 /// One stage of the report: its plan, its steps and how it ended.

@@ -200,6 +200,9 @@ fn critical_record(
         mode_vtu: mode
             .as_ref()
             .map(|_| format!("vtu/critical_stage{stage}_step{}.vtu", c.step)),
+        mode_png: mode
+            .as_ref()
+            .map(|_| format!("critical_stage{stage}_step{}_mode.png", c.step)),
     };
     pending.push(PendingCritical {
         record,

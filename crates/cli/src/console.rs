@@ -223,7 +223,14 @@ impl Observer for Console {
         let mode = r
             .mode_vtu
             .as_ref()
-            .map(|v| format!("; critical mode in {v}"))
+            .map(|v| {
+                let png = r
+                    .mode_png
+                    .as_ref()
+                    .map(|p| format!(" and {p}"))
+                    .unwrap_or_default();
+                format!("; critical mode in {v}{png}")
+            })
             .unwrap_or_default();
         let line = format!(
             "  stage {} ◆ {} between steps {} and {}: ϖ = {:.8}, λs = {:.6}, λz = {:.6}, V = {:.5} R³, negative pivots {} → {}{gps}{mode}",
