@@ -60,6 +60,17 @@ fn fronts(model: &Model, rings: &Rings, state: &State) -> Vec<f64> {
         .collect()
 }
 
+/// An error with its causes, "a: b: c".
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        s.push_str(&format!(": {c}"));
+        cause = c.source();
+    }
+    s
+}
+
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let arg = |i: usize, name: &str| -> Result<f64, String> {
@@ -207,11 +218,11 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 current = trial;
             }
             Err(e) if step > 1 => {
-                println!("  (a move of {step} rows failed: {e}; halving)");
+                println!("  (a move of {step} rows failed: {}; halving)", chain(&e));
                 step /= 2;
             }
             Err(e) => {
-                println!("stop: {e}");
+                println!("stop: {}", chain(&e));
                 break;
             }
         }
