@@ -1444,6 +1444,43 @@ fn a_whole_tube_holds_its_neutral_bulge_translation_and_reaches_the_target() {
         (plateau / (0.4508393877 * polygon) - 1.0).abs() < 1e-4,
         "{plateau}"
     );
+    // killed past the neutral point and resumed: the resumed path holds the mode again at once
+    // (before 2026-11-30 it did not, took 51 extra steps to find the mode again and reported a
+    // second neutral point), and it ends on the same plateau
+    let killed = d.join("killed");
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("1,")).count() >= 55
+    });
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let resumed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())
+            .unwrap();
+    let points = resumed["stages"][0]["critical_points"].as_array().unwrap();
+    let count = |k: &str| points.iter().filter(|c| c["kind"] == k).count();
+    assert_eq!(
+        (count("neutral"), count("bifurcation")),
+        (1, 0),
+        "{points:?}"
+    );
+    let rows = std::fs::read_to_string(killed.join("steps.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    let reference_rows = std::fs::read_to_string(out.join("steps.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    // measured 2026-11-30: 82 lines against the uninterrupted run's 79 (the resumed steps
+    // start from the checkpoint's step length); about 130 without the hold on resume
+    assert!(rows <= reference_rows + 10, "{rows} vs {reference_rows}");
+    let resumed_plateau = points.iter().find(|c| c["kind"] == "limit-min").unwrap()["w"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (resumed_plateau / (0.4508393877 * polygon) - 1.0).abs() < 1e-4,
+        "{resumed_plateau}"
+    );
 }
 
 /// Resource guards: the 6.6 M-equation full tube is refused before anything is built (well

@@ -1174,6 +1174,12 @@ pub fn run_arc_stage<E>(
         ..ArcSettings::default()
     };
     let mut path = MembranePath::new(model, loading);
+    if resume.is_some() {
+        // a run resumed past a neutral point holds its mode again at once, as the run before
+        // the checkpoint did (it was reported then); a mode that is not neutral here is not held
+        // (an error here only means no hold: the path finds the mode itself if it needs to)
+        let _ = path.hold_neutral(state);
+    }
     let target = Target {
         name: "target",
         monitor,
