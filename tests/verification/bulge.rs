@@ -159,7 +159,7 @@ fn arc_length_locates_the_pressure_maximum_and_the_maxwell_plateau_of_a_bulging_
 /// 10 times its volume (a bulge with fronts near Z = ±2.2 R; the caps' junctions at ±20 R).
 ///
 /// * Far from the caps the move is free: the energy at equal volume is that of the centred
-///   bulge to round-off (measured 2026-11-30: |ΔW| ≤ 3.3e-12 of W = 2.6e2, i.e. 1.3e-14; bound
+///   bulge to round-off (measured 2026-11-30: |ΔW| ≤ 3.3e-12 of W = 573, i.e. 6e-15; bound
 ///   1e-13), and the held mode's eigenvalue is round-off (≤ 1.5e-16 of the diagonal, bound
 ///   `NEUTRAL`).
 /// * Near a cap the energy grows and the hold's reaction pushes the bulge back (f > 0): the caps

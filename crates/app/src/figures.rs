@@ -1032,28 +1032,21 @@ pub fn mode_figure(
         .iter()
         .map(|p| p[0].hypot(p[1]))
         .fold(0.0, f64::max);
-    let tol = 1e-9 * mesh.scale();
-    let mut nodes: Vec<usize> = (0..mesh.nodes.len().min(mode.len()))
-        .filter(|&i| (mesh.nodes[i][0].hypot(mesh.nodes[i][1]) - radius).abs() <= tol)
-        .collect();
-    nodes.sort_by(|&a, &b| mesh.nodes[a][2].total_cmp(&mesh.nodes[b][2]));
-    // (Z, mean u_r, mean u_z) per ring
-    let mut rings: Vec<(f64, f64, f64, usize)> = vec![];
-    for i in nodes {
-        let p = mesh.nodes[i];
-        let ur = (mode[i][0] * p[0] + mode[i][1] * p[1]) / radius;
-        match rings.last_mut() {
-            Some(r) if (r.0 - p[2]).abs() <= tol => {
-                r.1 += ur;
-                r.2 += mode[i][2];
-                r.3 += 1;
+    // (Z, mean u_r, mean u_z) per ring (a mode of another mesh's length draws nothing)
+    let rings: Vec<(f64, f64, f64)> = mesh
+        .rings()
+        .iter()
+        .filter(|ring| !ring.is_empty() && ring.iter().all(|&i| i < mode.len()))
+        .map(|ring| {
+            let (mut ur, mut uz) = (0.0, 0.0);
+            for &i in ring {
+                let p = mesh.nodes[i];
+                ur += (mode[i][0] * p[0] + mode[i][1] * p[1]) / radius;
+                uz += mode[i][2];
             }
-            _ => rings.push((p[2], ur, mode[i][2], 1)),
-        }
-    }
-    let rings: Vec<(f64, f64, f64)> = rings
-        .into_iter()
-        .map(|(z, a, b, n)| (z, a / n as f64, b / n as f64))
+            let n = ring.len() as f64;
+            (mesh.nodes[ring[0]][2], ur / n, uz / n)
+        })
         .collect();
     let scale = rings
         .iter()

@@ -17,28 +17,18 @@
 //!   move (f > 0: the energy grows as the bulge approaches the cap — the cap pushes it back),
 //!   the held mode's eigenvalue over K's largest diagonal entry, and Newton's iterations;
 //! - the growth of W − W(centred) per R of approach.
-use tubemem_fem::continuation::{run_arc_stage, ArcLoading};
+mod common;
+
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::slide::{translate_bulge, Rings};
-use tubemem_fem::stepping::{prestress, Stage, StepSettings};
-use tubemem_mesh::tube::capped_tube;
-use tubemem_mesh::Symmetry;
-
-const USAGE: &str = "usage: bulge_slide LENGTH PER_R AROUND VOLUME_RATIO [MOVE_R]";
 
 fn main() -> std::process::ExitCode {
-    match run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("bulge_slide: {e}\n{USAGE}");
-            std::process::ExitCode::from(2)
-        }
-    }
+    common::main_with(
+        "bulge_slide",
+        "bulge_slide LENGTH PER_R AROUND VOLUME_RATIO [MOVE_R]",
+        run,
+    )
 }
-
-/// The largest mesh this example builds: 2 million nodes (the CLI's own resource guards do not
-/// apply here).
-const MAX_NODES: f64 = 2e6;
 
 /// The fronts of `state`: where the ring radius crosses halfway between its extremes (in R of
 /// reference Z).
@@ -60,81 +50,31 @@ fn fronts(model: &Model, rings: &Rings, state: &State) -> Vec<f64> {
         .collect()
 }
 
-/// An error with its causes, "a: b: c".
-fn chain(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        s.push_str(&format!(": {c}"));
-        cause = c.source();
-    }
-    s
-}
-
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let arg = |i: usize, name: &str| -> Result<f64, String> {
-        let a = args.get(i).ok_or(format!("missing {name}"))?;
-        a.parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .ok_or(format!("{name} = {a:?}: a positive number"))
-    };
+    let args = common::Args::new();
     let (length, per, around, ratio) = (
-        arg(0, "LENGTH")?,
-        arg(1, "PER_R")?,
-        arg(2, "AROUND")?,
-        arg(3, "VOLUME_RATIO")?,
+        args.positive(0, "LENGTH")?,
+        args.positive(1, "PER_R")?,
+        args.positive(2, "AROUND")?,
+        args.positive(3, "VOLUME_RATIO")?,
     );
     let max_move = if args.len() > 4 {
-        arg(4, "MOVE_R")?
+        args.positive(4, "MOVE_R")?
     } else {
         f64::INFINITY
     };
-    if around * per * length > MAX_NODES {
-        return Err(format!(
-            "{around} around × {} along is more than {MAX_NODES} nodes",
-            per * length
-        )
-        .into());
-    }
-    let along = (per * length) as usize;
-    let mesh = capped_tube(1.0, length, around as usize, along, Symmetry::None)?;
-    let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0)?;
-    let mut model = Model::new(mesh, Box::new(law))?;
+    let stage = common::stage(ratio);
+    let (mut model, mut state) = common::whole_tube(length, per, around, &stage)?;
     let rings = Rings::new(&model)?;
-    let mut state = model.reference_state();
-    let v0 = model.mesh().volume_at(&state.x) * model.multiplicity();
-    let stage = Stage {
-        index: 1,
-        from: 1.0,
-        to: ratio,
-        settings: StepSettings::default(),
-    };
-    prestress::<()>(&mut model, &mut state, &stage).map_err(|e| match e {
-        tubemem_fem::stepping::StageError::Solve(e) => format!("pre-stress: {e}"),
-        _ => "pre-stress".to_string(),
-    })?;
+    let v0 = model.mesh().volume() * model.multiplicity();
     let mesh = model.mesh().clone();
     let mult = model.multiplicity();
     let monitor = move |s: &State| mult * mesh.volume_at(&s.x) / v0;
     let t0 = std::time::Instant::now();
     let mut steps = 0;
-    run_arc_stage(
-        &mut model,
-        &mut state,
-        &stage,
-        None,
-        ArcLoading::Pressure(None),
-        &monitor,
-        1.0,
-        None,
-        |_, _, info| {
-            steps = info.step;
-            Ok::<(), ()>(())
-        },
-        |_, _| Ok(()),
-    )
+    common::follow(&mut model, &mut state, &stage, &monitor, |step, _, _, _| {
+        steps = step
+    })
     .map_err(|e| match e {
         tubemem_fem::stepping::StageError::Solve(e) => format!("inflation: {e}"),
         _ => "inflation".to_string(),
@@ -218,11 +158,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 current = trial;
             }
             Err(e) if step > 1 => {
-                println!("  (a move of {step} rows failed: {}; halving)", chain(&e));
+                println!(
+                    "  (a move of {step} rows failed: {}; halving)",
+                    common::chain(&e)
+                );
                 step /= 2;
             }
             Err(e) => {
-                println!("stop: {}", chain(&e));
+                println!("stop: {}", common::chain(&e));
                 break;
             }
         }

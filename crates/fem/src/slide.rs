@@ -44,28 +44,7 @@ impl Rings {
                 requirement: "sliding a bulge needs the whole capped tube (symmetry = \"none\") of 4-node elements",
             });
         }
-        let radius = mesh
-            .nodes
-            .iter()
-            .map(|p| p[0].hypot(p[1]))
-            .fold(0.0, f64::max);
-        let tol = 1e-9 * mesh.scale();
-        // the cylinder: nodes at the full radius (the caps' equators are the end rings)
-        let mut cyl: Vec<usize> = (0..mesh.nodes.len())
-            .filter(|&i| (mesh.nodes[i][0].hypot(mesh.nodes[i][1]) - radius).abs() <= tol)
-            .collect();
-        cyl.sort_by(|&a, &b| {
-            let (p, q) = (mesh.nodes[a], mesh.nodes[b]);
-            p[2].total_cmp(&q[2])
-                .then(p[1].atan2(p[0]).total_cmp(&q[1].atan2(q[0])))
-        });
-        let mut rings: Vec<Vec<usize>> = vec![];
-        for i in cyl {
-            match rings.last_mut() {
-                Some(r) if (mesh.nodes[r[0]][2] - mesh.nodes[i][2]).abs() <= tol => r.push(i),
-                _ => rings.push(vec![i]),
-            }
-        }
+        let rings = mesh.rings();
         let around = rings.first().map_or(0, Vec::len);
         if rings.len() < 3 || rings.iter().any(|r| r.len() != around) {
             return Err(FemError::InvalidParameter {

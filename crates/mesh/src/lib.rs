@@ -154,6 +154,35 @@ impl Mesh {
             .max(1e-300)
     }
 
+    /// The rings of nodes at the largest distance from the z axis (a tube's cylinder with the
+    /// caps' equators or the plug rings), by reference Z ascending, each ring in the order of
+    /// its nodes' angle about the axis (coordinates equal within 1e-9 of the mesh's scale).
+    pub fn rings(&self) -> Vec<Vec<usize>> {
+        let radius = self
+            .nodes
+            .iter()
+            .map(|p| p[0].hypot(p[1]))
+            .fold(0.0, f64::max);
+        let tol = PLANE_TOL * self.scale();
+        let mut nodes: Vec<usize> = (0..self.nodes.len())
+            .filter(|&i| (self.nodes[i][0].hypot(self.nodes[i][1]) - radius).abs() <= tol)
+            .collect();
+        let angle = |i: usize| self.nodes[i][1].atan2(self.nodes[i][0]);
+        nodes.sort_by(|&a, &b| {
+            self.nodes[a][2]
+                .total_cmp(&self.nodes[b][2])
+                .then(angle(a).total_cmp(&angle(b)))
+        });
+        let mut rings: Vec<Vec<usize>> = vec![];
+        for i in nodes {
+            match rings.last_mut() {
+                Some(r) if (self.nodes[r[0]][2] - self.nodes[i][2]).abs() <= tol => r.push(i),
+                _ => rings.push(vec![i]),
+            }
+        }
+        rings
+    }
+
     /// Nodes lying on the symmetry plane `axis` = 0.
     pub fn on_plane(&self, axis: usize) -> Vec<bool> {
         let tol = PLANE_TOL * self.scale();
