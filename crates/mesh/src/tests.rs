@@ -316,3 +316,23 @@ fn json_mesh_round_trip_and_rejection() {
     crate::io::write_json(&p, &q9).unwrap();
     assert_eq!(crate::io::read_json(&p, 1.0).unwrap(), q9);
 }
+
+/// `Mesh::rings` of a whole capped tube: its `along + 1` rings of `around` nodes (the cap
+/// equators are the end rings), at the generator's heights, each in increasing angle.
+#[test]
+fn rings_of_a_capped_tube_are_its_cylinder_rows() {
+    let mesh = capped_tube(1.0, 4.0, 16, 8, Symmetry::None).unwrap();
+    let rings = mesh.rings();
+    assert_eq!(rings.len(), 9);
+    for (l, ring) in rings.iter().enumerate() {
+        assert_eq!(ring.len(), 16);
+        for &i in ring {
+            assert!((mesh.nodes[i][2] - (-2.0 + 0.5 * l as f64)).abs() < 1e-12);
+        }
+        let angles: Vec<f64> = ring
+            .iter()
+            .map(|&i| mesh.nodes[i][1].atan2(mesh.nodes[i][0]))
+            .collect();
+        assert!(angles.windows(2).all(|w| w[1] > w[0]), "{angles:?}");
+    }
+}
