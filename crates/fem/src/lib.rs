@@ -124,6 +124,9 @@ pub enum FemError {
         #[source]
         source: Option<Box<newton::NewtonError<FemError>>>,
     },
+    /// A bulge could not be moved along the tube ([`slide`]).
+    #[error("cannot move the bulge: {what}")]
+    Slide { what: String },
 }
 
 impl FemError {

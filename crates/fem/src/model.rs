@@ -537,8 +537,8 @@ impl Model {
         newton::solve(&mut problem, state, &settings)
     }
 
-    /// Newton iterations at the prescribed total volume `volume` with the unit direction `phi0`
-    /// held (a bulge held where it sits, `phi0` its translation): the correction and the volume
+    /// Newton iterations at the prescribed total volume `volume` with the direction `phi0`
+    /// (normalized here) held (a bulge held where it sits, `phi0` its translation): the correction and the volume
     /// column are projected off the mode φ = K⁻¹φ0/‖K⁻¹φ0‖ at every linearization (one inverse
     /// iteration, so Kφ lies along φ0); at the fixed point the residual R = f_int − ϖg lies along `phi0`,
     /// and convergence is on the residual off it. `state` is the initial guess and, on success,
@@ -553,11 +553,14 @@ impl Model {
     ) -> Result<(newton::NewtonReport, Held), NewtonError<FemError>> {
         let settings = self.settings;
         let load = Load::new(Loading::Volume(volume));
+        // the hold's projections assume a unit direction
+        let n = norm(phi0).max(1e-300);
+        let phi0: Vec<f64> = phi0.iter().map(|v| v / n).collect();
         let mut problem = MembraneProblem::new(self, &load, None);
-        problem.hold = Some(phi0);
+        problem.hold = Some(&phi0);
         let report = newton::solve(&mut problem, state, &settings)?;
         let held = self
-            .held_at(state, phi0)
+            .held_at(state, &phi0)
             .map_err(|source| NewtonError::Problem {
                 iteration: report.iterations,
                 source,

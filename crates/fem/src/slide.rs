@@ -38,19 +38,19 @@ impl Rings {
     pub fn new(model: &Model) -> Result<Self, FemError> {
         let mesh = model.mesh();
         if mesh.symmetry != Symmetry::None || !mesh.mid.is_empty() || !mesh.plugs.is_empty() {
-            return Err(FemError::InvalidParameter {
-                name: "mesh",
-                value: 0.0,
-                requirement: "sliding a bulge needs the whole capped tube (symmetry = \"none\") of 4-node elements",
+            return Err(FemError::Slide {
+                what: "it needs the whole capped tube (symmetry = \"none\") of 4-node elements"
+                    .into(),
             });
         }
         let rings = mesh.rings();
         let around = rings.first().map_or(0, Vec::len);
         if rings.len() < 3 || rings.iter().any(|r| r.len() != around) {
-            return Err(FemError::InvalidParameter {
-                name: "mesh",
-                value: rings.len() as f64,
-                requirement: "the cylinder's nodes do not form rings of equal size",
+            return Err(FemError::Slide {
+                what: format!(
+                    "the cylinder's nodes do not form rings of equal size ({} rings)",
+                    rings.len()
+                ),
             });
         }
         Ok(Rings { rings })
@@ -107,19 +107,17 @@ pub fn translate_bulge(
     rows: isize,
 ) -> Result<Translated, FemError> {
     let n = rings.rings.len();
-    let (first, last) = rings.bulge(state).ok_or(FemError::InvalidParameter {
-        name: "state",
-        value: 0.0,
-        requirement: "there is no bulge to move (the rings' radii are within 1 % of one another)",
+    let (first, last) = rings.bulge(state).ok_or(FemError::Slide {
+        what: "there is none (the rings' radii are within 1 % of one another)".into(),
     })?;
     let (a, b) = (first / 2, (last + n - 1) / 2);
     let k = rows.unsigned_abs();
     let room = if rows > 0 { b - last } else { first - a };
     if rows == 0 || k >= room {
-        return Err(FemError::InvalidParameter {
-            name: "rows",
-            value: rows as f64,
-            requirement: "a move must be non-zero and stay within the uniform part between the bulge and the splice halfway to the cap",
+        return Err(FemError::Slide {
+            what: format!(
+                "a move of {rows} rows: it must be non-zero and shorter than the {room} rows of uniform tube between the bulge and the splice halfway to the cap"
+            ),
         });
     }
     let x = &state.x;

@@ -796,3 +796,52 @@ fn a_closed_gas_squeeze_by_arc_length_is_the_load_stepped_squeeze() {
     assert!((end.p - stepped.p).abs() <= 1e-8 * stepped.p);
     assert!(dx <= 1e-8);
 }
+
+/// Moving a bulge is refused with the reason: on a symmetry-reduced tube (no rings to shift
+/// whole), on a tube without a bulge, and by a move longer than the uniform part ahead of it.
+/// On a made-up bulge (a radial bump of the reference rings 4 to 8 of 25) a move of 2 rows
+/// puts the bump on rings 6 to 10 and keeps the caps where they were.
+#[test]
+fn a_bulge_is_moved_by_whole_rows_or_refused_with_the_reason() {
+    use crate::slide::{translate_bulge, Rings};
+    let law = || Box::new(AnssariBenamBucchi::new(1.0, 30.0).unwrap());
+    let eighth = Model::new(
+        capped_tube(1.0, 6.0, 8, 24, Symmetry::Eighth).unwrap(),
+        law(),
+    )
+    .unwrap();
+    let e = Rings::new(&eighth).unwrap_err();
+    assert!(e.to_string().contains("whole capped tube"), "{e}");
+    let model = Model::new(capped_tube(1.0, 6.0, 8, 24, Symmetry::None).unwrap(), law()).unwrap();
+    let rings = Rings::new(&model).unwrap();
+    assert_eq!(rings.rings.len(), 25);
+    let flat = model.reference_state();
+    let e = translate_bulge(&model, &rings, &flat, 1).unwrap_err();
+    assert!(e.to_string().contains("there is none"), "{e}");
+    let mut bumped = flat.clone();
+    for ring in &rings.rings[4..=8] {
+        for &i in ring {
+            bumped.x[i][0] *= 2.0;
+            bumped.x[i][1] *= 2.0;
+        }
+    }
+    let e = translate_bulge(&model, &rings, &bumped, 20).unwrap_err();
+    assert!(e.to_string().contains("shorter than"), "{e}");
+    let moved = translate_bulge(&model, &rings, &bumped, 2).unwrap();
+    let wide: Vec<usize> = rings
+        .radii(&moved.state)
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| **r > 1.5)
+        .map(|(l, _)| l)
+        .collect();
+    assert_eq!(wide, (6..=10).collect::<Vec<_>>());
+    // the caps (nodes off the cylinder) kept their positions up to the body's z-translation
+    // that keeps the pinned node's z: the uniform part here is the reference (λz = 1), so none
+    let cyl: std::collections::HashSet<usize> = rings.rings.iter().flatten().copied().collect();
+    for i in (0..flat.x.len()).filter(|i| !cyl.contains(i)) {
+        for k in 0..3 {
+            assert!((moved.state.x[i][k] - flat.x[i][k]).abs() < 1e-12);
+        }
+    }
+}
