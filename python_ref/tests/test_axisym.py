@@ -74,3 +74,21 @@ def test_volume_control_passes_the_limit_point_into_a_bulge():
     p_end, ls_mid, ls_side = states[-1]
     assert p_end < pmax - 0.03, "the pressure falls past the limit point"
     assert ls_mid - ls_side > 0.5, f"no localized bulge: mid-span {ls_mid}, Z = 6: {ls_side}"
+
+
+def test_cap_tail_decay_is_mesh_converged():
+    """The cap's boundary layer on the uniform part of the bulging tube (lambda_s = 1.15969, the
+    unbulged part of the whole FE tube at ten times its volume, README "Where the whole tube's
+    bulge goes"), L/R = 40: its decay per R at 3 and 4 R from the junction, 13.0008 and 13.0005
+    with 160 cylinder elements, 13.0010 and 13.0007 with 320 (measured 2026-11-30). The FE's
+    push on a bulge moved toward a cap grows at this rate (tests/verification/bulge.rs quotes
+    13.0007). Held: the two meshes within 1e-4 (5x their measured 2e-5), the layer exponential
+    (both distances within 1e-3), and the value the Rust test quotes, so that the quote cannot
+    drift from what this reference computes."""
+    coarse, p1 = axisym.cap_tail_decay(40.0, 1.15969, cylinder_elements=160)
+    fine, p2 = axisym.cap_tail_decay(40.0, 1.15969, cylinder_elements=320)
+    assert abs(p1 / p2 - 1) < 1e-9
+    for a, b in zip(coarse, fine):
+        assert abs(a / b - 1) < 1e-4, (coarse, fine)
+    assert abs(fine[0] / fine[1] - 1) < 1e-3, fine
+    assert abs(fine[1] - 13.0007) < 1e-3, fine

@@ -190,6 +190,20 @@ def inflate_volume(tube, q, p, v_target, dv, min_dv=1e-6, on_step=None):
     return q, p
 
 
+def cap_tail_decay(length, lambda_s, distances=(3.0, 4.0), law=None, **mesh):
+    """The decay of the cap's boundary layer of a uniform tube: inflate to mid-span stretch
+    `lambda_s`, then (r(d) - r_mid) / (r(d + 1) - r_mid) at each distance d (in R, along the
+    reference cylinder from the cap junction), the layer's factor of decay per R there; with
+    the pressure. A tail that decays as exp(-k d) gives exp(k) at every d."""
+    tube, q, p = inflate_to(length, lambda_s, law=law, **mesh)
+    nd = tube.basis.nodal_dofs
+    r, s = q[nd[0]], tube.basis.mesh.p[0]
+    cyl = s >= np.pi / 2
+    d, excess = s[cyl] - np.pi / 2, r[cyl] - r[cyl][-1]
+    ratios = [float(np.interp(x, d, excess) / np.interp(x + 1.0, d, excess)) for x in distances]
+    return ratios, p
+
+
 def pressure_maximum(length, lo, hi, law=None, tol=1e-7, **mesh):
     """The pressure maximum of the capped tube's inflation, (lambda_s, p) at mid-span: golden
     section on p(lambda_s) over [lo, hi] (which must bracket it), each p from a mid-span
