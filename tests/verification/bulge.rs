@@ -154,6 +154,11 @@ fn arc_length_locates_the_pressure_maximum_and_the_maxwell_plateau_of_a_bulging_
     }
 }
 
+/// The decay per R of the cap's boundary layer of the smooth axisymmetric tube at λs = 1.15969,
+/// 4 R from the junction (`python_ref`: `axisym.cap_tail_decay(40.0, 1.15969,
+/// cylinder_elements=320)`; `test_cap_tail_decay_is_mesh_converged` keeps this quote).
+const SMOOTH_CAP_TAIL_DECAY: f64 = 13.0007;
+
 /// The whole tube's bulge moved toward a cap at constant volume (`tubemem_fem::slide`,
 /// `Model::solve_held`): L/R = 40, 8 around, 8 elements per R along, inflated by arc length to
 /// 10 times its volume (a bulge with fronts near Z = ±2.2 R; the caps' junctions at ±20 R).
@@ -178,11 +183,6 @@ fn arc_length_locates_the_pressure_maximum_and_the_maxwell_plateau_of_a_bulging_
 ///   ΔW itself is referenced to the end of the path, converged to Newton's 1e-9 only,
 ///   so its ratios carry that offset (12.65 … 13.08) and are not tested. An attracting cap — the
 ///   premise of a stable off-centre branch — fails the sign; a different interaction, the rate.
-/// The decay per R of the cap's boundary layer of the smooth axisymmetric tube at λs = 1.15969,
-/// 4 R from the junction (`python_ref`: `axisym.cap_tail_decay(40.0, 1.15969,
-/// cylinder_elements=320)`; `test_cap_tail_decay_is_mesh_converged` keeps this quote).
-const SMOOTH_CAP_TAIL_DECAY: f64 = 13.0007;
-
 #[test]
 fn a_whole_tube_bulge_moved_toward_a_cap_costs_energy_growing_as_its_tails_decay() {
     use tubemem_fem::continuation::ArcLoading;
