@@ -482,30 +482,9 @@ pub fn follow<P: Path, O>(
                 // a path that turns within any step where the stiffness has a neutral mode:
                 // hold the mode out and take the step again, once
                 if failure.is_none() {
-                    let held =
-                        path.hold_neutral(&point.state)
-                            .map_err(|source| ArcError::Tangent {
-                                step: step + 1,
-                                source,
-                            })?;
-                    if held {
-                        let t = path
-                            .tangent(&point.state)
-                            .map_err(|source| ArcError::Tangent {
-                                step: step + 1,
-                                source,
-                            })?;
-                        let cp = Critical {
-                            kind: CriticalKind::Neutral,
-                            step: step + 1,
-                            s: point.s,
-                            bracket: 0.0,
-                            state: point.state.clone(),
-                            load: path.load(&point.state),
-                            negative_before: point.negative,
-                            negative_after: t.negative,
-                            switched: None,
-                        };
+                    if let Some((t, cp)) =
+                        neutral_point(path, &point.state, point.s, point.negative, step + 1)?
+                    {
                         on_event(path, ArcEvent::Critical(&cp)).map_err(|source| {
                             ArcError::Observer {
                                 step: step + 1,
@@ -581,7 +560,13 @@ pub fn follow<P: Path, O>(
                 None
             };
         let sigma_target = target_end.as_ref().map_or(f64::INFINITY, |t| t.0);
-        // critical points inside the step (before the target), in path order
+        // critical points inside the step (before the target), in path order; a count change
+        // by a neutral mode is held, not located
+        let neutral = if tl * point.tl >= 0.0 && negative != point.negative {
+            neutral_point(path, &next, s_next, point.negative, step + 1)?
+        } else {
+            None
+        };
         if tl * point.tl < 0.0 {
             let (tu0, tl0) = (point.tu.clone(), point.tl);
             let c = locate(path, &point, w, ds, settings, |path, s| {
@@ -603,38 +588,16 @@ pub fn follow<P: Path, O>(
                 })?;
                 criticals.push(cp);
             }
-        } else if negative != point.negative
-            && path
-                .hold_neutral(&next)
-                .map_err(|source| ArcError::Tangent {
-                    step: step + 1,
-                    source,
-                })?
-        {
+        } else if let Some((t, cp)) = neutral {
             // the count changed by a mode that is neutral at the step's end (eigenvalue at
             // round-off, free of the load: a bulge's translation in a long tube, which flips
             // sign with the rounding): not a bifurcation — no branch leaves here, and every
             // perturbation along it is another member of the same family. Held from here on,
             // and reported once as the neutral point
-            let t = path.tangent(&next).map_err(|source| ArcError::Tangent {
-                step: step + 1,
-                source,
-            })?;
             negative = t.negative;
             negative_conjugate = t.negative_conjugate;
             (tu, tl) = unit_tangent(t.b, w, Some((&tu, tl)), 1.0);
             if target_end.is_none() {
-                let cp = Critical {
-                    kind: CriticalKind::Neutral,
-                    step: step + 1,
-                    s: s_next,
-                    bracket: 0.0,
-                    state: next.clone(),
-                    load: path.load(&next),
-                    negative_before: point.negative,
-                    negative_after: negative,
-                    switched: None,
-                };
                 on_event(path, ArcEvent::Critical(&cp)).map_err(|source| ArcError::Observer {
                     step: step + 1,
                     source,
@@ -775,6 +738,41 @@ pub fn follow<P: Path, O>(
         let f = (settings.desired_iterations.max(1) as f64 / iterations.max(1) as f64).sqrt();
         ds = (ds * f.clamp(0.5, 2.0)).min(max_ds);
     }
+}
+
+/// The neutral point at `state` (arc length `s`, reached with `negative_before` negative
+/// pivots, in step `step`): when [`Path::hold_neutral`] finds a neutral mode there and holds it,
+/// the path tangent with the mode held out and the point as a critical point of kind
+/// [`CriticalKind::Neutral`]; `None` otherwise.
+#[allow(clippy::type_complexity)]
+fn neutral_point<P: Path, O>(
+    path: &mut P,
+    state: &P::State,
+    s: f64,
+    negative_before: usize,
+    step: usize,
+) -> Result<Option<(Tangent, Critical<P::State>)>, ArcError<P::Error, O>> {
+    if !path
+        .hold_neutral(state)
+        .map_err(|source| ArcError::Tangent { step, source })?
+    {
+        return Ok(None);
+    }
+    let t = path
+        .tangent(state)
+        .map_err(|source| ArcError::Tangent { step, source })?;
+    let cp = Critical {
+        kind: CriticalKind::Neutral,
+        step,
+        s,
+        bracket: 0.0,
+        state: state.clone(),
+        load: path.load(state),
+        negative_before,
+        negative_after: t.negative,
+        switched: None,
+    };
+    Ok(Some((t, cp)))
 }
 
 impl<S> Critical<S> {
