@@ -559,34 +559,14 @@ impl Model {
         let mut problem = MembraneProblem::new(self, &load, None);
         problem.hold = Some(&phi0);
         let report = newton::solve(&mut problem, state, &settings)?;
-        let held = self
-            .held_at(state, &phi0)
-            .map_err(|source| NewtonError::Problem {
-                iteration: report.iterations,
-                source,
-            })?;
+        // set by the converged linearization (Newton returns only from one)
+        let held = problem.held.take().ok_or(NewtonError::Problem {
+            iteration: report.iterations,
+            source: FemError::NonFiniteResidual {
+                what: "the held mode (no converged linearization)",
+            },
+        })?;
         Ok((report, held))
-    }
-
-    /// The held mode at the equilibrium `state` (pressure `state.p`): refreshed from `phi0`
-    /// by one inverse iteration, with its eigenvalue relative to K's largest diagonal entry and
-    /// the reaction φ0ᵀR.
-    fn held_at(&mut self, state: &State, phi0: &[f64]) -> Result<Held, FemError> {
-        let load = Load::pressure(state.p);
-        let (a, _, _) = self.pressure_tangent_with(state, &load)?;
-        let (phi, mu) = self.inverse_iteration(phi0);
-        let r: Vec<f64> = a
-            .f_int
-            .iter()
-            .zip(&a.g)
-            .map(|(f, g)| f - state.p * g)
-            .collect();
-        Ok(Held {
-            force: dot(phi0, &r),
-            relative_eigenvalue: mu / self.largest_diagonal(&a, state.p),
-            energy: a.energy,
-            mode: phi,
-        })
     }
 
     /// Newton iterations on equilibrium under the pressure `state.p` (a free unknown) together
@@ -760,10 +740,7 @@ impl Model {
     /// itself) is nearly neutral too: K⁻¹φ0 and `b` = K⁻¹g then span the two, and the held mode
     /// is their combination that does not change the volume (gᵀφ = 0).
     pub fn deflate(&self, phi0: &[f64], g: &[f64], b: &[f64]) -> (Vec<f64>, f64) {
-        let mut u = phi0.to_vec();
-        self.ldlt.solve(&mut u);
-        let nu = norm(&u).max(1e-300);
-        u.iter_mut().for_each(|v| *v /= nu);
+        let u = self.unit_solve(phi0);
         // the part of b = K⁻¹g off u: a second direction of the near-null space when it is
         // not negligible
         let nb = norm(b).max(1e-300);
@@ -780,23 +757,32 @@ impl Model {
         } else {
             u
         };
-        let mut w = phi.clone();
-        self.ldlt.solve(&mut w);
-        let mu = 1.0 / dot(&phi, &w);
+        let mu = self.rayleigh(&phi);
         (phi, mu)
     }
 
     /// One inverse iteration on the current factor of K from the unit vector `phi0`:
-    /// φ = K⁻¹φ0/‖K⁻¹φ0‖ (so Kφ lies along φ0) and its Rayleigh quotient μ = 1/(φᵀK⁻¹φ).
+    /// φ = K⁻¹φ0/‖K⁻¹φ0‖ (so Kφ lies along φ0) and its Rayleigh quotient.
     fn inverse_iteration(&self, phi0: &[f64]) -> (Vec<f64>, f64) {
-        let mut phi = phi0.to_vec();
-        self.ldlt.solve(&mut phi);
-        let n = norm(&phi).max(1e-300);
-        phi.iter_mut().for_each(|v| *v /= n);
-        let mut w = phi.clone();
-        self.ldlt.solve(&mut w);
-        let mu = 1.0 / dot(&phi, &w);
+        let phi = self.unit_solve(phi0);
+        let mu = self.rayleigh(&phi);
         (phi, mu)
+    }
+
+    /// K⁻¹v/‖K⁻¹v‖ with the current factor.
+    fn unit_solve(&self, v: &[f64]) -> Vec<f64> {
+        let mut u = v.to_vec();
+        self.ldlt.solve(&mut u);
+        let n = norm(&u).max(1e-300);
+        u.iter_mut().for_each(|x| *x /= n);
+        u
+    }
+
+    /// The Rayleigh quotient of K for the unit vector φ through its inverse: μ = 1/(φᵀK⁻¹φ).
+    fn rayleigh(&self, phi: &[f64]) -> f64 {
+        let mut w = phi.to_vec();
+        self.ldlt.solve(&mut w);
+        1.0 / dot(phi, &w)
     }
 
     /// The largest |diagonal entry| of K = K_int − p H in `a` (the scale of the stiffness).
@@ -1066,6 +1052,9 @@ struct MembraneProblem<'a> {
     /// force that would move the state along the mode — is left as the hold's reaction (see
     /// [`Model::solve_held`])
     hold: Option<&'a [f64]>,
+    /// with `hold`: the held mode, its eigenvalue, the reaction and the energy at the converged
+    /// linearization
+    held: Option<Held>,
     /// the assembly (with the tangent) of the last trial state the line search evaluated:
     /// when that trial is accepted, the next linearization is at the same state and takes it
     /// instead of assembling again
@@ -1087,6 +1076,7 @@ impl MembraneProblem<'_> {
             arc,
             planes: None,
             hold: None,
+            held: None,
             trial: std::cell::RefCell::new(None),
             rejected_seconds: std::cell::Cell::new(0.0),
         }
@@ -1267,6 +1257,14 @@ impl newton::Problem for MembraneProblem<'_> {
                 project_out(&mut r_off, phi0);
                 converged = norm(&r_off) / reference <= self.model.settings.rtol
                     && c.abs() <= 1e-12 * cscale;
+                if converged {
+                    self.held = Some(Held {
+                        force: dot(phi0, &r),
+                        relative_eigenvalue: mu / self.model.largest_diagonal(&a, p),
+                        energy: a.energy,
+                        mode: phi,
+                    });
+                }
             } else if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
                 // the neutral mode out of the load column (not out of the correction: the
                 // residual along it must still go); its pivot out of the count (its sign is
