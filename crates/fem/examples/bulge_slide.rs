@@ -19,7 +19,7 @@
 //! - the growth of W − W(centred) per R of approach.
 mod common;
 
-use tubemem_fem::model::{Model, State};
+use tubemem_fem::model::State;
 use tubemem_fem::slide::{translate_bulge, Rings};
 
 fn main() -> std::process::ExitCode {
@@ -28,26 +28,6 @@ fn main() -> std::process::ExitCode {
         "bulge_slide LENGTH PER_R AROUND VOLUME_RATIO [MOVE_R]",
         run,
     )
-}
-
-/// The fronts of `state`: where the ring radius crosses halfway between its extremes (in R of
-/// reference Z).
-fn fronts(model: &Model, rings: &Rings, state: &State) -> Vec<f64> {
-    let r = rings.radii(state);
-    let z: Vec<f64> = rings
-        .rings
-        .iter()
-        .map(|ring| model.mesh().nodes[ring[0]][2])
-        .collect();
-    let lo = r.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = r.iter().copied().fold(0.0, f64::max);
-    let level = 0.5 * (lo + hi);
-    (1..r.len())
-        .filter_map(|i| {
-            let (a, b) = (r[i - 1] - level, r[i] - level);
-            (a * b < 0.0).then(|| z[i - 1] + (z[i] - z[i - 1]) * a / (a - b))
-        })
-        .collect()
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
@@ -86,7 +66,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         volume / v0,
         t0.elapsed().as_secs_f64(),
         state.p,
-        fronts(&model, &rings, &state)
+        rings.fronts(model.mesh(), &state)
     );
     // the tail at the +Z cap: ring radius less the uniform part's, halfway to the bulge
     let radii = rings.radii(&state);
@@ -131,8 +111,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             Ok((report, held)) => {
                 // the bulge must have gone where it was put: within half the move (near the
                 // cap the held relaxation pushes it back and the move means nothing more)
-                let before = fronts(&model, &rings, &current);
-                let after = fronts(&model, &rings, &trial);
+                let before = rings.fronts(model.mesh(), &current);
+                let after = rings.fronts(model.mesh(), &trial);
                 let went = after.last().zip(before.last()).map(|(a, b)| a - b);
                 if went.is_none_or(|d| (d - step as f64 / per).abs() > 0.5 * step as f64 / per) {
                     println!(
@@ -146,7 +126,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 println!(
                     "  {:.3} {:?} {:.10} {dw:+.4e} {:+.4e} {:+.3e} {}",
                     moved as f64 / per,
-                    fronts(&model, &rings, &trial),
+                    rings.fronts(model.mesh(), &trial),
                     trial.p,
                     held.force,
                     held.relative_eigenvalue,

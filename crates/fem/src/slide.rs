@@ -74,16 +74,36 @@ impl Rings {
     /// another).
     pub fn bulge(&self, state: &State) -> Option<(usize, usize)> {
         let r = self.radii(state);
-        let lo = r.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = r.iter().copied().fold(0.0, f64::max);
-        if !(hi > 1.01 * lo) {
-            return None;
-        }
-        let level = 0.5 * (lo + hi);
+        let level = bulge_level(&r)?;
         let first = r.iter().position(|&v| v > level)?;
         let last = r.iter().rposition(|&v| v > level)?;
         Some((first, last))
     }
+
+    /// The fronts of the bulge at `state`: the reference heights (rings' Z in `mesh`,
+    /// interpolated) where the ring radius crosses halfway between the narrowest and the
+    /// widest; empty without a bulge.
+    pub fn fronts(&self, mesh: &tubemem_mesh::Mesh, state: &State) -> Vec<f64> {
+        let r = self.radii(state);
+        let Some(level) = bulge_level(&r) else {
+            return vec![];
+        };
+        let z = |l: usize| mesh.nodes[self.rings[l][0]][2];
+        (1..r.len())
+            .filter_map(|i| {
+                let (a, b) = (r[i - 1] - level, r[i] - level);
+                (a * b < 0.0).then(|| z(i - 1) + (z(i) - z(i - 1)) * a / (a - b))
+            })
+            .collect()
+    }
+}
+
+/// Halfway between the narrowest and the widest of the ring radii `r`, when the widest is more
+/// than 1 % wider (a bulge).
+fn bulge_level(r: &[f64]) -> Option<f64> {
+    let lo = r.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = r.iter().copied().fold(0.0, f64::max);
+    (hi > 1.01 * lo).then_some(0.5 * (lo + hi))
 }
 
 /// A bulge moved along the tube ([`translate_bulge`]).

@@ -836,6 +836,11 @@ fn a_bulge_is_moved_by_whole_rows_or_refused_with_the_reason() {
         .map(|(l, _)| l)
         .collect();
     assert_eq!(wide, (6..=10).collect::<Vec<_>>());
+    // its fronts halfway between the rings 5 | 6 and 10 | 11 (ring l at Z = −3 + l/4)
+    let fronts = rings.fronts(model.mesh(), &moved.state);
+    assert_eq!(fronts.len(), 2);
+    assert!((fronts[0] + 1.625).abs() < 1e-12 && (fronts[1] + 0.375).abs() < 1e-12);
+    assert!(rings.fronts(model.mesh(), &flat).is_empty());
     // the caps (nodes off the cylinder) kept their positions up to the body's z-translation
     // that keeps the pinned node's z: the uniform part here is the reference (λz = 1), so none
     let cyl: std::collections::HashSet<usize> = rings.rings.iter().flatten().copied().collect();
