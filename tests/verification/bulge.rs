@@ -164,15 +164,15 @@ const SMOOTH_CAP_TAIL_DECAY: f64 = 13.0007;
 /// 10 times its volume (a bulge with fronts near Z = ±2.2 R; the caps' junctions at ±20 R).
 ///
 /// * Far from the caps the move is free: the energy at equal volume is that of the centred
-///   bulge to round-off (measured 2026-11-30: |ΔW| ≤ 3.3e-12 of W = 573, i.e. 6e-15; bound
+///   bulge to round-off (measured 2026-11-30: |ΔW| ≤ 4.0e-12 of W = 573, i.e. 7e-15; bound
 ///   1e-13), and the held mode's eigenvalue is round-off (≤ 1.5e-16 of the diagonal, bound
 ///   `NEUTRAL`).
 /// * Near a cap the energy grows and the hold's reaction pushes the bulge back (f > 0): the caps
 ///   repel the fronts, so the centred bulge is the energy minimum of the family and no
 ///   off-centre branch is stable. The push grows as the front approaches the cap at the rate
 ///   the profile's own tails decay (an interaction through the overlap of the front's tail and
-///   the cap's, both decaying at the uniform part's slowest rate): f grows by 12.931, 12.928,
-///   12.931, 12.931 per R over the moves 8 → 12 (fronts 9.8 → 5.8 R from the junction), the
+///   the cap's, both decaying at the uniform part's slowest rate): f grows by 12.930, 12.928,
+///   12.930, 12.931 per R over the moves 8 → 12 (fronts 9.8 → 5.8 R from the junction), the
 ///   cap's tail decays by 12.934 and 12.911 per R at 2–4 R; held within 1 % (5× the measured
 ///   spread). Against an independent source, the smooth axisymmetric tube of `python_ref` at the
 ///   same stretch (λs = 1.15969: the cap's layer decays by 13.0007 per R at 4 R,
