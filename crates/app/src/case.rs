@@ -351,6 +351,16 @@ pub struct StageSpec {
     /// (default 1e-3), or the penalty itself
     pub penetration_tolerance: Option<f64>,
     pub penalty: Option<f64>,
+    /// squeeze and confine: how the planes are enforced, "penalty" (the default: the penalty
+    /// alone, the membrane sits about `penetration_tolerance` inside) or "augmented" (the
+    /// penalty with Uzawa multiplier updates until the gap is within `gap_tolerance`;
+    /// experimental, see the README's contact section)
+    pub contact_method: Option<ContactMethod>,
+    /// augmented contact: the largest gap (in R) the multiplier updates leave where a plane
+    /// pushes (default 1e-9)
+    pub gap_tolerance: Option<f64>,
+    /// augmented contact: the multiplier updates allowed in one step (default 50)
+    pub max_augmentations: Option<usize>,
     pub target_pressure: Option<f64>,
     pub target_stretch: Option<f64>,
     pub target_volume_ratio: Option<f64>,
@@ -362,6 +372,14 @@ pub struct StageSpec {
     /// arc-length stages: "follow-stable" switches branch at a bifurcation where the path
     /// loses stability, along the critical mode
     pub branch: Option<BranchSpec>,
+}
+
+/// `contact_method` of a squeeze or confine stage.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactMethod {
+    Penalty,
+    Augmented,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -445,6 +463,9 @@ pub struct StagePlan {
     pub steps: usize,
     /// squeeze stages only
     pub penalty: Option<PenaltySpec>,
+    /// squeeze and confine stages: how the planes are enforced
+    #[serde(default)]
+    pub enforcement: Option<tubemem_fem::contact::Enforcement>,
     /// `control = "arc-length"`: the target is reached along the path by arc-length
     /// continuation, through limit points and snap-backs, with critical points located
     #[serde(default)]
@@ -469,11 +490,28 @@ impl StageSpec {
             )),
             _ => None,
         };
+        let enforcement = match (self.kind, self.contact_method) {
+            (Kind::Squeeze | Kind::Confine, None | Some(ContactMethod::Penalty)) => {
+                Some(tubemem_fem::contact::Enforcement::Penalty)
+            }
+            (Kind::Squeeze | Kind::Confine, Some(ContactMethod::Augmented)) => {
+                Some(tubemem_fem::contact::Enforcement::Augmented {
+                    gap_tolerance: self
+                        .gap_tolerance
+                        .unwrap_or(tubemem_fem::contact::DEFAULT_GAP_TOLERANCE),
+                    max_augmentations: self
+                        .max_augmentations
+                        .unwrap_or(tubemem_fem::contact::DEFAULT_MAX_AUGMENTATIONS),
+                })
+            }
+            _ => None,
+        };
         Ok(StagePlan {
             index: i + 1,
             target,
             steps: self.steps,
             penalty,
+            enforcement,
             arc_length: self.control == Some(ControlKind::ArcLength),
             follow_stable: self.branch == Some(BranchSpec::FollowStable),
         })
@@ -593,6 +631,38 @@ impl StageSpec {
                 "[[stage]] {}: `penalty` and `penetration_tolerance` belong to squeeze stages",
                 i + 1
             );
+        }
+        let contact_key = [
+            ("contact_method", self.contact_method.is_some()),
+            ("gap_tolerance", self.gap_tolerance.is_some()),
+            ("max_augmentations", self.max_augmentations.is_some()),
+        ]
+        .into_iter()
+        .find(|k| k.1);
+        if let (Kind::Inflate, Some((key, _))) = (self.kind, contact_key) {
+            invalid!(
+                "[[stage]] {}: `{key}` belongs to squeeze and confine stages",
+                i + 1
+            );
+        }
+        if self.contact_method != Some(ContactMethod::Augmented)
+            && (self.gap_tolerance.is_some() || self.max_augmentations.is_some())
+        {
+            invalid!(
+                "[[stage]] {}: `gap_tolerance` and `max_augmentations` set the augmented contact: give `contact_method` = \"augmented\" (the default is \"penalty\")",
+                i + 1
+            );
+        }
+        if let Some(t) = self.gap_tolerance {
+            if !(t.is_finite() && t > 0.0 && t < 0.1) {
+                invalid!(
+                    "[[stage]] {}: `gap_tolerance` = {t}: must be in (0, 0.1) (in R)",
+                    i + 1
+                );
+            }
+        }
+        if self.max_augmentations == Some(0) {
+            invalid!("[[stage]] {}: `max_augmentations` must be ≥ 1", i + 1);
         }
         if let Some(t) = self.penetration_tolerance {
             if !(t.is_finite() && t > 0.0 && t < 0.1) {

@@ -9,7 +9,7 @@
 //!        → observers: RunWriter (steps.csv, summary.json, profiles/, VTU/PVD), progress, …
 //! ```
 //!
-//! * [`case`]: the case file and its validation into a [`case::Plan`] (stage targets resolved
+//! * [`case`]: the case file and its validation into a plan of [`case::StagePlan`]s (stage targets resolved
 //!   once).
 //! * [`run`]: the FE run: [`run::run`] returns a [`report::RunReport`] and calls
 //!   [`run::Observer`]s at every converged step and stage end.

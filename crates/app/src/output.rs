@@ -31,7 +31,8 @@ use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 /// The columns of steps.csv. New columns are only ever appended.
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
-arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume";
+arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
+augmentations,augmentation_iterations,contact_gap,multiplier_change";
 
 /// The `critical` column of steps.csv: the kind of a critical point located between the
 /// previous step and this one (empty: none).
@@ -171,6 +172,15 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
     v.push(r.nonuniformity);
     v.push(r.gps_applicable.map(|a| f64::from(u8::from(a))));
     v.push(r.negative_pivots_volume.map(|n| n as f64));
+    match &r.augmentation {
+        Some(a) => v.extend([
+            Some(a.updates as f64),
+            Some(a.iterations as f64),
+            Some(a.gap),
+            Some(a.change),
+        ]),
+        None => v.extend([None; 4]),
+    }
     v
 }
 
@@ -186,7 +196,7 @@ pub fn format_row(r: &StepRecord) -> String {
         .map(|(k, v)| match (k, v) {
             // integers as integers
             (0 | 1 | 9 | 10, Some(x)) => format!("{}", x as u64),
-            (29 | 31 | 32, Some(x)) => format!("{}", x as i64),
+            (29 | 31 | 32 | 33 | 34, Some(x)) => format!("{}", x as i64),
             (_, Some(x)) => format!("{x}"),
             (_, None) => String::new(),
         })
@@ -281,26 +291,35 @@ pub struct RunWriter {
     vtu: crate::case::OutputSpec,
 }
 
-const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT1";
+/// The first checkpoint format: the state's positions and pressure (and the previous state's).
+const CHECKPOINT_MAGIC_V1: &[u8; 12] = b"TUBEMEMCKPT1";
+/// The second adds the state's contact multipliers (an augmented-Lagrangian squeeze).
+const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT2";
 
 /// Write a checkpoint: magic, header length (u64 LE), the header as JSON (exact floats), the
-/// node count (u64 LE), the positions and the pressure as f64 LE.
+/// node count and the multiplier count (u64 LE), the positions, the pressure and the
+/// multipliers as f64 LE, then the previous state's positions and pressure when there is one.
 fn write_checkpoint(path: &Path, tmp: &Path, ck: &Checkpoint) -> Result<()> {
     let header = serde_json::to_vec(ck).map_err(|e| AppError::Output {
         what: path.display().to_string(),
         source: Box::new(e),
     })?;
-    let mut buf = Vec::with_capacity(40 + header.len() + 24 * ck.x.len());
+    let mut buf =
+        Vec::with_capacity(48 + header.len() + 48 * ck.x.len() + 8 * ck.multipliers.len());
     buf.extend_from_slice(CHECKPOINT_MAGIC);
     buf.extend_from_slice(&(header.len() as u64).to_le_bytes());
     buf.extend_from_slice(&header);
     buf.extend_from_slice(&(ck.x.len() as u64).to_le_bytes());
+    buf.extend_from_slice(&(ck.multipliers.len() as u64).to_le_bytes());
     for p in &ck.x {
         for v in p {
             buf.extend_from_slice(&v.to_le_bytes());
         }
     }
     buf.extend_from_slice(&ck.p.to_le_bytes());
+    for v in &ck.multipliers {
+        buf.extend_from_slice(&v.to_le_bytes());
+    }
     // the stepping's previous state, same layout, when there is one (an older checkpoint
     // without it reads as none)
     if let Some((x, p)) = &ck.previous {
@@ -318,7 +337,10 @@ fn write_checkpoint(path: &Path, tmp: &Path, ck: &Checkpoint) -> Result<()> {
 /// Read a checkpoint written by [`write_checkpoint`]; `None` if it is not a whole one.
 fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
     let buf = std::fs::read(path).ok()?;
-    let rest = buf.strip_prefix(CHECKPOINT_MAGIC)?;
+    let (rest, v2) = match buf.strip_prefix(CHECKPOINT_MAGIC) {
+        Some(r) => (r, true),
+        None => (buf.strip_prefix(CHECKPOINT_MAGIC_V1)?, false),
+    };
     let u64_at =
         |b: &[u8]| -> Option<u64> { Some(u64::from_le_bytes(b.get(..8)?.try_into().ok()?)) };
     let hl = usize::try_from(u64_at(rest)?).ok()?;
@@ -326,9 +348,15 @@ fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
     let mut ck: Checkpoint = serde_json::from_slice(header).ok()?;
     let rest = rest.get(8 + hl..)?;
     let n = usize::try_from(u64_at(rest)?).ok()?;
-    let data = rest.get(8..)?;
+    let (m, data) = if v2 {
+        let rest = rest.get(8..)?;
+        (usize::try_from(u64_at(rest)?).ok()?, rest.get(8..)?)
+    } else {
+        (0, rest.get(8..)?)
+    };
     let one = n.checked_mul(24)?.checked_add(8)?;
-    if data.len() != one && data.len() != one.checked_mul(2)? {
+    let state_len = one.checked_add(m.checked_mul(8)?)?;
+    if data.len() != state_len && data.len() != state_len.checked_add(one)? {
         return None;
     }
     // the length is checked above: 3n coordinates and the pressure, 8 bytes each
@@ -344,8 +372,9 @@ fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
         |w: &[f64]| -> Vec<[f64; 3]> { w.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
     ck.x = positions(&v[..3 * n]);
     ck.p = v[3 * n];
-    ck.previous =
-        (v.len() == 2 * (3 * n + 1)).then(|| (positions(&v[3 * n + 1..6 * n + 1]), v[6 * n + 1]));
+    let s = 3 * n + 1 + m;
+    ck.multipliers = v[3 * n + 1..s].to_vec();
+    ck.previous = (v.len() > s).then(|| (positions(&v[s..s + 3 * n]), v[s + 3 * n]));
     Some(ck)
 }
 
@@ -1005,6 +1034,7 @@ impl Observer for RunWriter {
             pvd: self.pvd.clone(),
             x: view.state.x.clone(),
             p: view.state.p,
+            multipliers: view.state.multipliers.clone(),
             previous: view.previous.map(|s| (s.x.clone(), s.p)),
         };
         let name = if (self.rows / self.checkpoint_every).is_multiple_of(2) {

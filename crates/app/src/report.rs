@@ -112,6 +112,11 @@ pub struct StepRecord {
     /// when the tube has no bulge
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub fronts: Vec<f64>,
+    /// a step of an augmented-Lagrangian contact (`contact_method = "augmented"`): the
+    /// multiplier updates, their Newton iterations, the gap left where a plane pushes and the
+    /// last multiplier change
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub augmentation: Option<tubemem_fem::newton::Augmentation>,
 }
 
 /// A profile holds a bulge when its largest hoop stretch exceeds its smallest by more than this

@@ -4,7 +4,7 @@
 use crate::case::{Caps, Case, PenaltySpec, StagePlan, Target};
 use crate::report::*;
 use crate::{AppError, Result};
-use tubemem_fem::contact::{penalty_for, Contact, MovingPlanes};
+use tubemem_fem::contact::{penalty_for, Contact, Enforcement, MovingPlanes};
 use tubemem_fem::continuation::{run_arc_stage, ArcLoading, Critical, CriticalKind};
 use tubemem_fem::model::{nearest_node, Load, Loading, Model, State};
 use tubemem_fem::post::{cell_values, midspan, midspan_contact, ring_profile, Regime};
@@ -498,6 +498,9 @@ pub struct Checkpoint {
     pub x: Vec<[f64; 3]>,
     #[serde(skip)]
     pub p: f64,
+    /// the state's contact multipliers (an augmented squeeze; empty otherwise)
+    #[serde(skip)]
+    pub multipliers: Vec<f64>,
     /// the converged state before it in the stage, if any (in binary after the state)
     #[serde(skip)]
     pub previous: Option<(Vec<[f64; 3]>, f64)>,
@@ -813,6 +816,7 @@ pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Con
             })
             .collect(),
         penalty,
+        enforcement: tubemem_fem::contact::Enforcement::Penalty,
     }
 }
 
@@ -942,6 +946,7 @@ fn run_inner(
         *report = ck.report.clone();
         state.x.clone_from(&ck.x);
         state.p = ck.p;
+        state.multipliers.clone_from(&ck.multipliers);
     }
     for o in observers.iter_mut() {
         o.started(report, &model, &state)
@@ -970,6 +975,7 @@ fn run_inner(
                         x: x.clone(),
                         p: *p,
                         planes: 0.0,
+                        multipliers: Vec::new(),
                     }),
                 )),
                 ck.steps.clone(),
@@ -997,6 +1003,7 @@ fn run_inner(
         };
         let start_lambda_s = context.start_lambda_s;
         let (pv, penalty) = (context.pv, context.penalty);
+        let enforcement = plan.enforcement.unwrap_or(Enforcement::Penalty);
         let load: Box<dyn Fn(f64) -> Load> = match plan.target {
             Target::Pressure(_) => Box::new(Load::pressure),
             Target::Stretch(_) => Box::new(move |v| {
@@ -1008,12 +1015,18 @@ fn run_inner(
             }),
             Target::VolumeRatio(_) => Box::new(|v| Load::new(Loading::Volume(v))),
             Target::Rho(_) => Box::new(move |h| {
-                Load::with_contact(Loading::Gas { pv }, Contact::plates(h, penalty))
+                Load::with_contact(
+                    Loading::Gas { pv },
+                    Contact::plates(h, penalty).with_enforcement(enforcement),
+                )
             }),
             Target::Confine(_) => {
                 let planes = case.stages[i - 1].plane.clone();
                 Box::new(move |t| {
-                    Load::with_contact(Loading::Gas { pv }, fe_planes(&planes, t, penalty))
+                    Load::with_contact(
+                        Loading::Gas { pv },
+                        fe_planes(&planes, t, penalty).with_enforcement(enforcement),
+                    )
                 })
             }
         };
@@ -1199,6 +1212,8 @@ fn run_inner(
                         .map(|u| u <= NONUNIFORM && started_uniform.is_none()),
                     negative_pivots_volume: info.negative_conjugate,
                     fronts: step_fronts,
+                    augmentation: matches!(plan.enforcement, Some(Enforcement::Augmented { .. }))
+                        .then_some(info.newton.augmentation),
                 };
                 steps.push(record);
                 let view = StepView {
@@ -1235,11 +1250,12 @@ fn run_inner(
             let loading = match plan.target {
                 Target::Rho(_) => ArcLoading::ClosedGas {
                     pv,
-                    planes: MovingPlanes::plates(penalty),
+                    planes: MovingPlanes::plates(penalty).with_enforcement(enforcement),
                 },
                 Target::Confine(_) => ArcLoading::ClosedGas {
                     pv,
-                    planes: fe_moving_planes(&case.stages[i - 1].plane, penalty),
+                    planes: fe_moving_planes(&case.stages[i - 1].plane, penalty)
+                        .with_enforcement(enforcement),
                 },
                 _ => ArcLoading::Pressure(None),
             };

@@ -681,3 +681,75 @@ fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
         "{err}"
     );
 }
+
+/// The augmented Lagrangian removes the penalty's regularization from the result: a squeeze with
+/// `contact_method = "augmented"` ends in the same state whatever the penalty κ (set by
+/// `penetration_tolerance` 1e-3 or 1e-4), while the penalty alone moves with κ by its offset
+/// (the flat zone sits about ϖJ/κ inside the plate). Every augmented step reports its updates
+/// and leaves a gap of at most the default gap tolerance, 1e-9 R, where a plate pushes, and
+/// no penetration beyond it anywhere. Agreement of the two augmented runs: 1e-6 relative (the
+/// gap tolerance 1e-9 R over the tube's ~1 R size, times the tangent's condition as in
+/// `a_squeeze_after_a_squeeze_ends_where_one_squeeze_ends`); the penalty runs differ by more
+/// than 1e-5 (their offsets differ by about 9e-4 R).
+#[test]
+fn an_augmented_squeeze_does_not_depend_on_the_penalty() {
+    let finish = |method: &str, tolerance: &str| {
+        let text = format!(
+            "{SMALL}{SQUEEZE}contact_method = \"{method}\"\npenetration_tolerance = {tolerance}\n"
+        );
+        let case = Case::parse(&text).unwrap();
+        let report = run(&case, "squeeze", &mut []).into_result().unwrap();
+        let stage = report.stages.last().unwrap().clone();
+        match &stage.outcome {
+            StageOutcome::Finished(s) => (s.clone(), stage.steps.clone()),
+            o => panic!("{o:?}"),
+        }
+    };
+    let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+    let (a3, steps3) = finish("augmented", "1e-3");
+    let (a4, _) = finish("augmented", "1e-4");
+    let (p3, psteps) = finish("penalty", "1e-3");
+    let (p4, _) = finish("penalty", "1e-4");
+    for s in &steps3 {
+        let aug = s
+            .augmentation
+            .expect("an augmented step reports its updates");
+        assert!(aug.gap <= 1e-9, "step {}: gap {:e}", s.step, aug.gap);
+        let pen = s.contact.as_ref().unwrap().values.penetration;
+        assert!(pen <= 1e-9, "step {}: penetration {pen:e}", s.step);
+    }
+    assert!(steps3.iter().any(|s| s.augmentation.unwrap().updates > 0));
+    assert!(psteps.iter().all(|s| s.augmentation.is_none()));
+    assert!(
+        psteps
+            .last()
+            .unwrap()
+            .contact
+            .as_ref()
+            .unwrap()
+            .values
+            .penetration
+            > 1e-4
+    );
+    let (fa3, fa4) = (
+        a3.final_state.contact.unwrap().force,
+        a4.final_state.contact.unwrap().force,
+    );
+    let (fp3, fp4) = (
+        p3.final_state.contact.unwrap().force,
+        p4.final_state.contact.unwrap().force,
+    );
+    assert!(rel(fa3, fa4) < 1e-6, "augmented: {fa3} vs {fa4}");
+    assert!(
+        rel(a3.final_state.midspan.w, a4.final_state.midspan.w) < 1e-6,
+        "augmented ϖ: {} vs {}",
+        a3.final_state.midspan.w,
+        a4.final_state.midspan.w
+    );
+    assert!(rel(fp3, fp4) > 1e-5, "penalty: {fp3} vs {fp4}");
+    eprintln!(
+        "force: augmented {fa3} / {fa4} ({:.2e}), penalty {fp3} / {fp4} ({:.2e})",
+        rel(fa3, fa4),
+        rel(fp3, fp4)
+    );
+}

@@ -501,7 +501,8 @@ fn run_writes_steps_summary_profiles_and_vtu() {
          rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
          gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,\
          local_lambda_s,local_lambda_z,local_chi,local_force,\
-         arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume"
+         arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
+         augmentations,augmentation_iterations,contact_gap,multiplier_change"
     );
     let empty_for_inflation = [
         "rho",

@@ -1,17 +1,23 @@
-//! Frictionless penalty contact with rigid planes, integrated at the Gauss points of the
-//! membrane elements (reference-area weights; any element, N nodes). [`Contact`] is the one owner of the planes and
-//! the penalty: the assembly, the outputs and the closed-form comparison all read them from it.
+//! Frictionless contact with rigid planes, integrated at the Gauss points of the membrane
+//! elements (reference-area weights; any element, N nodes): a penalty, optionally augmented by
+//! Lagrange multipliers (Uzawa). [`Contact`] is the one owner of the planes, the penalty and the
+//! enforcement: the assembly, the outputs and the closed-form comparison all read them from it.
 //!
 //! ```text
 //! plane {x : n·x = d}, n the unit normal pointing to the allowed side; gap g = n·x − d
-//! E_c = Σ_gp dA0 (κ/2) ⟨−g⟩²           (⟨·⟩ the positive part: only penetration costs)
-//! r_a += dA0 κ ⟨−g⟩ (−N_a) n            (the plane pushes along n)
-//! K_ab += dA0 κ N_a N_b n⊗n             (where g < 0)
+//! traction per reference area at a Gauss point with multiplier λ ≥ 0:  t = ⟨λ − κ g⟩
+//! E_c = Σ_gp dA0 (t² − λ²)/(2κ)          (λ = 0: the penalty (κ/2)⟨−g⟩²)
+//! r_a += dA0 t (−N_a) n                  (the plane pushes along n)
+//! K_ab += dA0 κ N_a N_b n⊗n              (where t > 0)
+//! Uzawa (between converged Newton solves, [`crate::model::Model::augment`]):  λ ← ⟨λ − κ g⟩
 //! ```
 //! Frictionless: the force is along n only. The contact pressure per current area is
-//! κ⟨−g⟩ dA0/da; the penetration at a contact pressure p is about p J/κ (J = da/dA0), so κ is
-//! chosen from the pressure, the area stretch and a stated penetration tolerance
-//! ([`penalty_for`]).
+//! t dA0/da. With the penalty alone (λ = 0) the membrane sits about p J/κ inside a plane that
+//! presses it with the pressure p (J = da/dA0), so κ is chosen from the pressure, the area
+//! stretch and a stated penetration tolerance ([`penalty_for`]). The augmented Lagrangian keeps
+//! that κ as the regularization and removes the offset: at the fixed point of the update
+//! λ = t, so every Gauss point either carries λ > 0 at g = 0 or is free with g ≥ 0; the update
+//! stops when max |Δλ|/κ (the largest gap still left) is below the gap tolerance.
 
 use crate::geometry::{RefElement, Vec3};
 use nalgebra::{SMatrix, SVector};
@@ -35,12 +41,88 @@ impl Plane {
     }
 }
 
-/// The rigid planes of a step and the penalty that enforces them.
+/// How the planes are enforced.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[serde(tag = "method", rename_all = "kebab-case")]
+pub enum Enforcement {
+    /// the penalty alone: the membrane sits about p J/κ inside each plane that presses it
+    Penalty,
+    /// the penalty augmented by Gauss-point multipliers, updated (Uzawa) between converged
+    /// Newton solves until the largest multiplier change over κ (the gap still left where the
+    /// plane pushes) is at most `gap_tolerance` (in R)
+    Augmented {
+        gap_tolerance: f64,
+        /// updates allowed in one step before it fails
+        max_augmentations: usize,
+    },
+}
+
+/// The augmentations allowed in one step by default: 50. The shipped squeezes take at most
+/// a handful (see the README's contact section); a step that needs more is not converging.
+pub const DEFAULT_MAX_AUGMENTATIONS: usize = 50;
+
+/// The gap tolerance of an augmented contact by default, in R: 1e-9, so that the gap left
+/// is far below every discretization error the verification resolves (the 9-node squeeze's
+/// λs error is about 1e-7 at 64 around).
+pub const DEFAULT_GAP_TOLERANCE: f64 = 1e-9;
+
+impl Enforcement {
+    /// The augmented Lagrangian with the default gap tolerance and update limit.
+    pub fn augmented() -> Self {
+        Enforcement::Augmented {
+            gap_tolerance: DEFAULT_GAP_TOLERANCE,
+            max_augmentations: DEFAULT_MAX_AUGMENTATIONS,
+        }
+    }
+}
+
+/// Values of a Gauss point's contact history per plane: the multiplier λ, the local penalty κ_g
+/// and the gap at the last update of the current solve (NaN: none).
+pub const HISTORY: usize = 3;
+/// A gap that fell by less than this factor in one multiplier update raises the local penalty.
+pub const SLOW_CONTRACTION: f64 = 0.3;
+/// The most the local penalty grows in one update.
+pub const PENALTY_GROWTH: f64 = 10.0;
+/// The largest local penalty, over the stage's κ: 1e4, a penetration tolerance of 1e-7 R at
+/// the default 1e-3.
+pub const MAX_PENALTY_RATIO: f64 = 1e2;
+
+/// What one multiplier update found (maxima over the Gauss points and planes it covers).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UpdateSize {
+    /// the largest |g| where the plane pushes (t > 0), in R
+    pub gap: f64,
+    /// the largest |Δλ| (per reference area, in μH/R)
+    pub change: f64,
+    /// the largest penetration ⟨−g⟩ where the plane pushes, in R
+    pub penetration: f64,
+}
+
+impl UpdateSize {
+    /// The maxima of two.
+    pub fn max(self, o: Self) -> Self {
+        Self {
+            gap: self.gap.max(o.gap),
+            change: self.change.max(o.change),
+            penetration: self.penetration.max(o.penetration),
+        }
+    }
+}
+
+/// A Gauss point's multiplier and local penalty against one plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussContact {
+    pub lambda: f64,
+    pub penalty: f64,
+}
+
+/// The rigid planes of a step, the penalty and how they are enforced.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Contact {
     pub planes: Vec<Plane>,
     /// κ, per unit μH/R² (see [`penalty_for`])
     pub penalty: f64,
+    pub enforcement: Enforcement,
 }
 
 impl Contact {
@@ -58,31 +140,83 @@ impl Contact {
                 },
             ],
             penalty,
+            enforcement: Enforcement::Penalty,
         }
+    }
+
+    /// The same planes and penalty, enforced by `enforcement`.
+    pub fn with_enforcement(mut self, enforcement: Enforcement) -> Self {
+        self.enforcement = enforcement;
+        self
+    }
+
+    /// The number of history values per element of `gauss_points` Gauss points: for each
+    /// Gauss point and plane, [`HISTORY`] values (the multiplier, the local penalty and the
+    /// gap at the last update).
+    pub fn multipliers_per_element(&self, gauss_points: usize) -> usize {
+        HISTORY * gauss_points * self.planes.len()
     }
 
     /// The top plate's height h for two plates made by [`Contact::plates`].
     pub fn half_gap(&self) -> Option<f64> {
-        self.planes
-            .iter()
-            .find(|p| p.normal == [0.0, -1.0, 0.0])
-            .map(|p| -p.offset)
+        self.top_plate().map(|k| -self.planes[k].offset)
     }
 
-    /// Contact traction per reference area at a gap (κ⟨−g⟩).
+    /// The index of the top plate y = h (normal −e_y) among the planes.
+    pub fn top_plate(&self) -> Option<usize> {
+        self.planes
+            .iter()
+            .position(|p| p.normal == [0.0, -1.0, 0.0])
+    }
+
+    /// Contact traction per reference area at a gap with no multiplier (κ⟨−g⟩).
     pub fn traction(&self, gap: f64) -> f64 {
-        if gap < 0.0 {
-            -self.penalty * gap
+        self.traction_at(gap, self.point(&[], 0, 0))
+    }
+
+    /// Contact traction per reference area at a gap and a Gauss point's multiplier and local
+    /// penalty: ⟨λ − κ_g g⟩.
+    pub fn traction_at(&self, gap: f64, at: GaussContact) -> f64 {
+        let t = at.lambda - at.penalty * gap;
+        if t > 0.0 {
+            t
         } else {
             0.0
         }
     }
 
-    /// Add the contact energy, residual and (if asked) stiffness of one element.
+    /// The multiplier and local penalty of Gauss point `g` against plane `k` in one element's
+    /// history `lambda` ([`Contact::multipliers_per_element`] values, Gauss point major;
+    /// empty: λ = 0 and the stage's penalty κ).
+    pub fn point(&self, lambda: &[f64], g: usize, k: usize) -> GaussContact {
+        let i = HISTORY * (g * self.planes.len() + k);
+        match lambda.get(i..i + HISTORY) {
+            Some(h) => GaussContact {
+                lambda: h[0],
+                penalty: h[1],
+            },
+            None => GaussContact {
+                lambda: 0.0,
+                penalty: self.penalty,
+            },
+        }
+    }
+
+    /// A fresh history for one element of `gauss_points` Gauss points: λ = 0, the stage's κ,
+    /// no last gap.
+    pub fn fresh_history(&self, gauss_points: usize) -> Vec<f64> {
+        (0..gauss_points * self.planes.len())
+            .flat_map(|_| [0.0, self.penalty, f64::NAN])
+            .collect()
+    }
+
+    /// Add the contact energy, residual and (if asked) stiffness of one element whose
+    /// contact history is `lambda` ([`Contact::point`]; empty: the penalty alone).
     pub fn kernel<const N: usize, const D: usize>(
         &self,
         re: &RefElement<N>,
         xe: &[Vec3; N],
+        lambda: &[f64],
         r: &mut SVector<f64, D>,
         mut k: Option<&mut SMatrix<f64, D, D>>,
     ) -> f64 {
@@ -90,16 +224,32 @@ impl Contact {
         for (g, gp) in re.gauss.iter().enumerate() {
             let n = &gp.n;
             let p = re.position(g, xe);
-            for plane in &self.planes {
+            for (kp, plane) in self.planes.iter().enumerate() {
                 let gap = plane.gap_at(&p);
-                if gap >= 0.0 {
+                let at = self.point(lambda, g, kp);
+                let (l, kappa) = (at.lambda, at.penalty);
+                let t = self.traction_at(gap, at);
+                if t <= 0.0 {
+                    // free: E = −λ²/(2κ), a constant of x
+                    if l != 0.0 {
+                        energy -= gp.w * l * l / (2.0 * kappa);
+                    }
                     continue;
                 }
-                let w = gp.w * self.penalty;
-                energy += 0.5 * w * gap * gap;
-                // u = ∂g/∂x_e: u[3a + i] = N_a n_i, so r += w g u and K += w u uᵀ (rank one)
+                let w = gp.w * kappa;
+                // r −= dA0 t u: with λ = 0 (the penalty alone) written as dA0 κ g u, the same
+                // arithmetic as before the multipliers existed (penalty runs are bitwise
+                // unchanged)
+                let coefficient = if l == 0.0 {
+                    energy += 0.5 * w * gap * gap;
+                    w * gap
+                } else {
+                    energy += gp.w * (t * t - l * l) / (2.0 * kappa);
+                    -gp.w * t
+                };
+                // u = ∂g/∂x_e: u[3a + i] = N_a n_i, and K += dA0 κ u uᵀ (rank one)
                 let u = SVector::<f64, D>::from_fn(|row, _| n[row / 3] * plane.normal[row % 3]);
-                r.axpy(w * gap, &u, 1.0);
+                r.axpy(coefficient, &u, 1.0);
                 if let Some(k) = k.as_deref_mut() {
                     k.ger(w, &u, &u, 1.0);
                 }
@@ -108,38 +258,105 @@ impl Contact {
         energy
     }
 
+    /// The Uzawa update of one element's contact history at the positions `xe`, written to
+    /// `out`: λ ← ⟨λ − κ_g g⟩ for every Gauss point and plane, and the local penalty κ_g raised
+    /// where the gap fell slowly since the last update of the same solve (`first`: there is
+    /// none). The multiplier iteration contracts a gap by about K/(K + κ_g), with K the
+    /// membrane's local stiffness against the plane: where a gap fell by less than
+    /// [`SLOW_CONTRACTION`] (K above about κ_g/2, e.g. where the flat zone meets the caps),
+    /// κ_g is raised to 9 K, which contracts by 0.1 (by at most [`PENALTY_GROWTH`] per update
+    /// and [`MAX_PENALTY_RATIO`] κ in all). Returns the largest |g| where the plane pushes
+    /// (t > 0: the gap left, either sign; where t = 0 the point is free with g ≥ λ/κ_g ≥ 0 and
+    /// complementarity holds), the largest |Δλ| and the largest penetration ⟨−g⟩ where the
+    /// plane pushes.
+    pub fn update_multipliers<const N: usize>(
+        &self,
+        re: &RefElement<N>,
+        xe: &[Vec3; N],
+        lambda: &[f64],
+        first: bool,
+        gap_tolerance: f64,
+        out: &mut [f64],
+    ) -> UpdateSize {
+        let mut size = UpdateSize::default();
+        for g in 0..re.gauss.len() {
+            let p = re.position(g, xe);
+            for (kp, plane) in self.planes.iter().enumerate() {
+                let gap = plane.gap_at(&p);
+                let at = self.point(lambda, g, kp);
+                let t = self.traction_at(gap, at);
+                size.change = size.change.max((t - at.lambda).abs());
+                if t > 0.0 {
+                    size.gap = size.gap.max(gap.abs());
+                    size.penetration = size.penetration.max(-gap);
+                }
+                let i = HISTORY * (g * self.planes.len() + kp);
+                let last = if first {
+                    f64::NAN
+                } else {
+                    lambda.get(i + 2).copied().unwrap_or(f64::NAN)
+                };
+                let mut kappa = at.penalty;
+                if t > 0.0 && gap.abs() > 10.0 * gap_tolerance && last.is_finite() {
+                    let ratio = gap.abs() / last.abs().max(1e-300);
+                    if ratio > SLOW_CONTRACTION {
+                        let factor = if ratio < 1.0 {
+                            (9.0 * ratio / (1.0 - ratio)).min(PENALTY_GROWTH)
+                        } else {
+                            PENALTY_GROWTH
+                        };
+                        kappa = (kappa * factor).min(MAX_PENALTY_RATIO * self.penalty);
+                    }
+                }
+                out[i] = t;
+                out[i + 1] = kappa;
+                out[i + 2] = if t > 0.0 { gap } else { f64::NAN };
+            }
+        }
+        size
+    }
+
     /// Add one element's ∂r/∂λ for planes whose offsets move as d_k(λ) with dd_k/dλ =
     /// `rates[k]`: the gap g = n·x − d_k falls by dd_k, so ∂r_a/∂d_k = −w N_a n where g < 0.
     pub fn rate_kernel<const N: usize, const D: usize>(
         &self,
         re: &RefElement<N>,
         xe: &[Vec3; N],
+        lambda: &[f64],
         rates: &[f64],
         q: &mut SVector<f64, D>,
     ) {
         for (g, gp) in re.gauss.iter().enumerate() {
             let n = &gp.n;
             let p = re.position(g, xe);
-            for (plane, rate) in self.planes.iter().zip(rates) {
-                if plane.gap_at(&p) >= 0.0 || *rate == 0.0 {
+            for (kp, (plane, rate)) in self.planes.iter().zip(rates).enumerate() {
+                let at = self.point(lambda, g, kp);
+                let t = self.traction_at(plane.gap_at(&p), at);
+                if t <= 0.0 || *rate == 0.0 {
                     continue;
                 }
-                let w = gp.w * self.penalty;
+                let w = gp.w * at.penalty;
                 let u = SVector::<f64, D>::from_fn(|row, _| n[row / 3] * plane.normal[row % 3]);
                 q.axpy(-w * rate, &u, 1.0);
             }
         }
     }
 
-    /// Mean contact pressure per current area of an element (for output).
-    pub fn element_pressure<const N: usize>(&self, re: &RefElement<N>, xe: &[Vec3; N]) -> f64 {
+    /// Mean contact pressure per current area of an element with multipliers `lambda` (for
+    /// output).
+    pub fn element_pressure<const N: usize>(
+        &self,
+        re: &RefElement<N>,
+        xe: &[Vec3; N],
+        lambda: &[f64],
+    ) -> f64 {
         let mut s = 0.0;
         let share = 1.0 / re.gauss.len() as f64;
         for g in 0..re.gauss.len() {
             let p = re.position(g, xe);
             let da = re.area_ratio(g, xe);
-            for pl in &self.planes {
-                s += share * self.traction(pl.gap_at(&p)) / da;
+            for (kp, pl) in self.planes.iter().enumerate() {
+                s += share * self.traction_at(pl.gap_at(&p), self.point(lambda, g, kp)) / da;
             }
         }
         s
@@ -164,6 +381,12 @@ impl MovingPlanes {
             at_zero: Contact::plates(0.0, penalty),
             rates: vec![-1.0, -1.0],
         }
+    }
+
+    /// The same planes enforced by `enforcement`.
+    pub fn with_enforcement(mut self, enforcement: Enforcement) -> Self {
+        self.at_zero.enforcement = enforcement;
+        self
     }
 
     /// The planes at λ.

@@ -1104,7 +1104,8 @@ impl Path for MembranePath<'_> {
             }
             ArcLoading::ClosedGas { pv, planes } => self.model.solve_arc_gas(s, *pv, planes, &c)?,
         };
-        let it = r.iterations;
+        // the step length follows the load step's own difficulty, not the augmentations'
+        let it = r.load_iterations();
         self.last = Some(r);
         Ok(it)
     }
@@ -1200,6 +1201,7 @@ pub fn run_arc_stage<E>(
                         residual: 0.0,
                         history: vec![],
                         inertia: Default::default(),
+                        augmentation: Default::default(),
                     });
                     newton.inertia.negative_pivots = s.negative_pivots;
                     let info = StepInfo {

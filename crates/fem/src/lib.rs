@@ -11,7 +11,7 @@
 //! | [`dofs`] | equation numbering: symmetry planes, rigid-body pins, rigid plugs |
 //! | [`pattern`] | the sparsity pattern, built once |
 //! | [`linsolve`] | sparse LDLᵀ on faer (symbolic once, numeric per iteration), inertia |
-//! | [`model`] | assembly as a sum of [`model::Term`]s plus the enclosed volume; loads; the membrane problem |
+//! | [`model`] | assembly of the membrane and contact terms plus the enclosed volume; loads; the membrane problem; the contact augmentation loop |
 //! | [`newton`] | a damped Newton driver that knows nothing of membranes |
 //! | [`stepping`] | load stepping with cut-back and growth |
 //! | [`post`] | mid-span values, profiles, contact values, cell values |
@@ -123,6 +123,13 @@ pub enum FemError {
         what: String,
         #[source]
         source: Option<Box<newton::NewtonError<FemError>>>,
+    },
+    /// The augmented Lagrangian's multipliers did not settle within their update limit.
+    #[error("the contact multipliers did not settle: after {updates} augmentations a plane still pushes where the gap is {gap:.3e} R, above the gap tolerance {tolerance:.1e} R (raise `max_augmentations` or `gap_tolerance`)")]
+    Augmentation {
+        updates: usize,
+        gap: f64,
+        tolerance: f64,
     },
     /// A bulge could not be moved along the tube ([`slide`]).
     #[error("cannot move the bulge: {what}")]

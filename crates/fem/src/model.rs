@@ -18,12 +18,14 @@
 //! #neg(K + c ggᵀ) = #neg(K) − [1 + c gᵀK⁻¹g < 0], and on the constraint subspace
 //! #neg = #neg(K) − [hᵀK⁻¹g < 0].
 
-use crate::contact::{Contact, MovingPlanes};
+use crate::contact::{Contact, Enforcement, MovingPlanes, UpdateSize};
 use crate::dofs::DofMap;
 use crate::element::membrane_kernel;
 use crate::geometry::{RefElement, Vec3};
 use crate::linsolve::SparseLdlt;
-use crate::newton::{self, Evaluation, Inertia, Linearization, NewtonError, NewtonSettings};
+use crate::newton::{
+    self, Augmentation, Evaluation, Inertia, Linearization, NewtonError, NewtonSettings,
+};
 use crate::pattern::Pattern;
 use crate::FemError;
 use nalgebra::{SMatrix, SVector};
@@ -90,6 +92,19 @@ pub struct State {
     /// the planes' load parameter λ of a closed-gas arc-length path ([`MovingPlanes`]);
     /// unused (0) elsewhere
     pub planes: f64,
+    /// the contact multipliers of an augmented-Lagrangian contact
+    /// ([`crate::contact::Enforcement::Augmented`]), element major, then Gauss point, then
+    /// plane, [`crate::contact::HISTORY`] values each ([`Contact::point`]); empty: none (the penalty alone)
+    pub multipliers: Vec<f64>,
+}
+
+impl State {
+    /// Element `e`'s multipliers (empty when the state has none).
+    pub fn element_multipliers(&self, e: usize, per_element: usize) -> &[f64] {
+        self.multipliers
+            .get(e * per_element..(e + 1) * per_element)
+            .unwrap_or(&[])
+    }
 }
 
 /// The reference elements of a model: all 4-node or all 9-node.
@@ -141,6 +156,8 @@ impl Elements {
 struct Terms<'a> {
     law: &'a dyn MembraneLaw,
     contact: Option<&'a Contact>,
+    /// the contact multipliers of every element ([`State::multipliers`]; empty: none)
+    multipliers: &'a [f64],
 }
 
 impl Terms<'_> {
@@ -162,7 +179,9 @@ impl Terms<'_> {
                 }
             })?;
         if let Some(c) = self.contact {
-            energy += c.kernel(el, xe, r, k);
+            let per = c.multipliers_per_element(el.gauss.len());
+            let lambda = self.multipliers.get(e * per..(e + 1) * per).unwrap_or(&[]);
+            energy += c.kernel(el, xe, lambda, r, k);
         }
         Ok(energy)
     }
@@ -342,6 +361,7 @@ impl Model {
             x: self.mesh.nodes.clone(),
             p: 0.0,
             planes: 0.0,
+            multipliers: Vec::new(),
         }
     }
 
@@ -360,9 +380,31 @@ impl Model {
         tangent: bool,
         contact: Option<&Contact>,
     ) -> Result<Assembled, FemError> {
+        self.assemble_with_multipliers(x, tangent, contact, &[])
+    }
+
+    /// [`Model::assemble`] at the positions and contact multipliers of `state`.
+    pub fn assemble_state(
+        &self,
+        state: &State,
+        tangent: bool,
+        contact: Option<&Contact>,
+    ) -> Result<Assembled, FemError> {
+        self.assemble_with_multipliers(&state.x, tangent, contact, &state.multipliers)
+    }
+
+    /// [`Model::assemble`] with the contact multipliers `multipliers` ([`State::multipliers`]).
+    pub fn assemble_with_multipliers(
+        &self,
+        x: &[[f64; 3]],
+        tangent: bool,
+        contact: Option<&Contact>,
+        multipliers: &[f64],
+    ) -> Result<Assembled, FemError> {
         let terms = Terms {
             law: self.law.as_ref(),
             contact,
+            multipliers,
         };
         match &self.elements {
             Elements::Quad4(els) => self.assemble_with::<4, 12>(els, x, tangent, terms),
@@ -533,8 +575,150 @@ impl Model {
             state.p = p;
         }
         let settings = self.settings;
-        let mut problem = MembraneProblem::new(self, load, None);
-        newton::solve(&mut problem, state, &settings)
+        let contact = load.contact.clone();
+        self.augmented(
+            state,
+            |_| contact.clone(),
+            |model, state| {
+                newton::solve(
+                    &mut MembraneProblem::new(model, load, None),
+                    state,
+                    &settings,
+                )
+            },
+        )
+    }
+
+    /// The Uzawa update of `state`'s contact history under `contact`
+    /// ([`Contact::update_multipliers`] for every element; `first`: the first update of a
+    /// solve). Returns the updated history and the update's maxima. Elements run in parallel;
+    /// the maxima do not depend on the number of threads.
+    pub fn augment(
+        &self,
+        state: &State,
+        contact: &Contact,
+        first: bool,
+        gap_tolerance: f64,
+    ) -> (Vec<f64>, UpdateSize) {
+        with_elements!(&self.elements, els => {
+            let per = contact.multipliers_per_element(els.first().map_or(0, |e| e.gauss.len()));
+            let mut out = vec![0.0; per * els.len()];
+            let size = out
+                .par_chunks_mut(per.max(1))
+                .zip(els.par_iter())
+                .enumerate()
+                .map(|(e, (o, el))| {
+                    let lambda = state.element_multipliers(e, per);
+                    contact.update_multipliers(
+                        el,
+                        &el.gather(&state.x),
+                        lambda,
+                        first,
+                        gap_tolerance,
+                        o,
+                    )
+                })
+                .reduce(UpdateSize::default, UpdateSize::max);
+            (out, size)
+        })
+    }
+
+    /// Run `once` (one Newton solve of `state`) and, when the contact at the state
+    /// (`contact_at`) is augmented ([`Enforcement::Augmented`]), the Uzawa loop around it:
+    /// update the multipliers ([`Model::augment`]) and solve again until the largest gap where
+    /// a plane pushes is within the gap tolerance. The state keeps the multipliers it is in
+    /// equilibrium with (the last update, which found the gap within the tolerance, is not
+    /// applied). A penalty contact (or none) drops the state's multipliers and solves once.
+    fn augmented(
+        &mut self,
+        state: &mut State,
+        contact_at: impl Fn(&State) -> Option<Contact>,
+        mut once: impl FnMut(
+            &mut Self,
+            &mut State,
+        ) -> Result<newton::NewtonReport, NewtonError<FemError>>,
+    ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
+        let Some((gap_tolerance, max_augmentations, per)) =
+            contact_at(state).and_then(|c| match c.enforcement {
+                Enforcement::Augmented {
+                    gap_tolerance,
+                    max_augmentations,
+                } => Some((
+                    gap_tolerance,
+                    max_augmentations,
+                    c.multipliers_per_element(self.gauss_points()),
+                )),
+                Enforcement::Penalty => None,
+            })
+        else {
+            state.multipliers.clear();
+            return once(self, state);
+        };
+        // a stage whose planes changed (or the first with multipliers) starts afresh; every
+        // solve starts from the stage's penalty at every point (a local penalty raised in the
+        // last step's updates would meet this step's new penetrations as a stiff penalty, which
+        // Newton handles badly) and keeps the multipliers
+        if let Some(c) = contact_at(state) {
+            if state.multipliers.len() != per * self.elements.len() {
+                state.multipliers = c
+                    .fresh_history(self.gauss_points())
+                    .repeat(self.elements.len());
+            } else {
+                for h in state.multipliers.chunks_exact_mut(crate::contact::HISTORY) {
+                    h[1] = c.penalty;
+                }
+            }
+        }
+        let mut report = once(self, state)?;
+        let mut aug = Augmentation::default();
+        loop {
+            let contact = contact_at(state).ok_or(NewtonError::Problem {
+                iteration: report.iterations,
+                source: FemError::NonFiniteResidual {
+                    what: "contact (the planes vanished during the augmentation)",
+                },
+            })?;
+            let (lambda, size) = self.augment(state, &contact, aug.updates == 0, gap_tolerance);
+            aug.gap = size.gap;
+            aug.penetration = size.penetration;
+            if !(size.gap.is_finite() && size.change.is_finite()) {
+                return Err(NewtonError::Problem {
+                    iteration: report.iterations,
+                    source: FemError::NonFiniteResidual {
+                        what: "contact multipliers",
+                    },
+                });
+            }
+            if size.gap <= gap_tolerance {
+                break;
+            }
+            if aug.updates >= max_augmentations {
+                return Err(NewtonError::Problem {
+                    iteration: report.iterations,
+                    source: FemError::Augmentation {
+                        updates: aug.updates,
+                        gap: size.gap,
+                        tolerance: gap_tolerance,
+                    },
+                });
+            }
+            state.multipliers = lambda;
+            aug.updates += 1;
+            aug.change = size.change;
+            let again = once(self, state)?;
+            aug.iterations += again.iterations;
+            report.iterations += again.iterations;
+            report.history.extend(again.history);
+            report.residual = again.residual;
+            report.inertia = again.inertia;
+        }
+        report.augmentation = aug;
+        Ok(report)
+    }
+
+    /// The Gauss points of one element (all elements of a model have the same rule).
+    pub fn gauss_points(&self) -> usize {
+        with_elements!(&self.elements, els => els.first().map_or(0, |e| e.gauss.len()))
     }
 
     /// Newton iterations at the prescribed total volume `volume` with the direction `phi0`
@@ -586,8 +770,18 @@ impl Model {
             loading: Loading::Pressure(state.p),
             contact: load.contact.clone(),
         };
-        let mut problem = MembraneProblem::new(self, load, Some(arc));
-        newton::solve(&mut problem, state, &settings)
+        let contact = load.contact.clone();
+        self.augmented(
+            state,
+            |_| contact.clone(),
+            |model, state| {
+                newton::solve(
+                    &mut MembraneProblem::new(model, load, Some(arc)),
+                    state,
+                    &settings,
+                )
+            },
+        )
     }
 
     /// Newton iterations on equilibrium of the closed gas (Boyle's constant `pv`) pressed by
@@ -603,18 +797,28 @@ impl Model {
     ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
         let settings = self.settings;
         let load = &Load::new(Loading::Gas { pv });
-        let mut problem = MembraneProblem::new(self, load, Some(arc));
-        problem.planes = Some(planes);
-        newton::solve(&mut problem, state, &settings)
+        self.augmented(
+            state,
+            |s| Some(planes.at(s.planes)),
+            |model, state| {
+                let mut problem = MembraneProblem::new(model, load, Some(arc));
+                problem.planes = Some(planes);
+                newton::solve(&mut problem, state, &settings)
+            },
+        )
     }
 
     /// ∂R/∂λ on the free dofs for the planes `planes` at λ, at the positions `x` (the load
     /// column of a closed-gas arc-length path).
-    pub fn plane_rate(&self, x: &[[f64; 3]], planes: &MovingPlanes, lambda: f64) -> Vec<f64> {
+    pub fn plane_rate(&self, state: &State, planes: &MovingPlanes, lambda: f64) -> Vec<f64> {
         let contact = planes.at(lambda);
         match &self.elements {
-            Elements::Quad4(els) => self.plane_rate_with::<4, 12>(els, x, &contact, &planes.rates),
-            Elements::Quad9(els) => self.plane_rate_with::<9, 27>(els, x, &contact, &planes.rates),
+            Elements::Quad4(els) => {
+                self.plane_rate_with::<4, 12>(els, state, &contact, &planes.rates)
+            }
+            Elements::Quad9(els) => {
+                self.plane_rate_with::<9, 27>(els, state, &contact, &planes.rates)
+            }
         }
     }
 
@@ -622,14 +826,16 @@ impl Model {
     fn plane_rate_with<const N: usize, const D: usize>(
         &self,
         elements: &[RefElement<N>],
-        x: &[[f64; 3]],
+        state: &State,
         contact: &Contact,
         rates: &[f64],
     ) -> Vec<f64> {
         let mut q = vec![0.0; self.n_eq()];
-        for el in elements {
+        for (e, el) in elements.iter().enumerate() {
             let mut qe = SVector::<f64, D>::zeros();
-            contact.rate_kernel(el, &el.gather(x), rates, &mut qe);
+            let lambda =
+                state.element_multipliers(e, contact.multipliers_per_element(el.gauss.len()));
+            contact.rate_kernel(el, &el.gather(&state.x), lambda, rates, &mut qe);
             for (i, v) in qe.iter().enumerate() {
                 if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {
                     q[a] += v;
@@ -649,11 +855,11 @@ impl Model {
         planes: &MovingPlanes,
     ) -> Result<(Vec<f64>, Vec<f64>, usize), FemError> {
         let contact = planes.at(state.planes);
-        let a = self.assemble(&state.x, true, Some(&contact))?;
+        let a = self.assemble_state(state, true, Some(&contact))?;
         let p = pv / (self.multiplicity() * a.volume);
         let (neg, _) = self.factorize(&a, p)?;
         let minus_q: Vec<f64> = self
-            .plane_rate(&state.x, planes, state.planes)
+            .plane_rate(state, planes, state.planes)
             .into_iter()
             .map(|v| -v)
             .collect();
@@ -696,7 +902,7 @@ impl Model {
         state: &State,
         load: &Load,
     ) -> Result<(Assembled, Vec<f64>, usize), FemError> {
-        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
+        let a = self.assemble_state(state, true, load.contact.as_ref())?;
         let (neg, _) = self.factorize(&a, state.p)?;
         let mut b = a.g.clone();
         self.ldlt.solve(&mut b);
@@ -816,7 +1022,7 @@ impl Model {
         load: &Load,
         iterations: usize,
     ) -> Result<(Vec<f64>, f64, Assembled, f64), FemError> {
-        let a = self.assemble(&state.x, true, load.contact.as_ref())?;
+        let a = self.assemble_state(state, true, load.contact.as_ref())?;
         // closed gas: the stiffness is K + (ϖ/V) g gᵀ, solved by Sherman–Morrison
         let gas = load.gas().map(|pv| pv / (self.multiplicity() * a.volume));
         self.factorize(&a, gas.unwrap_or(state.p))?;
@@ -1111,7 +1317,7 @@ impl MembraneProblem<'_> {
         let t = std::time::Instant::now();
         let a = self
             .model
-            .assemble(x, true, self.contact(state).as_deref())?;
+            .assemble_state(state, true, self.contact(state).as_deref())?;
         Ok((a, t.elapsed().as_secs_f64()))
     }
 
@@ -1228,7 +1434,7 @@ impl newton::Problem for MembraneProblem<'_> {
             negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
             let mut bq: Vec<f64> = self
                 .model
-                .plane_rate(&state.x, planes, state.planes)
+                .plane_rate(state, planes, state.planes)
                 .into_iter()
                 .map(|v| -v)
                 .collect();
@@ -1320,7 +1526,7 @@ impl newton::Problem for MembraneProblem<'_> {
         }
         let trial = self
             .model
-            .assemble(&state.x, true, self.contact(state).as_deref())?;
+            .assemble_state(state, true, self.contact(state).as_deref())?;
         let pt = self.pressure(state.p, trial.volume);
         let rt: Vec<f64> = trial
             .f_int

@@ -103,11 +103,40 @@ pub trait Problem {
 /// A converged solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewtonReport {
+    /// all Newton iterations, those of the augmentations' re-solves included
     pub iterations: usize,
     pub residual: f64,
     /// the scaled residual (merit) at every linearization
     pub history: Vec<f64>,
     pub inertia: Inertia,
+    /// the contact multipliers' updates of an augmented-Lagrangian solve (zero otherwise)
+    pub augmentation: Augmentation,
+}
+
+impl NewtonReport {
+    /// The iterations of the first solve, before any augmentation: the measure of how hard
+    /// the load step itself was (for step-size control).
+    pub fn load_iterations(&self) -> usize {
+        self.iterations - self.augmentation.iterations
+    }
+}
+
+/// The Uzawa updates of the contact multipliers in one solve
+/// ([`crate::contact::Enforcement::Augmented`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Augmentation {
+    /// multiplier updates, each followed by a Newton re-solve
+    pub updates: usize,
+    /// the Newton iterations of those re-solves
+    pub iterations: usize,
+    /// the largest |g| where a plane pushes at the returned state (in R): within the gap
+    /// tolerance
+    pub gap: f64,
+    /// the largest multiplier change |Δλ| of the last update applied (per reference area, in
+    /// μH/R; 0 when none was needed)
+    pub change: f64,
+    /// the largest penetration of a plane where it pushes, at the returned state (in R)
+    pub penetration: f64,
 }
 
 /// Why a solve failed.
@@ -240,6 +269,7 @@ pub fn solve<P: Problem>(
                 residual: lin.residual,
                 history,
                 inertia: lin.inertia,
+                augmentation: Augmentation::default(),
             });
         }
         if it == settings.max_iterations {

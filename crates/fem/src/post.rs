@@ -467,7 +467,12 @@ pub fn ring_profile(
             .map(|e| {
                 let samples = gauss_samples(model, e, &state.x);
                 let force = match (contact, half_gap) {
-                    (Some(c), Some(h)) => element_contact_force(&samples, c, h),
+                    (Some(c), Some(h)) => element_contact_force(
+                        &samples,
+                        c,
+                        h,
+                        state.element_multipliers(e, c.multipliers_per_element(samples.len())),
+                    ),
                     _ => 0.0,
                 };
                 Ok((projected_resultants(model, e, &samples)?, force))
@@ -657,16 +662,20 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
     let own: Vec<(f64, f64, f64)> = contact
         .planes
         .iter()
-        .map(|plane| {
+        .enumerate()
+        .map(|(kp, plane)| {
             let c = penetrated_length(state, &ring, |p| plane.gap(p));
             let mut penetration = 0.0f64;
             let forces: Vec<f64> = (0..model.elements().len())
                 .map(|e| {
                     let mut fe = 0.0;
-                    for sp in gauss_samples(model, e, &state.x) {
+                    let samples = gauss_samples(model, e, &state.x);
+                    let lambda = state
+                        .element_multipliers(e, contact.multipliers_per_element(samples.len()));
+                    for (g, sp) in samples.iter().enumerate() {
                         let gap = plane.gap(sp.x.into());
+                        fe += sp.w * contact.traction_at(gap, contact.point(lambda, g, kp));
                         if gap < 0.0 {
-                            fe += sp.w * contact.traction(gap);
                             penetration = penetration.max(-gap);
                         }
                     }
@@ -705,15 +714,19 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
         .collect()
 }
 
-/// The contact force of one element (its Gauss points `samples`) against the plate y = h:
-/// Σ_g w_g t(gap_g) over its Gauss points in contact.
-fn element_contact_force(samples: &[GaussSample], contact: &Contact, h: f64) -> f64 {
+/// The contact force of one element (its Gauss points `samples`, its multipliers `lambda`)
+/// against the plate y = h: Σ_g w_g t(gap_g, λ_g) over its Gauss points in contact.
+fn element_contact_force(
+    samples: &[GaussSample],
+    contact: &Contact,
+    h: f64,
+    lambda: &[f64],
+) -> f64 {
+    let top = contact.top_plate().unwrap_or(0);
     let mut fe = 0.0;
-    for sp in samples {
+    for (g, sp) in samples.iter().enumerate() {
         let gp_gap = h - sp.x[1];
-        if gp_gap < 0.0 {
-            fe += sp.w * contact.traction(gp_gap);
-        }
+        fe += sp.w * contact.traction_at(gp_gap, contact.point(lambda, g, top));
     }
     fe
 }
@@ -745,6 +758,7 @@ pub struct ContactValues {
 /// [`Contact::plates`]; `None` if `contact` has no such plate.
 pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Option<ContactValues> {
     let h = contact.half_gap()?;
+    let top = contact.top_plate()?;
     let mesh = model.mesh();
     let planes = mesh.symmetry.planes();
     let x_copies = if planes.contains(&0) { 2.0 } else { 1.0 };
@@ -764,12 +778,16 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             .iter()
             .any(|i| on_ring.contains(i));
         let mut fe = 0.0;
-        for sp in gauss_samples(model, e, &state.x) {
+        let samples = gauss_samples(model, e, &state.x);
+        let lambda = state.element_multipliers(e, contact.multipliers_per_element(samples.len()));
+        for (g, sp) in samples.iter().enumerate() {
             let gp_gap = gap(sp.x.into());
+            let t = contact.traction_at(gp_gap, contact.point(lambda, g, top));
             if gp_gap < 0.0 {
-                let t = contact.traction(gp_gap);
-                fe += sp.w * t;
                 penetration = penetration.max(-gp_gap);
+            }
+            if t > 0.0 {
+                fe += sp.w * t;
                 if touches {
                     pc_sum += t / sp.area_ratio();
                     pc_n += 1;
@@ -799,8 +817,13 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
 pub fn cell_contact_pressure(model: &Model, state: &State, contact: Option<&Contact>) -> Vec<f64> {
     with_elements!(model.elements(), els => els
         .iter()
-        .map(|el| match contact {
-            Some(c) => c.element_pressure(el, &el.gather(&state.x)),
+        .enumerate()
+        .map(|(e, el)| match contact {
+            Some(c) => c.element_pressure(
+                el,
+                &el.gather(&state.x),
+                state.element_multipliers(e, c.multipliers_per_element(el.gauss.len())),
+            ),
             None => 0.0,
         })
         .collect())

@@ -173,6 +173,7 @@ pub fn translate_bulge(
             x: y,
             p: state.p,
             planes: state.planes,
+            multipliers: Vec::new(),
         },
         direction,
         splices: (a, b),

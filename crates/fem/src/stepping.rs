@@ -203,7 +203,7 @@ pub fn run_stage_from<E>(
                 previous_lambda = Some(lambda);
                 lambda = next;
                 previous = Some(std::mem::replace(state, trial));
-                if report.iterations <= set.easy_iterations {
+                if report.load_iterations() <= set.easy_iterations {
                     dl = (dl * set.growth).min(set.max_fraction);
                 }
                 let info = StepInfo {

@@ -4,7 +4,7 @@
 //! loadings, constraints and error paths on small meshes. The FE-versus-closed-form
 //! verification of whole tubes lives in the top-level `tests/` folder.
 
-use crate::contact::{Contact, Plane};
+use crate::contact::{Contact, Enforcement, Plane};
 use crate::element::{membrane_kernel, point_state, Matrix12, Vector12};
 use crate::geometry::{RefElement, Vec3};
 use crate::model::{Load, Loading, Model};
@@ -152,8 +152,9 @@ fn contact_tangent_matches_finite_differences() {
                 offset: n.dot(&mid),
             }],
             penalty: 300.0,
+            enforcement: Enforcement::Penalty,
         };
-        let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x);
+        let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x, &[]);
         assert!(eval(&x).0 > 0.0, "the plane penetrates the element");
         // the penalty is C¹: where a Gauss point crosses the plane within ±h the difference
         // quotient sees the kink; none does at these random states
@@ -166,10 +167,60 @@ pub(crate) fn contact_eval<const N: usize, const D: usize>(
     contact: &Contact,
     re: &RefElement<N>,
     x: &[Vec3; N],
+    history: &[f64],
 ) -> (f64, SVector<f64, D>, SMatrix<f64, D, D>) {
     let (mut r, mut k) = (SVector::zeros(), SMatrix::zeros());
-    let e = contact.kernel(re, x, &mut r, Some(&mut k));
+    let e = contact.kernel(re, x, history, &mut r, Some(&mut k));
     (e, r, k)
+}
+
+/// The augmented-Lagrangian contact kernel, t = ⟨λ − κ_g g⟩ with random multipliers and local
+/// penalties at each Gauss point (so that some points are pushed where they do not penetrate,
+/// g > 0 with λ > κ_g g, and some penetrate with λ = 0): residual and tangent against central
+/// differences of its energy and residual.
+#[test]
+fn augmented_contact_tangent_matches_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(15);
+    let h = 1e-7;
+    let n = Vec3::new(0.2, -0.9, 0.3).normalize();
+    let mut pushed_outside = 0;
+    for _ in 0..20 {
+        let x0 = random_quad(&mut rng);
+        let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
+        let x = deform(&x0, &mut rng);
+        let mid = (x[0] + x[1] + x[2] + x[3]) / 4.0;
+        let contact = Contact {
+            planes: vec![Plane {
+                normal: [n[0], n[1], n[2]],
+                offset: n.dot(&mid),
+            }],
+            penalty: 300.0,
+            enforcement: Enforcement::augmented(),
+        };
+        // λ = κ_g (g + s): a point outside the plane (g > 0) with s > 0 is pushed from a
+        // distance, a penetrating one (g < 0) with g + s < 0 carries no multiplier
+        let history: Vec<f64> = (0..4)
+            .flat_map(|g| {
+                let kappa = 300.0 * rng.random_range(1.0..20.0);
+                let gap = n.dot(&re.position(g, &x)) - n.dot(&mid);
+                let s = rng.random_range(-0.05..0.3);
+                [(kappa * (gap + s)).max(0.0), kappa, f64::NAN]
+            })
+            .collect();
+        for g in 0..4 {
+            let at = contact.point(&history, g, 0);
+            let gap = n.dot(&re.position(g, &x)) - n.dot(&mid);
+            if gap > 0.0 && contact.traction_at(gap, at) > 0.0 {
+                pushed_outside += 1;
+            }
+        }
+        let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x, &history);
+        check_element_fd(&x, h, "augmented contact", eval);
+    }
+    assert!(
+        pushed_outside > 0,
+        "no Gauss point pushed outside the plane"
+    );
 }
 
 /// Patch test: a flat (tilted, distorted) element under a uniform in-plane stretch reproduces the
@@ -226,10 +277,11 @@ fn flat_membrane_pressed_on_a_plane() {
             offset: 0.0,
         }],
         penalty: kappa,
+        enforcement: Enforcement::Penalty,
     };
     let mut r = Vector12::zeros();
     let mut k = Matrix12::zeros();
-    let e = contact.kernel(&re, &x.map(Vec3::from), &mut r, Some(&mut k));
+    let e = contact.kernel(&re, &x.map(Vec3::from), &[], &mut r, Some(&mut k));
     let area = tubemem_mesh::quad_area(&x);
     assert!((e - 0.5 * kappa * delta * delta * area).abs() < 1e-12 * e);
     // total force on the membrane (minus the residual) is κδA along n
@@ -243,7 +295,7 @@ fn flat_membrane_pressed_on_a_plane() {
     // outside the plane: no contact
     let xo = place(delta).map(Vec3::from);
     let mut r2 = Vector12::zeros();
-    assert_eq!(contact.kernel(&re, &xo, &mut r2, None), 0.0);
+    assert_eq!(contact.kernel(&re, &xo, &[], &mut r2, None), 0.0);
     assert!(r2.iter().all(|v| *v == 0.0));
 }
 
@@ -347,7 +399,7 @@ pub(crate) fn check_assembled_tangents(mesh: tubemem_mesh::Mesh, seed: u64, dire
     // within the step, which the tolerance of the tangent checks covers)
     let moving = crate::contact::MovingPlanes::plates(50.0);
     let lambda = 0.7 * ymax;
-    let q = model.plane_rate(&st.x, &moving, lambda);
+    let q = model.plane_rate(&st, &moving, lambda);
     let at = |l: f64| {
         model
             .residual(

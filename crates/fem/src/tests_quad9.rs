@@ -101,8 +101,9 @@ fn quad9_contact_tangent_matches_finite_differences() {
                 offset: n.dot(&x[8]) + 0.013,
             }],
             penalty: 300.0,
+            enforcement: crate::contact::Enforcement::Penalty,
         };
-        let eval = |x: &[Vec3; 9]| contact_eval::<9, 27>(&contact, &re, x);
+        let eval = |x: &[Vec3; 9]| contact_eval::<9, 27>(&contact, &re, x, &[]);
         assert!(eval(&x).0 > 0.0, "the plane penetrates the element");
         check_element_fd(&x, 1e-7, "contact", eval);
     }

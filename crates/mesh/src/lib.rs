@@ -136,7 +136,7 @@ pub struct Mesh {
     /// translate axially. The surface may be open along a plug ring; the disc face closes it.
     pub plugs: Vec<Vec<usize>>,
     /// For a biquadratic (9-node) mesh, the mid-side nodes of edges 0–1, 1–2, 2–3, 3–0 and the
-    /// centre node of each quad (see [`shape`](crate::shape)); empty for a bilinear mesh. The
+    /// centre node of each quad (see the module [`mod@crate::shape`]); empty for a bilinear mesh. The
     /// corners stay in `quads`, so every topological check reads the corners alone.
     pub mid: Vec<[usize; 5]>,
 }

@@ -104,7 +104,7 @@ pub struct CheckSpec {
     // invariance
     pub min_core_fraction: Option<Tol>,
     // gold
-    /// the gold folder, relative to the suite file (default gold/<name>)
+    /// the gold folder, relative to the suite file (default `gold/<name>`)
     pub gold: Option<String>,
     pub rel_err: Option<f64>,
     pub abs_zero: Option<f64>,
