@@ -94,17 +94,9 @@ pub struct State {
     pub planes: f64,
     /// the contact multipliers of an augmented-Lagrangian contact
     /// ([`crate::contact::Enforcement::Augmented`]), element major, then Gauss point, then
-    /// plane, [`crate::contact::HISTORY`] values each ([`Contact::point`]); empty: none (the penalty alone)
+    /// plane, [`crate::contact::HISTORY`] values each ([`Contact::point`],
+    /// [`Contact::element_history`]); empty: none (the penalty alone)
     pub multipliers: Vec<f64>,
-}
-
-impl State {
-    /// Element `e`'s multipliers (empty when the state has none).
-    pub fn element_multipliers(&self, e: usize, per_element: usize) -> &[f64] {
-        self.multipliers
-            .get(e * per_element..(e + 1) * per_element)
-            .unwrap_or(&[])
-    }
 }
 
 /// The reference elements of a model: all 4-node or all 9-node.
@@ -179,8 +171,7 @@ impl Terms<'_> {
                 }
             })?;
         if let Some(c) = self.contact {
-            let per = c.multipliers_per_element(el.gauss.len());
-            let lambda = self.multipliers.get(e * per..(e + 1) * per).unwrap_or(&[]);
+            let lambda = c.element_history(self.multipliers, e, el.gauss.len());
             energy += c.kernel(el, xe, lambda, r, k);
         }
         Ok(energy)
@@ -574,6 +565,17 @@ impl Model {
         if let Loading::Pressure(p) = load.loading {
             state.p = p;
         }
+        self.solve_load(state, load, None)
+    }
+
+    /// Newton under `load` (with the arc-length constraint `arc`, if any) inside the
+    /// augmentation loop of the load's contact ([`Model::augmented`]).
+    fn solve_load(
+        &mut self,
+        state: &mut State,
+        load: &Load,
+        arc: Option<&ArcConstraint<'_>>,
+    ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
         let settings = self.settings;
         let contact = load.contact.clone();
         self.augmented(
@@ -581,7 +583,7 @@ impl Model {
             |_| contact.clone(),
             |model, state| {
                 newton::solve(
-                    &mut MembraneProblem::new(model, load, None),
+                    &mut MembraneProblem::new(model, load, arc),
                     state,
                     &settings,
                 )
@@ -590,14 +592,13 @@ impl Model {
     }
 
     /// The Uzawa update of `state`'s contact history under `contact`
-    /// ([`Contact::update_multipliers`] for every element; `first`: the first update of a
-    /// solve). Returns the updated history and the update's maxima. Elements run in parallel;
-    /// the maxima do not depend on the number of threads.
-    pub fn augment(
+    /// ([`Contact::update_multipliers`] for every element). Returns the updated history and
+    /// the update's maxima. Elements run in parallel; the maxima do not depend on the number of
+    /// threads.
+    fn augment(
         &self,
         state: &State,
         contact: &Contact,
-        first: bool,
         gap_tolerance: f64,
     ) -> (Vec<f64>, UpdateSize) {
         with_elements!(&self.elements, els => {
@@ -608,15 +609,8 @@ impl Model {
                 .zip(els.par_iter())
                 .enumerate()
                 .map(|(e, (o, el))| {
-                    let lambda = state.element_multipliers(e, per);
-                    contact.update_multipliers(
-                        el,
-                        &el.gather(&state.x),
-                        lambda,
-                        first,
-                        gap_tolerance,
-                        o,
-                    )
+                    let lambda = contact.element_history(&state.multipliers, e, el.gauss.len());
+                    contact.update_multipliers(el, &el.gather(&state.x), lambda, gap_tolerance, o)
                 })
                 .reduce(UpdateSize::default, UpdateSize::max);
             (out, size)
@@ -638,47 +632,37 @@ impl Model {
             &mut State,
         ) -> Result<newton::NewtonReport, NewtonError<FemError>>,
     ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
-        let Some((gap_tolerance, max_augmentations, per)) =
-            contact_at(state).and_then(|c| match c.enforcement {
+        let start = contact_at(state);
+        let (Some(contact), Some((gap_tolerance, max_augmentations))) = (
+            start.as_ref(),
+            start.as_ref().and_then(|c| match c.enforcement {
                 Enforcement::Augmented {
                     gap_tolerance,
                     max_augmentations,
-                } => Some((
-                    gap_tolerance,
-                    max_augmentations,
-                    c.multipliers_per_element(self.gauss_points()),
-                )),
+                } => Some((gap_tolerance, max_augmentations)),
                 Enforcement::Penalty => None,
-            })
-        else {
+            }),
+        ) else {
             state.multipliers.clear();
             return once(self, state);
         };
         // a stage whose planes changed (or the first with multipliers) starts afresh; every
-        // solve starts from the stage's penalty at every point (a local penalty raised in the
-        // last step's updates would meet this step's new penetrations as a stiff penalty, which
-        // Newton handles badly) and keeps the multipliers
-        if let Some(c) = contact_at(state) {
-            if state.multipliers.len() != per * self.elements.len() {
-                state.multipliers = c
-                    .fresh_history(self.gauss_points())
-                    .repeat(self.elements.len());
-            } else {
-                for h in state.multipliers.chunks_exact_mut(crate::contact::HISTORY) {
-                    h[1] = c.penalty;
-                }
-            }
+        // solve restarts the local penalties and keeps the multipliers
+        let gauss_points =
+            with_elements!(&self.elements, els => els.first().map_or(0, |e| e.gauss.len()));
+        let per = contact.multipliers_per_element(gauss_points);
+        if state.multipliers.len() == per * self.elements.len() {
+            contact.restart_history(&mut state.multipliers);
+        } else {
+            state.multipliers = contact
+                .fresh_history(gauss_points)
+                .repeat(self.elements.len());
         }
         let mut report = once(self, state)?;
         let mut aug = Augmentation::default();
-        loop {
-            let contact = contact_at(state).ok_or(NewtonError::Problem {
-                iteration: report.iterations,
-                source: FemError::NonFiniteResidual {
-                    what: "contact (the planes vanished during the augmentation)",
-                },
-            })?;
-            let (lambda, size) = self.augment(state, &contact, aug.updates == 0, gap_tolerance);
+        // the planes at the state (closed gas pressed by moving planes: at its parameter)
+        while let Some(contact) = contact_at(state) {
+            let (lambda, size) = self.augment(state, &contact, gap_tolerance);
             aug.gap = size.gap;
             aug.penetration = size.penetration;
             if !(size.gap.is_finite() && size.change.is_finite()) {
@@ -714,11 +698,6 @@ impl Model {
         }
         report.augmentation = aug;
         Ok(report)
-    }
-
-    /// The Gauss points of one element (all elements of a model have the same rule).
-    pub fn gauss_points(&self) -> usize {
-        with_elements!(&self.elements, els => els.first().map_or(0, |e| e.gauss.len()))
     }
 
     /// Newton iterations at the prescribed total volume `volume` with the direction `phi0`
@@ -763,25 +742,13 @@ impl Model {
         load: &Load,
         arc: &ArcConstraint<'_>,
     ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
-        let settings = self.settings;
         // the pressure is the continuation parameter: whatever the stage's own control, the
         // corrector solves equilibrium under ϖ (an unknown) with the stage's planes
         let load = &Load {
             loading: Loading::Pressure(state.p),
             contact: load.contact.clone(),
         };
-        let contact = load.contact.clone();
-        self.augmented(
-            state,
-            |_| contact.clone(),
-            |model, state| {
-                newton::solve(
-                    &mut MembraneProblem::new(model, load, Some(arc)),
-                    state,
-                    &settings,
-                )
-            },
-        )
+        self.solve_load(state, load, Some(arc))
     }
 
     /// Newton iterations on equilibrium of the closed gas (Boyle's constant `pv`) pressed by
@@ -833,8 +800,7 @@ impl Model {
         let mut q = vec![0.0; self.n_eq()];
         for (e, el) in elements.iter().enumerate() {
             let mut qe = SVector::<f64, D>::zeros();
-            let lambda =
-                state.element_multipliers(e, contact.multipliers_per_element(el.gauss.len()));
+            let lambda = contact.element_history(&state.multipliers, e, el.gauss.len());
             contact.rate_kernel(el, &el.gather(&state.x), lambda, rates, &mut qe);
             for (i, v) in qe.iter().enumerate() {
                 if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {

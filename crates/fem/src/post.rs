@@ -456,6 +456,7 @@ pub fn ring_profile(
         }
     }
     let half_gap = contact.and_then(Contact::half_gap);
+    let top = contact.and_then(Contact::top_plate);
     // every element's projected resultants once (in parallel; collected in element order, so
     // the result does not depend on the thread count), and the volume once
     // each element's Gauss points once: its projected resultants and, against plates, its
@@ -466,12 +467,12 @@ pub fn ring_profile(
             .into_par_iter()
             .map(|e| {
                 let samples = gauss_samples(model, e, &state.x);
-                let force = match (contact, half_gap) {
-                    (Some(c), Some(h)) => element_contact_force(
+                let force = match (contact, top) {
+                    (Some(c), Some(top)) => element_contact_force(
                         &samples,
                         c,
-                        h,
-                        state.element_multipliers(e, c.multipliers_per_element(samples.len())),
+                        top,
+                        c.element_history(&state.multipliers, e, samples.len()),
                     ),
                     _ => 0.0,
                 };
@@ -670,8 +671,7 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
                 .map(|e| {
                     let mut fe = 0.0;
                     let samples = gauss_samples(model, e, &state.x);
-                    let lambda = state
-                        .element_multipliers(e, contact.multipliers_per_element(samples.len()));
+                    let lambda = contact.element_history(&state.multipliers, e, samples.len());
                     for (g, sp) in samples.iter().enumerate() {
                         let gap = plane.gap(sp.x.into());
                         fe += sp.w * contact.traction_at(gap, contact.point(lambda, g, kp));
@@ -714,15 +714,16 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
         .collect()
 }
 
-/// The contact force of one element (its Gauss points `samples`, its multipliers `lambda`)
-/// against the plate y = h: Σ_g w_g t(gap_g, λ_g) over its Gauss points in contact.
+/// The contact force of one element (its Gauss points `samples`, its contact history `lambda`)
+/// against the top plate y = h (plane `top` of `contact`): Σ_g w_g t(gap_g, λ_g) over its
+/// Gauss points in contact.
 fn element_contact_force(
     samples: &[GaussSample],
     contact: &Contact,
-    h: f64,
+    top: usize,
     lambda: &[f64],
 ) -> f64 {
-    let top = contact.top_plate().unwrap_or(0);
+    let h = -contact.planes[top].offset;
     let mut fe = 0.0;
     for (g, sp) in samples.iter().enumerate() {
         let gp_gap = h - sp.x[1];
@@ -779,7 +780,7 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             .any(|i| on_ring.contains(i));
         let mut fe = 0.0;
         let samples = gauss_samples(model, e, &state.x);
-        let lambda = state.element_multipliers(e, contact.multipliers_per_element(samples.len()));
+        let lambda = contact.element_history(&state.multipliers, e, samples.len());
         for (g, sp) in samples.iter().enumerate() {
             let gp_gap = gap(sp.x.into());
             let t = contact.traction_at(gp_gap, contact.point(lambda, g, top));
@@ -822,7 +823,7 @@ pub fn cell_contact_pressure(model: &Model, state: &State, contact: Option<&Cont
             Some(c) => c.element_pressure(
                 el,
                 &el.gather(&state.x),
-                state.element_multipliers(e, c.multipliers_per_element(el.gauss.len())),
+                c.element_history(&state.multipliers, e, el.gauss.len()),
             ),
             None => 0.0,
         })

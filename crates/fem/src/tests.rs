@@ -134,26 +134,33 @@ fn volume_gradient_and_hessian_match_finite_differences() {
     }
 }
 
+/// A random distorted element, deformed, and a tilted plane through its centroid with the
+/// penalty κ = 300 (so that some Gauss points penetrate it), for the contact FD checks.
+fn element_on_tilted_plane(rng: &mut ChaCha8Rng) -> (RefElement<4>, [Vec3; 4], Contact) {
+    let n = Vec3::new(0.2, -0.9, 0.3).normalize();
+    let x0 = random_quad(rng);
+    let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
+    let x = deform(&x0, rng);
+    let mid = (x[0] + x[1] + x[2] + x[3]) / 4.0;
+    let contact = Contact {
+        planes: vec![Plane {
+            normal: [n[0], n[1], n[2]],
+            offset: n.dot(&mid),
+        }],
+        penalty: 300.0,
+        enforcement: Enforcement::Penalty,
+    };
+    (re, x, contact)
+}
+
 /// The contact kernel's residual and tangent against central differences of its energy and
 /// residual, with a tilted plane that some Gauss points penetrate.
 #[test]
 fn contact_tangent_matches_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(14);
     let h = 1e-7;
-    let n = Vec3::new(0.2, -0.9, 0.3).normalize();
     for _ in 0..20 {
-        let x0 = random_quad(&mut rng);
-        let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
-        let x = deform(&x0, &mut rng);
-        let mid = (x[0] + x[1] + x[2] + x[3]) / 4.0;
-        let contact = Contact {
-            planes: vec![Plane {
-                normal: [n[0], n[1], n[2]],
-                offset: n.dot(&mid),
-            }],
-            penalty: 300.0,
-            enforcement: Enforcement::Penalty,
-        };
+        let (re, x, contact) = element_on_tilted_plane(&mut rng);
         let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x, &[]);
         assert!(eval(&x).0 > 0.0, "the plane penetrates the element");
         // the penalty is C¹: where a Gauss point crosses the plane within ±h the difference
@@ -182,38 +189,30 @@ pub(crate) fn contact_eval<const N: usize, const D: usize>(
 fn augmented_contact_tangent_matches_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(15);
     let h = 1e-7;
-    let n = Vec3::new(0.2, -0.9, 0.3).normalize();
     let mut pushed_outside = 0;
     for _ in 0..20 {
-        let x0 = random_quad(&mut rng);
-        let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
-        let x = deform(&x0, &mut rng);
-        let mid = (x[0] + x[1] + x[2] + x[3]) / 4.0;
-        let contact = Contact {
-            planes: vec![Plane {
-                normal: [n[0], n[1], n[2]],
-                offset: n.dot(&mid),
-            }],
-            penalty: 300.0,
-            enforcement: Enforcement::augmented(),
-        };
+        let (re, x, contact) = element_on_tilted_plane(&mut rng);
+        let contact = contact.with_enforcement(Enforcement::augmented());
+        let gaps: Vec<f64> = (0..4)
+            .map(|g| contact.planes[0].gap(re.position(g, &x).into()))
+            .collect();
         // λ = κ_g (g + s): a point outside the plane (g > 0) with s > 0 is pushed from a
         // distance, a penetrating one (g < 0) with g + s < 0 carries no multiplier
-        let history: Vec<f64> = (0..4)
-            .flat_map(|g| {
+        let history: Vec<f64> = gaps
+            .iter()
+            .flat_map(|gap| {
                 let kappa = 300.0 * rng.random_range(1.0..20.0);
-                let gap = n.dot(&re.position(g, &x)) - n.dot(&mid);
                 let s = rng.random_range(-0.05..0.3);
                 [(kappa * (gap + s)).max(0.0), kappa, f64::NAN]
             })
             .collect();
-        for g in 0..4 {
-            let at = contact.point(&history, g, 0);
-            let gap = n.dot(&re.position(g, &x)) - n.dot(&mid);
-            if gap > 0.0 && contact.traction_at(gap, at) > 0.0 {
-                pushed_outside += 1;
-            }
-        }
+        pushed_outside += gaps
+            .iter()
+            .enumerate()
+            .filter(|&(g, &gap)| {
+                gap > 0.0 && contact.traction_at(gap, contact.point(&history, g, 0)) > 0.0
+            })
+            .count();
         let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x, &history);
         check_element_fd(&x, h, "augmented contact", eval);
     }
