@@ -92,7 +92,7 @@ macro_rules! invalid {
     ($($arg:tt)*) => { return Err(CaseError::Invalid(format!($($arg)*))) };
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
     /// the folder of the case file (user mesh paths are relative to it)
@@ -192,7 +192,7 @@ impl Default for OutputSpec {
 }
 
 /// `[solver]`: optional.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
     /// "relaxed" (tension-field theory, default) or "none"
@@ -240,7 +240,7 @@ fn default_max_iterations() -> usize {
     30
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Geometry {
     pub radius: f64,
@@ -263,7 +263,7 @@ pub enum Caps {
     RigidPlug,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
     /// a user mesh (tubemem JSON, see `tubemem_mesh::io`; `python -m tubemem_ref.meshio_io`
@@ -280,6 +280,14 @@ pub struct MeshSpec {
     /// the element of the generated tube (a user mesh's file sets its own)
     #[serde(default)]
     pub element: ElementKind,
+    /// the generated tube's hoop node line nearest the contact edge of the last squeeze moved
+    /// onto the closed form's edge at its target (an element boundary where the curvature
+    /// jumps), blended back to uniform spacing over the last 2R before each cap
+    #[serde(default)]
+    pub fit_contact_edge: bool,
+    /// the reference angle (radians, from the plates' symmetry line x = 0) where the fitted
+    /// node line goes, instead of the one `fit_contact_edge` finds
+    pub contact_edge_angle: Option<f64>,
 }
 
 impl MeshSpec {
@@ -338,7 +346,7 @@ pub enum ControlKind {
     ArcLength,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StageSpec {
     pub kind: Kind,
@@ -361,6 +369,9 @@ pub struct StageSpec {
     pub gap_tolerance: Option<f64>,
     /// augmented contact: the multiplier updates allowed in one step (default 50)
     pub max_augmentations: Option<usize>,
+    /// squeeze and confine: where the planes act on an element, "gauss" (its Gauss points, the
+    /// default) or "nodal" (its nodes, each weighted by its share of the element's area)
+    pub contact_points: Option<tubemem_fem::contact::ContactPoints>,
     pub target_pressure: Option<f64>,
     pub target_stretch: Option<f64>,
     pub target_volume_ratio: Option<f64>,
@@ -466,6 +477,9 @@ pub struct StagePlan {
     /// squeeze and confine stages: how the planes are enforced
     #[serde(default)]
     pub enforcement: Option<tubemem_fem::contact::Enforcement>,
+    /// squeeze and confine stages: where the planes act on an element
+    #[serde(default)]
+    pub contact_points: tubemem_fem::contact::ContactPoints,
     /// `control = "arc-length"`: the target is reached along the path by arc-length
     /// continuation, through limit points and snap-backs, with critical points located
     #[serde(default)]
@@ -512,6 +526,7 @@ impl StageSpec {
             steps: self.steps,
             penalty,
             enforcement,
+            contact_points: self.contact_points.unwrap_or_default(),
             arc_length: self.control == Some(ControlKind::ArcLength),
             follow_stable: self.branch == Some(BranchSpec::FollowStable),
         })
@@ -636,6 +651,7 @@ impl StageSpec {
             ("contact_method", self.contact_method.is_some()),
             ("gap_tolerance", self.gap_tolerance.is_some()),
             ("max_augmentations", self.max_augmentations.is_some()),
+            ("contact_points", self.contact_points.is_some()),
         ]
         .into_iter()
         .find(|k| k.1);
@@ -718,6 +734,12 @@ impl Case {
     /// The resolved stages.
     pub fn plan(&self) -> &[StagePlan] {
         &self.plan
+    }
+
+    /// Keep the first `n` resolved stages (with [`Case::stages`] truncated to match: a case
+    /// that stops earlier).
+    pub(crate) fn truncate_plan(&mut self, n: usize) {
+        self.plan.truncate(n);
     }
 
     fn validate(&self) -> Result<Vec<StagePlan>, CaseError> {

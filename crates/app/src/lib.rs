@@ -21,6 +21,7 @@
 
 pub mod case;
 pub mod curves;
+pub mod edge_fit;
 pub mod export;
 pub mod figures;
 pub mod main_job;
@@ -122,6 +123,12 @@ pub enum AppError {
         equations: usize,
         estimate_bytes: u64,
         available_bytes: u64,
+    },
+    #[error("[mesh] `fit_contact_edge`: the locating solve ({around} elements around) failed")]
+    Locator {
+        around: usize,
+        #[source]
+        source: Box<AppError>,
     },
     #[error("interrupted at stage {stage} after {steps} converged steps of it")]
     Interrupted { stage: usize, steps: usize },

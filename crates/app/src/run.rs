@@ -12,7 +12,8 @@ use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepInfo, StepSet
 use tubemem_fem::NewtonSettings;
 use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
-use tubemem_mesh::tube::{capped_tube_with_cap_rows_of, plugged_tube_of};
+use tubemem_mesh::hoop::HoopMap;
+use tubemem_mesh::tube::{capped_tube_fitted_of, plugged_tube_of};
 use tubemem_mesh::Mesh;
 
 /// The largest penetration of the plates, as a fraction of the plate half-gap ρ, that a squeeze
@@ -242,9 +243,13 @@ pub fn build_mesh(case: &Case) -> Result<Mesh> {
         (None, Some(around), Some(along)) => {
             let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
             let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
+            let fit = match crate::edge_fit::contact_edges(case)? {
+                Some(f) => Some(HoopMap::fitted(around, &f.edges()).map_err(AppError::Mesh)?),
+                None => None,
+            };
             match g.caps {
                 Caps::Hemisphere => {
-                    capped_tube_with_cap_rows_of(kind, 1.0, ll, around, along, cap_rows, sym)
+                    capped_tube_fitted_of(kind, 1.0, ll, around, along, cap_rows, sym, fit.as_ref())
                 }
                 Caps::RigidPlug => plugged_tube_of(kind, 1.0, ll, around, along, sym),
             }
@@ -817,6 +822,7 @@ pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Con
             .collect(),
         penalty,
         enforcement: tubemem_fem::contact::Enforcement::Penalty,
+        points: Default::default(),
     }
 }
 
@@ -1004,6 +1010,7 @@ fn run_inner(
         let start_lambda_s = context.start_lambda_s;
         let (pv, penalty) = (context.pv, context.penalty);
         let enforcement = plan.enforcement.unwrap_or(Enforcement::Penalty);
+        let points = plan.contact_points;
         let load: Box<dyn Fn(f64) -> Load> = match plan.target {
             Target::Pressure(_) => Box::new(Load::pressure),
             Target::Stretch(_) => Box::new(move |v| {
@@ -1017,7 +1024,9 @@ fn run_inner(
             Target::Rho(_) => Box::new(move |h| {
                 Load::with_contact(
                     Loading::Gas { pv },
-                    Contact::plates(h, penalty).with_enforcement(enforcement),
+                    Contact::plates(h, penalty)
+                        .with_enforcement(enforcement)
+                        .with_points(points),
                 )
             }),
             Target::Confine(_) => {
@@ -1025,7 +1034,9 @@ fn run_inner(
                 Box::new(move |t| {
                     Load::with_contact(
                         Loading::Gas { pv },
-                        fe_planes(&planes, t, penalty).with_enforcement(enforcement),
+                        fe_planes(&planes, t, penalty)
+                            .with_enforcement(enforcement)
+                            .with_points(points),
                     )
                 })
             }
@@ -1250,12 +1261,15 @@ fn run_inner(
             let loading = match plan.target {
                 Target::Rho(_) => ArcLoading::ClosedGas {
                     pv,
-                    planes: MovingPlanes::plates(penalty).with_enforcement(enforcement),
+                    planes: MovingPlanes::plates(penalty)
+                        .with_enforcement(enforcement)
+                        .with_points(points),
                 },
                 Target::Confine(_) => ArcLoading::ClosedGas {
                     pv,
                     planes: fe_moving_planes(&case.stages[i - 1].plane, penalty)
-                        .with_enforcement(enforcement),
+                        .with_enforcement(enforcement)
+                        .with_points(points),
                 },
                 _ => ArcLoading::Pressure(None),
             };
@@ -1388,7 +1402,11 @@ fn run_inner(
         let rings = match steps.last() {
             Some(l) if !l.profile.is_empty() => l.profile.clone(),
             _ => {
-                let plates = contact.map(|c| Contact::plates(c.values.rho, c.penalty));
+                let plates = contact.map(|c| {
+                    Contact::plates(c.values.rho, c.penalty)
+                        .with_enforcement(enforcement)
+                        .with_points(points)
+                });
                 ring_profile(&model, &state, plates.as_ref())
                     .map_err(|source| AppError::Post { stage: i, source })?
             }

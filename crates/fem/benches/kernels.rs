@@ -51,6 +51,7 @@ fn bench(c: &mut Criterion) {
         }],
         penalty: 1e3,
         enforcement: tubemem_fem::contact::Enforcement::Penalty,
+        points: Default::default(),
     };
     c.bench_function("contact_kernel_with_tangent", |b| {
         b.iter(|| {

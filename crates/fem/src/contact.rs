@@ -19,7 +19,7 @@
 //! λ = t, so every Gauss point either carries λ > 0 at g = 0 or is free with g ≥ 0; the updates
 //! stop when the largest |g| where a plane pushes (t > 0) is within the gap tolerance.
 
-use crate::geometry::{RefElement, Vec3};
+use crate::geometry::{GaussPoint, RefElement, Vec3};
 use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
@@ -55,6 +55,18 @@ pub enum Enforcement {
         /// updates allowed in one step before it fails
         max_augmentations: usize,
     },
+}
+
+/// Where the contact acts: at an element's Gauss points, or at its nodes, each weighted by
+/// ∫N_a dA0 (a nodal quadrature: one constraint per node and plane, where the Gauss points of
+/// an element, 9 of them on 9 nodes but closer together, give nearly dependent constraints
+/// along a contact edge that cuts the element).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactPoints {
+    #[default]
+    Gauss,
+    Nodal,
 }
 
 /// The augmentations allowed in one step by default: 50, about twice the most a converging
@@ -126,6 +138,8 @@ pub struct Contact {
     /// κ, per unit μH/R² (see [`penalty_for`])
     pub penalty: f64,
     pub enforcement: Enforcement,
+    /// where the planes act on an element
+    pub points: ContactPoints,
 }
 
 impl Contact {
@@ -144,6 +158,22 @@ impl Contact {
             ],
             penalty,
             enforcement: Enforcement::Penalty,
+            points: ContactPoints::Gauss,
+        }
+    }
+
+    /// The same planes, acting at `points`.
+    pub fn with_points(mut self, points: ContactPoints) -> Self {
+        self.points = points;
+        self
+    }
+
+    /// The points of element `re` where the planes act ([`Contact::points`]): its Gauss points
+    /// or its nodes.
+    pub fn samples<'a, const N: usize>(&self, re: &'a RefElement<N>) -> &'a [GaussPoint<N>] {
+        match self.points {
+            ContactPoints::Gauss => &re.gauss,
+            ContactPoints::Nodal => &re.nodal,
         }
     }
 
@@ -153,17 +183,17 @@ impl Contact {
         self
     }
 
-    /// The number of history values per element of `gauss_points` Gauss points: for each
+    /// The number of history values per element of `points` contact points ([`Contact::samples`]): for each
     /// Gauss point and plane, [`HISTORY`] values (the multiplier, the local penalty and the
     /// gap at the last update).
-    pub fn multipliers_per_element(&self, gauss_points: usize) -> usize {
-        HISTORY * gauss_points * self.planes.len()
+    pub fn multipliers_per_element(&self, points: usize) -> usize {
+        HISTORY * points * self.planes.len()
     }
 
-    /// Element `e`'s part of a model's contact history `all` (elements of `gauss_points`
+    /// Element `e`'s part of a model's contact history `all` (elements of `points`
     /// Gauss points, element major; empty when `all` holds none, e.g. under the penalty alone).
-    pub fn element_history<'a>(&self, all: &'a [f64], e: usize, gauss_points: usize) -> &'a [f64] {
-        let per = self.multipliers_per_element(gauss_points);
+    pub fn element_history<'a>(&self, all: &'a [f64], e: usize, points: usize) -> &'a [f64] {
+        let per = self.multipliers_per_element(points);
         all.get(e * per..(e + 1) * per).unwrap_or(&[])
     }
 
@@ -228,10 +258,10 @@ impl Contact {
         }
     }
 
-    /// A fresh history for one element of `gauss_points` Gauss points: λ = 0, the stage's κ,
+    /// A fresh history for one element of `points` contact points: λ = 0, the stage's κ,
     /// no last gap.
-    pub fn fresh_history(&self, gauss_points: usize) -> Vec<f64> {
-        (0..gauss_points * self.planes.len())
+    pub fn fresh_history(&self, points: usize) -> Vec<f64> {
+        (0..points * self.planes.len())
             .flat_map(|_| [0.0, self.penalty, f64::NAN])
             .collect()
     }
@@ -247,9 +277,9 @@ impl Contact {
         mut k: Option<&mut SMatrix<f64, D, D>>,
     ) -> f64 {
         let mut energy = 0.0;
-        for (g, gp) in re.gauss.iter().enumerate() {
+        for (g, gp) in self.samples(re).iter().enumerate() {
             let n = &gp.n;
-            let p = re.position(g, xe);
+            let p = gp.position(xe);
             for (kp, plane) in self.planes.iter().enumerate() {
                 let gap = plane.gap_at(&p);
                 let at = self.point(lambda, g, kp);
@@ -304,8 +334,8 @@ impl Contact {
         out: &mut [f64],
     ) -> UpdateSize {
         let mut size = UpdateSize::default();
-        for g in 0..re.gauss.len() {
-            let p = re.position(g, xe);
+        for (g, gp) in self.samples(re).iter().enumerate() {
+            let p = gp.position(xe);
             for (kp, plane) in self.planes.iter().enumerate() {
                 let gap = plane.gap_at(&p);
                 let at = self.point(lambda, g, kp);
@@ -347,9 +377,9 @@ impl Contact {
         rates: &[f64],
         q: &mut SVector<f64, D>,
     ) {
-        for (g, gp) in re.gauss.iter().enumerate() {
+        for (g, gp) in self.samples(re).iter().enumerate() {
             let n = &gp.n;
-            let p = re.position(g, xe);
+            let p = gp.position(xe);
             for (kp, (plane, rate)) in self.planes.iter().zip(rates).enumerate() {
                 let at = self.point(lambda, g, kp);
                 let t = self.traction_at(plane.gap_at(&p), at);
@@ -372,10 +402,12 @@ impl Contact {
         lambda: &[f64],
     ) -> f64 {
         let mut s = 0.0;
-        let share = 1.0 / re.gauss.len() as f64;
-        for g in 0..re.gauss.len() {
-            let p = re.position(g, xe);
-            let da = re.area_ratio(g, xe);
+        let points = self.samples(re);
+        let share = 1.0 / points.len() as f64;
+        for (g, gp) in points.iter().enumerate() {
+            let p = gp.position(xe);
+            let f = gp.gradient(xe);
+            let da = f[0].cross(&f[1]).norm();
             for (kp, pl) in self.planes.iter().enumerate() {
                 s += share * self.traction_at(pl.gap_at(&p), self.point(lambda, g, kp)) / da;
             }
@@ -407,6 +439,12 @@ impl MovingPlanes {
     /// The same planes enforced by `enforcement`.
     pub fn with_enforcement(mut self, enforcement: Enforcement) -> Self {
         self.at_zero.enforcement = enforcement;
+        self
+    }
+
+    /// The same planes acting at `points`.
+    pub fn with_points(mut self, points: ContactPoints) -> Self {
+        self.at_zero.points = points;
         self
     }
 

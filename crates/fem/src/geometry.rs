@@ -37,11 +37,103 @@ pub struct GaussPoint<const N: usize> {
     pub frame: [Vec3; 2],
 }
 
+impl<const N: usize> GaussPoint<N> {
+    /// x at the point.
+    pub fn position(&self, xe: &[Vec3; N]) -> Vec3 {
+        let mut p = Vec3::zeros();
+        for a in 0..N {
+            p += xe[a] * self.n[a];
+        }
+        p
+    }
+
+    /// The in-plane deformation gradient columns f_1, f_2 at the point.
+    pub fn gradient(&self, xe: &[Vec3; N]) -> [Vec3; 2] {
+        let mut f = [Vec3::zeros(); 2];
+        for a in 0..N {
+            for i in 0..2 {
+                f[i] += xe[a] * self.dn[a][i];
+            }
+        }
+        f
+    }
+}
+
 /// Reference data of one element at its Gauss points.
 #[derive(Clone, Debug)]
 pub struct RefElement<const N: usize = 4> {
     pub nodes: [usize; N],
     pub gauss: Box<[GaussPoint<N>]>,
+    /// the element's nodes as points (N_b = δ_ab there), each with the reference area
+    /// ∫N_a dA0 as its weight: the contact's nodal quadrature
+    pub nodal: Box<[GaussPoint<N>]>,
+}
+
+/// The reference coordinates (ξ, η) of an element's nodes, in node order.
+fn node_coordinates<const N: usize>() -> &'static [(f64, f64)] {
+    const CORNERS: [(f64, f64); 4] = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    const NINE: [(f64, f64); 9] = [
+        (-1.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+        (0.0, -1.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (-1.0, 0.0),
+        (0.0, 0.0),
+    ];
+    if N == 9 {
+        &NINE
+    } else {
+        &CORNERS
+    }
+}
+
+/// The reference data at a point with shape values `n` and reference derivatives `d` of an
+/// element with nodes at `xv`, and `weight` times det J as its weight; `None` where the
+/// element is degenerate.
+fn point_at<const N: usize>(
+    xv: &[Vec3; N],
+    n: [f64; N],
+    d: &[[f64; 2]; N],
+    weight: f64,
+) -> Option<GaussPoint<N>> {
+    let mut g1 = Vec3::zeros();
+    let mut g2 = Vec3::zeros();
+    for a in 0..N {
+        g1 += xv[a] * d[a][0];
+        g2 += xv[a] * d[a][1];
+    }
+    let n3 = g1.cross(&g2);
+    let area = n3.norm();
+    if !(area > 1e-14 * g1.norm() * g2.norm()) {
+        return None;
+    }
+    let e1 = g1 / g1.norm();
+    let e3 = n3 / area;
+    let e2 = e3.cross(&e1);
+    let j = Matrix2::new(e1.dot(&g1), e1.dot(&g2), e2.dot(&g1), e2.dot(&g2));
+    let det = j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)];
+    let inv = Matrix2::new(
+        j[(1, 1)] / det,
+        -j[(0, 1)] / det,
+        -j[(1, 0)] / det,
+        j[(0, 0)] / det,
+    );
+    let mut dn = [[0.0; 2]; N];
+    for a in 0..N {
+        for i in 0..2 {
+            dn[a][i] = d[a][0] * inv[(0, i)] + d[a][1] * inv[(1, i)];
+        }
+    }
+    Some(GaussPoint {
+        n,
+        dn,
+        // the 2 × 2 rule's weights are 1: det * 1 is det, bit for bit
+        w: det * weight,
+        frame: [e1, e2],
+    })
 }
 
 impl<const N: usize> RefElement<N> {
@@ -62,48 +154,32 @@ impl<const N: usize> RefElement<N> {
         let mut gauss = Vec::with_capacity(rule.len());
         for (g, &(xi, eta, weight)) in rule.iter().enumerate() {
             let (n, d) = shape_n::<N>(xi, eta);
-            let mut g1 = Vec3::zeros();
-            let mut g2 = Vec3::zeros();
-            for a in 0..N {
-                g1 += xv[a] * d[a][0];
-                g2 += xv[a] * d[a][1];
-            }
-            let n3 = g1.cross(&g2);
-            let area = n3.norm();
-            if !(area > 1e-14 * g1.norm() * g2.norm()) {
-                return Err(FemError::DegenerateElement {
-                    element: id,
-                    gauss_point: g,
-                });
-            }
-            let e1 = g1 / g1.norm();
-            let e3 = n3 / area;
-            let e2 = e3.cross(&e1);
-            let j = Matrix2::new(e1.dot(&g1), e1.dot(&g2), e2.dot(&g1), e2.dot(&g2));
-            let det = j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)];
-            let inv = Matrix2::new(
-                j[(1, 1)] / det,
-                -j[(0, 1)] / det,
-                -j[(1, 0)] / det,
-                j[(0, 0)] / det,
-            );
-            let mut dn = [[0.0; 2]; N];
-            for a in 0..N {
-                for i in 0..2 {
-                    dn[a][i] = d[a][0] * inv[(0, i)] + d[a][1] * inv[(1, i)];
-                }
-            }
-            gauss.push(GaussPoint {
-                n,
-                dn,
-                // the 2 × 2 rule's weights are 1: det * 1 is det, bit for bit
-                w: det * weight,
-                frame: [e1, e2],
-            });
+            let point = point_at(&xv, n, &d, weight).ok_or(FemError::DegenerateElement {
+                element: id,
+                gauss_point: g,
+            })?;
+            gauss.push(point);
+        }
+        // the nodes as points, each weighted by ∫N_a dA0 over the element (by its rule: the
+        // row sums of the consistent mass, all positive for both elements: 1/4 of the area
+        // each on a 4-node parallelogram, Simpson's 1/36, 4/36, 16/36 on a 9-node one)
+        let mut nodal = Vec::with_capacity(N);
+        for (a, &(xi, eta)) in node_coordinates::<N>().iter().enumerate() {
+            let (_, d) = shape_n::<N>(xi, eta);
+            let mut n = [0.0; N];
+            n[a] = 1.0;
+            let lumped: f64 = gauss.iter().map(|gp| gp.w * gp.n[a]).sum();
+            let mut point = point_at(&xv, n, &d, 1.0).ok_or(FemError::DegenerateNode {
+                element: id,
+                node: a,
+            })?;
+            point.w = lumped;
+            nodal.push(point);
         }
         Ok(Self {
             nodes,
             gauss: gauss.into_boxed_slice(),
+            nodal: nodal.into_boxed_slice(),
         })
     }
 
@@ -115,12 +191,7 @@ impl<const N: usize> RefElement<N> {
 
     /// x at Gauss point `g`.
     pub fn position(&self, g: usize, xe: &[Vec3; N]) -> Vec3 {
-        let n = &self.gauss[g].n;
-        let mut p = Vec3::zeros();
-        for a in 0..N {
-            p += xe[a] * n[a];
-        }
-        p
+        self.gauss[g].position(xe)
     }
 
     /// The in-plane deformation gradient columns f_1, f_2 at Gauss point `g`.

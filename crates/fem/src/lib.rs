@@ -57,6 +57,8 @@ pub enum FemError {
     Mesh(#[from] MeshError),
     #[error("element {element} is degenerate at Gauss point {gauss_point} of the reference configuration")]
     DegenerateElement { element: usize, gauss_point: usize },
+    #[error("element {element} is degenerate at its node {node} (of 0..N, in element order) in the reference configuration")]
+    DegenerateNode { element: usize, node: usize },
     #[error("element {element}, Gauss point {gauss_point}")]
     Material {
         element: usize,

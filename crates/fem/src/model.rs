@@ -171,7 +171,7 @@ impl Terms<'_> {
                 }
             })?;
         if let Some(c) = self.contact {
-            let lambda = c.element_history(self.multipliers, e, el.gauss.len());
+            let lambda = c.element_history(self.multipliers, e, c.samples(el).len());
             energy += c.kernel(el, xe, lambda, r, k);
         }
         Ok(energy)
@@ -602,14 +602,14 @@ impl Model {
         gap_tolerance: f64,
     ) -> (Vec<f64>, UpdateSize) {
         with_elements!(&self.elements, els => {
-            let per = contact.multipliers_per_element(els.first().map_or(0, |e| e.gauss.len()));
+            let per = contact.multipliers_per_element(els.first().map_or(0, |e| contact.samples(e).len()));
             let mut out = vec![0.0; per * els.len()];
             let size = out
                 .par_chunks_mut(per.max(1))
                 .zip(els.par_iter())
                 .enumerate()
                 .map(|(e, (o, el))| {
-                    let lambda = contact.element_history(&state.multipliers, e, el.gauss.len());
+                    let lambda = contact.element_history(&state.multipliers, e, contact.samples(el).len());
                     contact.update_multipliers(el, &el.gather(&state.x), lambda, gap_tolerance, o)
                 })
                 .reduce(UpdateSize::default, UpdateSize::max);
@@ -648,15 +648,12 @@ impl Model {
         };
         // a stage whose planes changed (or the first with multipliers) starts afresh; every
         // solve restarts the local penalties and keeps the multipliers
-        let gauss_points =
-            with_elements!(&self.elements, els => els.first().map_or(0, |e| e.gauss.len()));
-        let per = contact.multipliers_per_element(gauss_points);
+        let points = with_elements!(&self.elements, els => els.first().map_or(0, |e| contact.samples(e).len()));
+        let per = contact.multipliers_per_element(points);
         if state.multipliers.len() == per * self.elements.len() {
             contact.restart_history(&mut state.multipliers);
         } else {
-            state.multipliers = contact
-                .fresh_history(gauss_points)
-                .repeat(self.elements.len());
+            state.multipliers = contact.fresh_history(points).repeat(self.elements.len());
         }
         let mut report = once(self, state)?;
         let mut aug = Augmentation::default();
@@ -800,7 +797,7 @@ impl Model {
         let mut q = vec![0.0; self.n_eq()];
         for (e, el) in elements.iter().enumerate() {
             let mut qe = SVector::<f64, D>::zeros();
-            let lambda = contact.element_history(&state.multipliers, e, el.gauss.len());
+            let lambda = contact.element_history(&state.multipliers, e, contact.samples(el).len());
             contact.rate_kernel(el, &el.gather(&state.x), lambda, rates, &mut qe);
             for (i, v) in qe.iter().enumerate() {
                 if let Some(a) = self.dofs.eq(el.nodes[i / 3], i % 3) {

@@ -15,7 +15,7 @@
 //!        made horizontal) and a the axial direction in the tangent plane
 //! ϖ    = the reduced pressure,  volume = total enclosed volume (all symmetry copies)
 //! ```
-use crate::contact::Contact;
+use crate::contact::{Contact, ContactPoints};
 use crate::element::point_state_of;
 use crate::geometry::{RefElement, Vec3};
 use crate::model::{Elements, Model, State};
@@ -63,25 +63,41 @@ impl GaussSample {
 }
 
 fn samples_of<const N: usize>(
+    points: &[crate::geometry::GaussPoint<N>],
     el: &RefElement<N>,
     x0: &[[f64; 3]],
     x: &[[f64; 3]],
 ) -> Vec<GaussSample> {
     let (xe, xr) = (el.gather(x), el.gather(x0));
-    (0..el.gauss.len())
-        .map(|g| GaussSample {
-            w: el.gauss[g].w,
-            frame: el.gauss[g].frame,
-            x_ref: el.position(g, &xr),
-            x: el.position(g, &xe),
-            f: el.gradient(g, &xe),
+    points
+        .iter()
+        .map(|gp| GaussSample {
+            w: gp.w,
+            frame: gp.frame,
+            x_ref: gp.position(&xr),
+            x: gp.position(&xe),
+            f: gp.gradient(&xe),
         })
         .collect()
 }
 
 /// The Gauss points of element `e` at the nodal positions `x`.
 pub fn gauss_samples(model: &Model, e: usize, x: &[[f64; 3]]) -> Vec<GaussSample> {
-    with_elements!(model.elements(), els => samples_of(&els[e], &model.mesh().nodes, x))
+    with_elements!(model.elements(), els => samples_of(&els[e].gauss, &els[e], &model.mesh().nodes, x))
+}
+
+/// The points of element `e` where `contact` acts ([`Contact::samples`]: its Gauss points or
+/// its nodes) at the nodal positions `x`.
+pub fn contact_samples(
+    model: &Model,
+    e: usize,
+    x: &[[f64; 3]],
+    contact: &Contact,
+) -> Vec<GaussSample> {
+    with_elements!(model.elements(), els => {
+        let el = &els[e];
+        samples_of(contact.samples(el), el, &model.mesh().nodes, x)
+    })
 }
 
 /// The length of a chain of parabolic arcs through the points `p` (corner, mid-side, corner,
@@ -468,12 +484,18 @@ pub fn ring_profile(
             .map(|e| {
                 let samples = gauss_samples(model, e, &state.x);
                 let force = match (contact, top) {
-                    (Some(c), Some(top)) => element_contact_force(
-                        &samples,
-                        c,
-                        top,
-                        c.element_history(&state.multipliers, e, samples.len()),
-                    ),
+                    (Some(c), Some(top)) => {
+                        let points = match c.points {
+                            ContactPoints::Gauss => samples.clone(),
+                            ContactPoints::Nodal => contact_samples(model, e, &state.x, c),
+                        };
+                        element_contact_force(
+                            &points,
+                            c,
+                            top,
+                            c.element_history(&state.multipliers, e, points.len()),
+                        )
+                    }
                     _ => 0.0,
                 };
                 Ok((projected_resultants(model, e, &samples)?, force))
@@ -670,7 +692,7 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
             let forces: Vec<f64> = (0..model.elements().len())
                 .map(|e| {
                     let mut fe = 0.0;
-                    let samples = gauss_samples(model, e, &state.x);
+                    let samples = contact_samples(model, e, &state.x, contact);
                     let lambda = contact.element_history(&state.multipliers, e, samples.len());
                     for (g, sp) in samples.iter().enumerate() {
                         let gap = plane.gap(sp.x.into());
@@ -779,7 +801,7 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             .iter()
             .any(|i| on_ring.contains(i));
         let mut fe = 0.0;
-        let samples = gauss_samples(model, e, &state.x);
+        let samples = contact_samples(model, e, &state.x, contact);
         let lambda = contact.element_history(&state.multipliers, e, samples.len());
         for (g, sp) in samples.iter().enumerate() {
             let gp_gap = gap(sp.x.into());
@@ -823,7 +845,7 @@ pub fn cell_contact_pressure(model: &Model, state: &State, contact: Option<&Cont
             Some(c) => c.element_pressure(
                 el,
                 &el.gather(&state.x),
-                c.element_history(&state.multipliers, e, el.gauss.len()),
+                c.element_history(&state.multipliers, e, c.samples(el).len()),
             ),
             None => 0.0,
         })

@@ -149,6 +149,7 @@ fn element_on_tilted_plane(rng: &mut ChaCha8Rng) -> (RefElement<4>, [Vec3; 4], C
         }],
         penalty: 300.0,
         enforcement: Enforcement::Penalty,
+        points: Default::default(),
     };
     (re, x, contact)
 }
@@ -277,6 +278,7 @@ fn flat_membrane_pressed_on_a_plane() {
         }],
         penalty: kappa,
         enforcement: Enforcement::Penalty,
+        points: Default::default(),
     };
     let mut r = Vector12::zeros();
     let mut k = Matrix12::zeros();

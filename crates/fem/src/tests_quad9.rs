@@ -102,6 +102,7 @@ fn quad9_contact_tangent_matches_finite_differences() {
             }],
             penalty: 300.0,
             enforcement: crate::contact::Enforcement::Penalty,
+            points: Default::default(),
         };
         let eval = |x: &[Vec3; 9]| contact_eval::<9, 27>(&contact, &re, x, &[]);
         assert!(eval(&x).0 > 0.0, "the plane penetrates the element");

@@ -271,6 +271,26 @@ pub fn capped_tube_with_cap_rows_of(
     cap_rows: usize,
     symmetry: Symmetry,
 ) -> Result<Mesh, MeshError> {
+    capped_tube_fitted_of(
+        kind, radius, length, around, along, cap_rows, symmetry, None,
+    )
+}
+
+/// [`capped_tube_with_cap_rows_of`] with the cylinder's hoop spacing fitted by `fit` (see
+/// [`crate::hoop`]): its corner node lines moved by the map, the mid-side lines of a 9-node
+/// element at the mid-angle of its corners, blended back to uniform spacing towards the caps
+/// ([`crate::hoop::blend`]). `None`: uniform.
+#[allow(clippy::too_many_arguments)]
+pub fn capped_tube_fitted_of(
+    kind: ElementKind,
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    cap_rows: usize,
+    symmetry: Symmetry,
+    fit: Option<&crate::hoop::HoopMap>,
+) -> Result<Mesh, MeshError> {
     if cap_rows == 0 {
         return Err(MeshError::InvalidParameter {
             name: "cap_rows",
@@ -305,12 +325,49 @@ pub fn capped_tube_with_cap_rows_of(
         .map(|&(i, j)| unit([lattice(i, m), lattice(j, m), 0.0]))
         .collect();
     let np = per.len();
+    // the uniform angles of the ring's lattice points (θ_p = 2πp/np from the x axis) and, with
+    // a fit, their fitted angles: corner lines mapped, mid-side lines at their corners' mean
+    let fitted: Option<Vec<(f64, f64)>> = fit.map(|f| {
+        let theta = |p: usize| 2.0 * std::f64::consts::PI * p as f64 / np as f64;
+        (0..np)
+            .map(|p| {
+                let phi = if p % (np / 4) == 0 {
+                    // the lines x = 0 and y = 0 stay where the lattice has them
+                    theta(p)
+                } else if p % order == 0 {
+                    f.map(theta(p))
+                } else {
+                    let (a, b) = (theta(p - 1), theta(p + 1));
+                    let (fa, fb) = (f.map(a), f.map(b));
+                    // the map reduces angles to [0, 2π): keep the pair together across 0
+                    let fb = if fb < fa {
+                        fb + 2.0 * std::f64::consts::PI
+                    } else {
+                        fb
+                    };
+                    0.5 * (fa + fb)
+                };
+                (theta(p), phi)
+            })
+            .collect()
+    });
     let mut nodes = Vec::new();
     for l in 0..=lattice_along {
         let z = -0.5 * length + length * l as f64 / lattice_along as f64;
         let z = if 2 * l == lattice_along { 0.0 } else { z };
-        for d in &ring_dir {
-            nodes.push([radius * d[0], radius * d[1], z]);
+        let b = fitted
+            .as_ref()
+            .map_or(0.0, |_| crate::hoop::blend(z, 0.5 * length, radius));
+        for (p, d) in ring_dir.iter().enumerate() {
+            match fitted.as_ref().map(|f| f[p]) {
+                // moved: on the circle at the blended angle (lines that do not move, the
+                // symmetry lines among them, and rings where b = 0 keep the lattice's values)
+                Some((theta, phi)) if b > 0.0 && phi != theta => {
+                    let a = theta + b * (phi - theta);
+                    nodes.push([radius * a.cos(), radius * a.sin(), z]);
+                }
+                _ => nodes.push([radius * d[0], radius * d[1], z]),
+            }
         }
     }
     let mut cells: Vec<Vec<usize>> = Vec::new();
