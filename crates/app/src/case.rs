@@ -355,22 +355,23 @@ pub struct StageSpec {
     pub control: Option<ControlKind>,
     /// squeeze only: the final half-gap ρ = r/R between the plates
     pub target_rho: Option<f64>,
-    /// squeeze only: penetration (in R) at the gas pressure that sets the penalty κ = ϖ/tol
-    /// (default 1e-3), or the penalty itself
+    /// squeeze and confine: penetration (in R) at the gas pressure that sets the penalty
+    /// κ = ϖJ/tol (default 1e-3 for the penalty alone; 1e-6 as the augmented contact's
+    /// regularization), or the penalty itself
     pub penetration_tolerance: Option<f64>,
     pub penalty: Option<f64>,
-    /// squeeze and confine: how the planes are enforced, "penalty" (the default: the penalty
-    /// alone, the membrane sits about `penetration_tolerance` inside) or "augmented" (the
-    /// penalty with Uzawa multiplier updates until the gap is within `gap_tolerance`;
-    /// experimental, see the README's contact section)
+    /// squeeze and confine: how the planes are enforced, "augmented" (the default: the penalty
+    /// with Uzawa multiplier updates until the gap is within `gap_tolerance`) or "penalty" (the
+    /// penalty alone, the membrane sits about `penetration_tolerance` inside)
     pub contact_method: Option<ContactMethod>,
     /// augmented contact: the largest gap (in R) the multiplier updates leave where a plane
     /// pushes (default 1e-9)
     pub gap_tolerance: Option<f64>,
     /// augmented contact: the multiplier updates allowed in one step (default 50)
     pub max_augmentations: Option<usize>,
-    /// squeeze and confine: where the planes act on an element, "gauss" (its Gauss points, the
-    /// default) or "nodal" (its nodes, each weighted by its share of the element's area)
+    /// squeeze and confine: where the planes act on an element, "nodal" (its nodes, each
+    /// weighted by its share of the element's area; the default of the augmented contact) or
+    /// "gauss" (its Gauss points; the default of the penalty)
     pub contact_points: Option<tubemem_fem::contact::ContactPoints>,
     pub target_pressure: Option<f64>,
     pub target_stretch: Option<f64>,
@@ -489,26 +490,39 @@ pub struct StagePlan {
     pub follow_stable: bool,
 }
 
-/// The penetration tolerance (in R) that sets the penalty when a squeeze gives neither
-/// `penalty` nor `penetration_tolerance`: penalty converged below 1e-4 in the README's study.
+/// The penetration tolerance (in R) that sets the penalty of a `contact_method = "penalty"`
+/// stage that gives neither `penalty` nor `penetration_tolerance`: penalty converged below
+/// 1e-4 in the README's study.
 pub const DEFAULT_PENETRATION_TOLERANCE: f64 = 1e-3;
+
+/// The tolerance (in R) that sets the regularizing penalty κ = ϖJ/tol of an augmented contact
+/// (the default method) that gives neither `penalty` nor `penetration_tolerance`: 1e-6, where
+/// one multiplier update per step reaches the 1e-9 gap on the squeezes at λs* = 1.3 and 6.0,
+/// 16 to 128 around, both elements, with nodal contact points (README "Contact"); at 1e-3 the
+/// same runs take 7 to 10 updates a step.
+pub const DEFAULT_REGULARIZATION_TOLERANCE: f64 = 1e-6;
 
 impl StageSpec {
     /// Resolve the stage (`i` is 0-based).
     pub fn plan(&self, i: usize) -> Result<StagePlan, CaseError> {
         let target = self.target(i)?;
+        let augmented = self.contact_method != Some(ContactMethod::Penalty);
         let penalty = match (self.kind, self.penalty, self.penetration_tolerance) {
             (Kind::Squeeze | Kind::Confine, Some(k), _) => Some(PenaltySpec::Value(k)),
-            (Kind::Squeeze | Kind::Confine, None, t) => Some(PenaltySpec::Tolerance(
-                t.unwrap_or(DEFAULT_PENETRATION_TOLERANCE),
-            )),
+            (Kind::Squeeze | Kind::Confine, None, t) => {
+                Some(PenaltySpec::Tolerance(t.unwrap_or(if augmented {
+                    DEFAULT_REGULARIZATION_TOLERANCE
+                } else {
+                    DEFAULT_PENETRATION_TOLERANCE
+                })))
+            }
             _ => None,
         };
         let enforcement = match (self.kind, self.contact_method) {
-            (Kind::Squeeze | Kind::Confine, None | Some(ContactMethod::Penalty)) => {
+            (Kind::Squeeze | Kind::Confine, Some(ContactMethod::Penalty)) => {
                 Some(tubemem_fem::contact::Enforcement::Penalty)
             }
-            (Kind::Squeeze | Kind::Confine, Some(ContactMethod::Augmented)) => {
+            (Kind::Squeeze | Kind::Confine, None | Some(ContactMethod::Augmented)) => {
                 Some(tubemem_fem::contact::Enforcement::Augmented {
                     gap_tolerance: self
                         .gap_tolerance
@@ -526,7 +540,11 @@ impl StageSpec {
             steps: self.steps,
             penalty,
             enforcement,
-            contact_points: self.contact_points.unwrap_or_default(),
+            contact_points: self.contact_points.unwrap_or(if augmented {
+                tubemem_fem::contact::ContactPoints::Nodal
+            } else {
+                tubemem_fem::contact::ContactPoints::Gauss
+            }),
             arc_length: self.control == Some(ControlKind::ArcLength),
             follow_stable: self.branch == Some(BranchSpec::FollowStable),
         })
@@ -661,11 +679,11 @@ impl StageSpec {
                 i + 1
             );
         }
-        if self.contact_method != Some(ContactMethod::Augmented)
+        if self.contact_method == Some(ContactMethod::Penalty)
             && (self.gap_tolerance.is_some() || self.max_augmentations.is_some())
         {
             invalid!(
-                "[[stage]] {}: `gap_tolerance` and `max_augmentations` set the augmented contact: give `contact_method` = \"augmented\" (the default is \"penalty\")",
+                "[[stage]] {}: `gap_tolerance` and `max_augmentations` set the augmented contact, and this stage has `contact_method` = \"penalty\"",
                 i + 1
             );
         }

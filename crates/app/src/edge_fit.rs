@@ -1,49 +1,55 @@
 //! `[mesh] fit_contact_edge = true`: the generated tube's hoop node lines fitted to the
-//! closed form's contact edges at the case's contact target (see `tubemem_mesh::hoop`).
+//! contact edges of the case's last contact stage at its end (see `tubemem_mesh::hoop`).
 //!
-//! For plates y = ±ρR the GPS section's flat zone has the current width c = πχR on each plate,
+//! The edges are the GPS section's under the FE's own mid-span pressure at the stage's end,
+//! not the gas law's: the caps' gas changes that pressure by O(1/L), 1.4 % at L/R = 20, which
+//! moves the plates' edge by 0.036 of an element at 64 around, where the node line must lie
+//! within about 0.02 of one (the 9-node squeeze's χ error grows from 3e-6 to 1.7e-5). That
+//! pressure comes from a locating solve of the same case on a coarse uniform mesh
+//! ([`LOCATOR_AROUND`]).
+//!
+//! For plates y = ±ρR the section's flat zone has the current width c = πχR on each plate,
 //! centred on the plate's symmetry line x = 0; a material line at reference angle θ from it
-//! has the current arc length λs R θ, so the edge is at
+//! has the current arc length λs R θ, so the edges are at
 //! ```text
-//! θ_edge = c / (2 λs R) = π χ / (2 λs)   from x = 0,  i.e. at π/2 − θ_edge from the x axis
+//! θ_edge = c / (2 λs R) = π χ / (2 λs)   from x = 0 (and y = 0's mirror images)
 //! ```
-//! (λs, χ of the GPS flattening to the last squeeze stage's ρ after inflating to the inflate
-//! stage's λs*). The closed form's state differs from the FE's by the end effect, O(1/L), and
-//! the FE's edge by that much from the fitted line.
+//! For any walls symmetric about y = 0, `tubemem_gps::confine::contact_edges` walks the
+//! section's outline.
 
 use crate::case::{Case, CaseError, Target};
 use crate::{AppError, Result};
-use tubemem_gps::{flatten, section_at_pressure, Hypothesis};
+use std::f64::consts::{FRAC_PI_2, PI};
+use tubemem_gps::section_at_pressure;
 
-/// Where the fitted node line goes.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// Where the fitted node lines go.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Fit {
-    /// the contact edge's reference angle from the plates' symmetry line x = 0 (radians)
-    pub from_symmetry_line: f64,
-    /// the locating solve's mid-span pressure ϖ at the squeeze's end (`None`: the angle was
+    /// the contact edges' reference angles, from the x axis, in [0, 2π) (radians)
+    pub edges: Vec<f64>,
+    /// the locating solve's mid-span pressure ϖ at the stage's end (`None`: the angle was
     /// given as `contact_edge_angle`)
     pub pressure: Option<f64>,
     /// the locating solve's elements around
     pub locator_around: Option<usize>,
 }
 
-impl Fit {
-    /// The edges in the first quadrant, from the x axis (for `tubemem_mesh::hoop`).
-    pub fn edges(&self) -> Vec<f64> {
-        vec![std::f64::consts::FRAC_PI_2 - self.from_symmetry_line]
-    }
+/// The plates' four edges (from the x axis) at `a` from their symmetry line x = 0.
+fn plate_edges(a: f64) -> Vec<f64> {
+    vec![FRAC_PI_2 - a, FRAC_PI_2 + a, 1.5 * PI - a, 1.5 * PI + a]
 }
 
-/// Where the case's mesh is fitted to the contact edge of its last squeeze, or `None` without
-/// `fit_contact_edge` or `contact_edge_angle`. The edge is the GPS section's under the FE's
-/// own mid-span pressure at the squeeze's end (not the gas law's: the caps' gas changes that
-/// pressure by O(1/L), 1.4 % at L/R = 20, which moves the edge by 0.036 of an element at 64
-/// around, where the node line must lie within about 0.02 of one): that pressure comes from a
-/// locating solve of the same case on a coarse uniform mesh ([`LOCATOR_AROUND`]).
+/// The reference angle of the plates' contact edge from their symmetry line, π χ / (2 λs).
+pub fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
+    PI * chi / (2.0 * lambda_s)
+}
+
+/// Where the case's mesh is fitted to the contact edges of its last contact stage, or `None`
+/// without `fit_contact_edge` or `contact_edge_angle`.
 pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
     if let Some(a) = case.mesh.contact_edge_angle {
         return Ok(Some(Fit {
-            from_symmetry_line: a,
+            edges: plate_edges(a),
             pressure: None,
             locator_around: None,
         }));
@@ -63,69 +69,49 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
         .rposition(|p| matches!(p.target, Target::Rho(_) | Target::Confine(_)))
     else {
         return Err(CaseError::Invalid(
-            "[mesh] `fit_contact_edge` fits the mesh to a squeeze's contact edge: the case has no squeeze stage".into(),
+            "[mesh] `fit_contact_edge` fits the mesh to a contact edge: the case has no squeeze or confine stage".into(),
         )
         .into());
-    };
-    let Target::Rho(rho) = plan[k].target else {
-        return Err(CaseError::Invalid(format!(
-            "[mesh] `fit_contact_edge`: the last contact stage, [[stage]] {}, is a confine stage; only squeezes between plates are fitted so far",
-            k + 1
-        ))
-        .into());
-    };
-    // the stretch the squeeze starts from: the last inflation before it, by its target λs*
-    let start = plan[..k].iter().rev().find_map(|p| match p.target {
-        Target::Stretch(s) => Some(Ok(s)),
-        Target::Rho(_) | Target::Confine(_) => None,
-        _ => Some(Err(p.index)),
-    });
-    let initial_stretch = match start {
-        Some(Ok(s)) => s,
-        Some(Err(i)) => {
-            return Err(CaseError::Invalid(format!(
-                "[mesh] `fit_contact_edge`: the inflation before the squeeze, [[stage]] {i}, must give `target_stretch` (the closed form's edge is found from the stretch the squeeze starts at)"
-            ))
-            .into())
-        }
-        None => {
-            return Err(CaseError::Invalid(
-                "[mesh] `fit_contact_edge`: no inflate stage with `target_stretch` before the squeeze".into(),
-            )
-            .into())
-        }
     };
     let law = case.material.build()?;
-    let gps = flatten(law.as_ref(), Hypothesis::Gps, initial_stretch, rho).map_err(|e| {
-        AppError::gps(
-            format!(
-                "[mesh] `fit_contact_edge`: the closed form at [[stage]] {} (ρ = {rho})",
-                k + 1
-            ),
-            e,
+    let located = locate(case, k)?;
+    let w = located.w;
+    let context = |what: &str| {
+        format!(
+            "[mesh] `fit_contact_edge`: the {what} under the locating solve's pressure ϖ = {w} at the end of [[stage]] {}",
+            k + 1
         )
-    })?;
-    // the FE's mid-span pressure at the target, from the locating solve
-    let w = locate_pressure(case, k)?;
-    let section = section_at_pressure(law.as_ref(), rho, w, [gps.lambda_s, gps.lambda_z])
-        .map_err(|e| {
-            AppError::gps(
-                format!(
-                    "[mesh] `fit_contact_edge`: the section at the locating solve's pressure ϖ = {w} (ρ = {rho})"
-                ),
-                e,
+    };
+    let edges = match plan[k].target {
+        Target::Rho(rho) => {
+            let section =
+                section_at_pressure(law.as_ref(), rho, w, [located.lambda_s, located.lambda_z])
+                    .map_err(|e| AppError::gps(context("section between the plates"), e))?;
+            plate_edges(edge_angle(section.chi, section.lambda_s))
+        }
+        _ => {
+            let walls = case.stages[k]
+                .plane
+                .iter()
+                .map(|p| p.wall_at(1.0))
+                .collect::<std::result::Result<Vec<_>, _>>()
+                .map_err(|e| AppError::gps(context("walls"), e))?;
+            let state = tubemem_gps::confine::confine_at_pressure(
+                law.as_ref(),
+                tubemem_gps::Hypothesis::Gps,
+                &walls,
+                w,
             )
-        })?;
+            .map_err(|e| AppError::gps(context("section in the walls"), e))?;
+            tubemem_gps::confine::contact_edges(&walls, &state)
+                .map_err(|e| AppError::gps(context("section in the walls"), e))?
+        }
+    };
     Ok(Some(Fit {
-        from_symmetry_line: edge_angle(section.chi, section.lambda_s),
+        edges,
         pressure: Some(w),
         locator_around: Some(LOCATOR_AROUND.min(case.mesh.around.unwrap_or(LOCATOR_AROUND))),
     }))
-}
-
-/// The reference angle of the plates' contact edge from their symmetry line, π χ / (2 λs).
-pub fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
-    std::f64::consts::PI * chi / (2.0 * lambda_s)
 }
 
 /// Elements around of the locating solve: 16, where the 9-node element's mid-span pressure
@@ -134,10 +120,10 @@ pub fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
 /// 64 around.
 pub const LOCATOR_AROUND: usize = 16;
 
-/// The mid-span pressure at the end of stage `k` (0-based) of `case` solved on the coarse
+/// The mid-span state at the end of stage `k` (0-based) of `case` solved on the coarse
 /// uniform mesh of [`LOCATOR_AROUND`] elements around (fewer if the case has fewer), the same
 /// case otherwise, in memory.
-fn locate_pressure(case: &Case, k: usize) -> Result<f64> {
+fn locate(case: &Case, k: usize) -> Result<tubemem_fem::post::MidSpan> {
     let mut coarse = case.clone();
     let around = case.mesh.around.unwrap_or(LOCATOR_AROUND);
     let n = LOCATOR_AROUND.min(around);
@@ -158,7 +144,7 @@ fn locate_pressure(case: &Case, k: usize) -> Result<f64> {
     coarse.truncate_plan(k + 1);
     let outcome = crate::run::run(&coarse, "contact-edge locator", &mut []);
     let located = outcome.report.stages.get(k).and_then(|s| match &s.outcome {
-        crate::report::StageOutcome::Finished(f) => Some(f.final_state.midspan.w),
+        crate::report::StageOutcome::Finished(f) => Some(f.final_state.midspan),
         _ => None,
     });
     match (outcome.error, located) {

@@ -26,6 +26,9 @@ pub struct MeshInfo {
     /// floating-point operations of one numeric factorization
     #[serde(default)]
     pub factor_flops: f64,
+    /// where the hoop node line was fitted to the contact edge (`[mesh] fit_contact_edge`)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_edge_fit: Option<crate::edge_fit::Fit>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

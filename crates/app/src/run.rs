@@ -230,29 +230,39 @@ impl RunOutcome {
 
 /// Build the mesh a case asks for.
 pub fn build_mesh(case: &Case) -> Result<Mesh> {
+    build_mesh_with_fit(case).map(|(m, _)| m)
+}
+
+/// [`build_mesh`], with where its node line was fitted to the contact edge (`[mesh]
+/// fit_contact_edge`, [`crate::edge_fit`]).
+pub fn build_mesh_with_fit(case: &Case) -> Result<(Mesh, Option<crate::edge_fit::Fit>)> {
     let g = &case.geometry;
     let ll = g.length / g.radius;
     match (&case.mesh.file, case.mesh.around, case.mesh.along) {
         (Some(file), ..) => {
             let path = case.base_dir.join(file);
-            tubemem_mesh::io::read_json(&path, g.radius).map_err(|source| AppError::MeshFile {
-                file: file.clone(),
-                source,
-            })
+            tubemem_mesh::io::read_json(&path, g.radius)
+                .map(|m| (m, None))
+                .map_err(|source| AppError::MeshFile {
+                    file: file.clone(),
+                    source,
+                })
         }
         (None, Some(around), Some(along)) => {
             let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
             let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
-            let fit = match crate::edge_fit::contact_edges(case)? {
-                Some(f) => Some(HoopMap::fitted(around, &f.edges()).map_err(AppError::Mesh)?),
+            let fit = crate::edge_fit::contact_edges(case)?;
+            let map = match &fit {
+                Some(f) => Some(HoopMap::fitted(around, &f.edges).map_err(AppError::Mesh)?),
                 None => None,
             };
             match g.caps {
                 Caps::Hemisphere => {
-                    capped_tube_fitted_of(kind, 1.0, ll, around, along, cap_rows, sym, fit.as_ref())
+                    capped_tube_fitted_of(kind, 1.0, ll, around, along, cap_rows, sym, map.as_ref())
                 }
                 Caps::RigidPlug => plugged_tube_of(kind, 1.0, ll, around, along, sym),
             }
+            .map(|m| (m, fit))
             .map_err(AppError::Mesh)
         }
         _ => Err(crate::case::CaseError::Invalid(
@@ -852,6 +862,7 @@ pub fn run_with(
             element: String::new(),
             factor_nnz: 0,
             factor_flops: 0.0,
+            contact_edge_fit: None,
         },
         material: String::new(),
         material_spec: case.material,
@@ -886,7 +897,7 @@ fn run_inner(
     if let Some(n) = equations_estimate(case) {
         check_memory(n, options.force)?;
     }
-    let mesh = build_mesh(case)?;
+    let (mesh, contact_edge_fit) = build_mesh_with_fit(case)?;
     if case.mesh.file.is_some() {
         check_memory(3 * mesh.nodes.len(), options.force)?;
     }
@@ -919,6 +930,7 @@ fn run_inner(
             element: model.mesh().element().name().into(),
             factor_nnz: model.factor_nnz(),
             factor_flops: model.factor_flops(),
+            contact_edge_fit,
         },
         material: model.law().name(),
         material_spec: case.material,

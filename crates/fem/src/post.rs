@@ -768,9 +768,13 @@ pub struct ContactValues {
     /// plate force per unit current length at mid-span over πμH (the FE counterpart of ϖχ,
     /// eq. 80)
     pub force: f64,
-    /// mean contact pressure per current area at the Gauss points in contact next to Z = 0
-    /// (GPS: equal to ϖ in the flat zone)
+    /// mean contact pressure per current area on the flat zone next to Z = 0: at the contact
+    /// points of the elements next to the ring that are wholly in contact (at nodal points, not
+    /// at the flat zone's last nodes, which carry the edge's share) (GPS: equal to ϖ)
     pub contact_pressure: f64,
+    /// the largest |p_c/ϖ − 1| over those points (`None`: no element wholly in contact)
+    #[serde(default)]
+    pub flat_pressure_deviation: Option<f64>,
     /// largest penetration anywhere
     pub penetration: f64,
     /// total force on one plate (all symmetry copies), over μH R
@@ -790,10 +794,12 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
     let ring = Ring::midspan(model);
     let chi_geometric = contact_width(model, state, &ring, h);
     let on_ring = ring.contains_set();
-    let (mut pc_sum, mut pc_n) = (0.0, 0usize);
     let (mut total, mut penetration) = (0.0, 0.0_f64);
     let mut forces = vec![0.0; model.elements().len()];
     let mut touching = vec![];
+    // the elements next to the ring: their contact points' pressures per current area, and
+    // whether every point of the element is in contact
+    let mut points: Vec<(usize, Vec<f64>, bool)> = vec![];
     for e in 0..model.elements().len() {
         let touches = model
             .elements()
@@ -803,6 +809,7 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
         let mut fe = 0.0;
         let samples = contact_samples(model, e, &state.x, contact);
         let lambda = contact.element_history(&state.multipliers, e, samples.len());
+        let mut pressures = Vec::with_capacity(samples.len());
         for (g, sp) in samples.iter().enumerate() {
             let gp_gap = gap(sp.x.into());
             let t = contact.traction_at(gp_gap, contact.point(lambda, g, top));
@@ -811,16 +818,44 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             }
             if t > 0.0 {
                 fe += sp.w * t;
-                if touches {
-                    pc_sum += t / sp.area_ratio();
-                    pc_n += 1;
-                }
             }
+            pressures.push(t / sp.area_ratio());
         }
         total += fe;
         forces[e] = fe;
         if touches {
             touching.push(e);
+            let full = pressures.iter().all(|&p| p > 0.0);
+            points.push((e, pressures, full));
+        }
+    }
+    // the flat zone's interior: the points of elements wholly in contact, and at nodal points
+    // only nodes whose every element next to the ring is wholly in contact (the last node of
+    // the flat zone carries the edge's share, not a pressure)
+    let nodal = contact.points == ContactPoints::Nodal;
+    let mut edge_nodes = std::collections::HashSet::new();
+    if nodal {
+        for (e, _, full) in &points {
+            if !full {
+                edge_nodes.extend(model.elements().nodes(*e).iter().copied());
+            }
+        }
+    }
+    let (mut pc_sum, mut pc_n, mut deviation) = (0.0, 0usize, 0.0f64);
+    for (e, pressures, full) in &points {
+        if !full {
+            continue;
+        }
+        let nodes = model.elements().nodes(*e);
+        for (g, &pc) in pressures.iter().enumerate() {
+            if nodal && edge_nodes.contains(&nodes[g]) {
+                continue;
+            }
+            pc_sum += pc;
+            pc_n += 1;
+            if state.p > 0.0 {
+                deviation = deviation.max((pc / state.p - 1.0).abs());
+            }
         }
     }
     // force per unit length from the element rows next to the ring, side by side
@@ -831,6 +866,7 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
         chi_geometric,
         force,
         contact_pressure: if pc_n > 0 { pc_sum / pc_n as f64 } else { 0.0 },
+        flat_pressure_deviation: if pc_n > 0 { Some(deviation) } else { None },
         penetration,
         total_force: x_copies * z_copies * total,
     })

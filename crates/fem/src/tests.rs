@@ -903,3 +903,100 @@ fn a_bulge_is_moved_by_whole_rows_or_refused_with_the_reason() {
         }
     }
 }
+
+/// Nodal contact points ([`crate::contact::ContactPoints::Nodal`]): residual and tangent
+/// against central differences of the energy and residual, on the 4- and 9-node elements, with
+/// the penalty alone and augmented (random multipliers and local penalties at the nodes).
+#[test]
+fn nodal_contact_tangent_matches_finite_differences() {
+    use crate::contact::ContactPoints;
+    let mut rng = ChaCha8Rng::seed_from_u64(16);
+    let mut penetrating = 0;
+    for k in 0..20 {
+        let (re, x, contact) = element_on_tilted_plane(&mut rng);
+        let contact = contact.with_points(ContactPoints::Nodal);
+        let contact = if k % 2 == 0 {
+            contact
+        } else {
+            contact.with_enforcement(Enforcement::augmented())
+        };
+        let history: Vec<f64> = if k % 2 == 0 {
+            vec![]
+        } else {
+            (0..4)
+                .flat_map(|a| {
+                    let gap = contact.planes[0].gap(x[a].into());
+                    let kappa = 300.0 * rng.random_range(1.0..20.0);
+                    let s = rng.random_range(-0.05..0.3);
+                    [(kappa * (gap + s)).max(0.0), kappa, f64::NAN]
+                })
+                .collect()
+        };
+        let eval = |x: &[Vec3; 4]| contact_eval::<4, 12>(&contact, &re, x, &history);
+        let (_, r, _) = eval(&x);
+        penetrating += usize::from(r.iter().any(|v| *v != 0.0));
+        check_element_fd(&x, 1e-7, "nodal contact", eval);
+    }
+    assert!(penetrating >= 10, "the planes push at most of the states");
+}
+
+/// The nodal weights are ∫N_a dA0: on a flat parallelogram each 4-node weight is a quarter of
+/// the area, and on a flat 9-node rectangle they are Simpson's, 1/36, 4/36 and 16/36 of the
+/// area at the corners, the mid-sides and the centre; on any element they sum to its area (the
+/// Gauss rule's). A flat membrane lying δ inside a plane then carries the exact force κδA at
+/// nodal points too, along n only.
+#[test]
+fn nodal_weights_are_the_shape_function_integrals() {
+    use crate::contact::ContactPoints;
+    // a parallelogram in z = 0
+    let x4 = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.5, 0.0],
+        [2.6, 1.7, 0.0],
+        [0.6, 1.2, 0.0],
+    ];
+    let re = RefElement::new(0, [0, 1, 2, 3], &x4).unwrap();
+    let area = tubemem_mesh::quad_area(&x4);
+    for p in re.nodal.iter() {
+        assert!((p.w - 0.25 * area).abs() < 1e-14 * area);
+    }
+    // a 3 × 2 rectangle as a 9-node element (node order: corners, mid-sides, centre)
+    let (a, b) = (3.0, 2.0);
+    let xi = [
+        (-1.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+        (0.0, -1.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (-1.0, 0.0),
+        (0.0, 0.0),
+    ];
+    let x9 = xi.map(|(u, v)| [0.5 * a * u, 0.5 * b * v, 0.0]);
+    let re9 = RefElement::new(0, [0, 1, 2, 3, 4, 5, 6, 7, 8], &x9).unwrap();
+    let expect = [1.0, 1.0, 1.0, 1.0, 4.0, 4.0, 4.0, 4.0, 16.0].map(|s| s / 36.0 * a * b);
+    for (p, e) in re9.nodal.iter().zip(expect) {
+        assert!((p.w - e).abs() < 1e-14 * a * b, "{} vs {e}", p.w);
+    }
+    for p in re9.nodal.iter() {
+        assert!(p.n.iter().filter(|v| **v == 1.0).count() == 1);
+        assert!(p.n.iter().filter(|v| **v == 0.0).count() == 8);
+    }
+    // pressed δ into the plane z = 0 (normal +e_z, the membrane on z ≥ 0)
+    let (kappa, delta) = (250.0, 2e-3);
+    let contact = Contact {
+        planes: vec![Plane {
+            normal: [0.0, 0.0, 1.0],
+            offset: delta,
+        }],
+        penalty: kappa,
+        enforcement: Enforcement::Penalty,
+        points: ContactPoints::Nodal,
+    };
+    let mut r = SVector::<f64, 27>::zeros();
+    contact.kernel(&re9, &x9.map(Vec3::from), &[], &mut r, None);
+    let fz: f64 = -(0..9).map(|a| r[3 * a + 2]).sum::<f64>();
+    assert!((fz - kappa * delta * a * b).abs() < 1e-12 * kappa * delta * a * b);
+    assert!((0..9).all(|a| r[3 * a] == 0.0 && r[3 * a + 1] == 0.0));
+}

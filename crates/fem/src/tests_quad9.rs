@@ -107,6 +107,17 @@ fn quad9_contact_tangent_matches_finite_differences() {
         let eval = |x: &[Vec3; 9]| contact_eval::<9, 27>(&contact, &re, x, &[]);
         assert!(eval(&x).0 > 0.0, "the plane penetrates the element");
         check_element_fd(&x, 1e-7, "contact", eval);
+        // the same at the nodes (ContactPoints::Nodal); the offset keeps every node off the
+        // kink too (the centre node is 0.013 from the plane, the others at random gaps)
+        let nodal = contact
+            .clone()
+            .with_points(crate::contact::ContactPoints::Nodal);
+        let eval = |x: &[Vec3; 9]| contact_eval::<9, 27>(&nodal, &re, x, &[]);
+        assert!(
+            eval(&x).0 > 0.0,
+            "the plane penetrates the element at a node"
+        );
+        check_element_fd(&x, 1e-7, "nodal contact", eval);
     }
 }
 

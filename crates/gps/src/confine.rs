@@ -725,6 +725,63 @@ pub fn confine_at_pressure(
     Ok(cur)
 }
 
+/// The reference angles (in [0, 2π), from the x axis, per R = 1) of the ends of every flat
+/// contact of `state` in `walls`, for walls symmetric under y → −y (so that the material point
+/// on the positive x axis stays at the outline's point whose normal is e_x).
+///
+/// The outline Q ⊕ B(r) walked counterclockwise from that point: its support point at normal
+/// direction t moves along the arcs at the rate r and jumps along wall j's flat (length c_j)
+/// where t passes the wall's normal angle α_j, so the arc length to direction t is
+/// ```text
+/// S(t) = r t + Σ_{0 < α_j < t} c_j + c_0/2      (c_0: a flat centred on t = 0, if any)
+/// ```
+/// and a material line at reference angle θ sits at S = λs R θ (the stretch is uniform,
+/// L = 2πλs R = 2πr + Σ c_j). Wall j's flat spans θ ∈ [S(α_j), S(α_j) + c_j]/λs.
+pub fn contact_edges(walls: &[Wall], state: &ConfineState) -> Result<Vec<f64>, GpsError> {
+    let mirrored = walls.iter().all(|w| {
+        walls.iter().any(|v| {
+            (v.normal[0] - w.normal[0]).abs() < 1e-12
+                && (v.normal[1] + w.normal[1]).abs() < 1e-12
+                && (v.offset - w.offset).abs() < 1e-12 * (1.0 + w.offset.abs())
+        })
+    });
+    if !mirrored {
+        return Err(GpsError::Walls {
+            message: "the contact edges' reference angles need walls symmetric about the plane y = 0 (each wall's mirror image among them): otherwise the closed form leaves the section's rotation against the material free".into(),
+        });
+    }
+    let flats: Vec<(f64, f64)> = walls
+        .iter()
+        .zip(&state.walls)
+        .filter(|(_, c)| c.contact_length > 0.0)
+        .map(|(w, c)| {
+            let a = w.normal[1].atan2(w.normal[0]).rem_euclid(2.0 * PI);
+            // a wall whose normal is e_x to rounding
+            let a = if a.min(2.0 * PI - a) < 1e-12 { 0.0 } else { a };
+            (a, c.contact_length)
+        })
+        .collect();
+    let centred = flats.iter().find(|f| f.0 == 0.0).map_or(0.0, |f| 0.5 * f.1);
+    let mut edges = vec![];
+    for &(a, c) in &flats {
+        if a == 0.0 {
+            edges.push((-centred / state.lambda_s).rem_euclid(2.0 * PI));
+            edges.push(centred / state.lambda_s);
+            continue;
+        }
+        let before: f64 = flats
+            .iter()
+            .filter(|f| f.0 > 0.0 && f.0 < a)
+            .map(|f| f.1)
+            .sum();
+        let start = state.r * a + before + centred;
+        edges.push(start / state.lambda_s);
+        edges.push((start + c) / state.lambda_s);
+    }
+    edges.sort_by(f64::total_cmp);
+    Ok(edges)
+}
+
 /// The outline of the section P ⊕ B(r) of `state` in `walls` (offsets at the state's scale):
 /// `n` points of the support function, arcs at the corners and straight flats between them.
 pub fn section_outline(walls: &[Wall], state: &ConfineState, n: usize) -> Vec<[f64; 2]> {
@@ -1019,6 +1076,61 @@ mod tests {
         let g = inflate(&law, Hypothesis::Gps, low.lambda_s).unwrap();
         assert_eq!(low.regime, Regime::Free);
         assert!(0.3 < contact && rel(g.w, 0.3) < 1e-12);
+    }
+
+    /// The flats' reference angles ([`contact_edges`]) against independent geometry: between
+    /// plates, π/2 ± πχ/(2λs) and their mirror images with χ and λs from eq. 76's section
+    /// (`section_at_pressure`, its own solver); in the square channel the hand calculation's
+    /// flats 2(h − r) centred on the walls' normals, at (α_j r ± (h − r) + Σ of the flats
+    /// before)/λs; walls not symmetric about y = 0 are refused.
+    #[test]
+    fn contact_edges_match_the_section_geometry() {
+        let law = abb();
+        let (rho, w) = (1.1, 0.8);
+        let plates = [
+            Wall::new(0.0, 1.0, rho).unwrap(),
+            Wall::new(0.0, -1.0, rho).unwrap(),
+        ];
+        let c = confine_at_pressure(&law, Hypothesis::Gps, &plates, w).unwrap();
+        let f = crate::section_at_pressure(&law, rho, w, [c.lambda_s, c.lambda_z]).unwrap();
+        let a = PI * f.chi / (2.0 * f.lambda_s);
+        let expect = [PI / 2.0 - a, PI / 2.0 + a, 1.5 * PI - a, 1.5 * PI + a];
+        let edges = contact_edges(&plates, &c).unwrap();
+        assert_eq!(edges.len(), 4);
+        for (e, x) in edges.iter().zip(expect) {
+            assert!((e - x).abs() < 1e-9, "{edges:?} vs {expect:?}");
+        }
+        // the square channel: flats of 2(h − r) centred on 0, π/2, π, 3π/2
+        let h = 1.1;
+        let walls = [
+            Wall::new(1.0, 0.0, h).unwrap(),
+            Wall::new(-1.0, 0.0, h).unwrap(),
+            Wall::new(0.0, 1.0, h).unwrap(),
+            Wall::new(0.0, -1.0, h).unwrap(),
+        ];
+        let s = confine(&law, Hypothesis::Gps, &walls, 1.3).unwrap();
+        let half = (h - s.r) / s.lambda_s;
+        let quarter = (s.r * PI / 2.0 + 2.0 * (h - s.r)) / s.lambda_s;
+        assert!(
+            (quarter - PI / 2.0).abs() < 1e-9,
+            "a quarter of the outline is π/2"
+        );
+        let mut expect = vec![];
+        for q in 0..4 {
+            let centre = q as f64 * PI / 2.0;
+            expect.push((centre - half).rem_euclid(2.0 * PI));
+            expect.push(centre + half);
+        }
+        expect.sort_by(f64::total_cmp);
+        let edges = contact_edges(&walls, &s).unwrap();
+        for (e, x) in edges.iter().zip(&expect) {
+            assert!((e - x).abs() < 1e-9, "{edges:?} vs {expect:?}");
+        }
+        // the channel with its lower wall further out: not symmetric about y = 0
+        let mut lopsided = walls;
+        lopsided[3] = Wall::new(0.0, -1.0, 1.3).unwrap();
+        let s1 = confine_at_pressure(&law, Hypothesis::Gps, &lopsided, 0.8).unwrap();
+        assert!(contact_edges(&lopsided, &s1).is_err());
     }
 
     #[test]

@@ -4,50 +4,56 @@
 //! there, which limits the order of any element).
 //!
 //! ```text
-//! first quadrant θ ∈ [0, π/2]: φ piecewise linear through (0, 0), (θ_k, t_k), …, (π/2, π/2)
-//!   t_k a target angle, θ_k = the interior corner line nearest it (uniform spacing 2π/around)
-//! other quadrants by the reflections x → −x, y → −y:  φ(π − θ) = π − φ(θ), φ(−θ) = −φ(θ)
+//! φ piecewise linear through (0, 0), (θ_k, t_k), …, (π/2, π/2), …, (2π, 2π)
+//!   t_k a target angle, θ_k = 2πk/around the corner line nearest it (not on x = 0 or y = 0)
 //! along the tube:  θ ↦ θ + b(z) (φ(θ) − θ),  b = 1 for |z| ≤ z1, 0 for |z| ≥ z2 (C¹ between)
 //! ```
 //! Each element between two anchors is stretched by the same factor, at least 1 − 1/(2k) with
 //! k ≥ 1 the elements between the anchors, so no element shrinks below half its uniform width.
-//! The lines x = 0 and y = 0 stay put (they are symmetry planes), and so do the cylinder's end
-//! rings (b = 0 there), which the caps' equators share.
+//! The lines x = 0 and y = 0 stay put (they may be symmetry planes), and so do the cylinder's
+//! end rings (b = 0 there), which the caps' equators share. Targets symmetric under the
+//! model's reflections give a map with the same symmetry.
 
 use crate::MeshError;
-use std::f64::consts::FRAC_PI_2;
+use std::f64::consts::{FRAC_PI_2, PI};
 
-/// The hoop map of one quadrant: the anchors (θ, φ), sorted, from (0, 0) to (π/2, π/2).
+/// The hoop map: the anchors (θ, φ), sorted, from (0, 0) to (2π, 2π).
 #[derive(Clone, Debug, PartialEq)]
 pub struct HoopMap {
     anchors: Vec<(f64, f64)>,
 }
 
 impl HoopMap {
-    /// The map that moves, for each angle of `edges` (in (0, π/2), the first quadrant's
-    /// contact edges, mirrored to the other three), the nearest corner line of a tube with
-    /// `around` elements around onto it. Two edges that would move the same line, or an edge
-    /// not strictly inside the quadrant, are an error.
+    /// The map that moves, for each angle of `edges` (in [0, 2π), from the x axis), the
+    /// nearest corner line of a tube with `around` elements around onto it (the lines x = 0
+    /// and y = 0 excepted: an edge nearest one of those moves its neighbour). Two edges that
+    /// would move the same line are an error.
     pub fn fitted(around: usize, edges: &[f64]) -> Result<Self, MeshError> {
-        let per_quadrant = around / 4;
-        if per_quadrant < 2 {
+        let quarter = around / 4;
+        if quarter < 2 {
             return Err(MeshError::InvalidParameter {
                 name: "around",
                 value: around as f64,
                 requirement: "fitting a contact edge needs at least 8 elements around (a node line inside each quadrant)",
             });
         }
-        let h = FRAC_PI_2 / per_quadrant as f64;
-        let mut anchors = vec![(0.0, 0.0), (FRAC_PI_2, FRAC_PI_2)];
+        let h = 2.0 * PI / around as f64;
+        let mut anchors: Vec<(f64, f64)> = (0..=4)
+            .map(|q| (q as f64 * FRAC_PI_2, q as f64 * FRAC_PI_2))
+            .collect();
         for &t in edges {
-            if !(t > 0.0 && t < FRAC_PI_2) {
+            if !(t.is_finite() && (0.0..2.0 * PI).contains(&t)) {
                 return Err(MeshError::InvalidParameter {
                     name: "contact edge angle",
                     value: t,
-                    requirement: "must lie strictly between the symmetry lines, in (0, π/2)",
+                    requirement: "must be an angle in [0, 2π) from the x axis",
                 });
             }
-            let k = ((t / h).round() as usize).clamp(1, per_quadrant - 1);
+            let mut k = (t / h).round() as usize;
+            if k.is_multiple_of(quarter) {
+                // on x = 0 or y = 0: its neighbour towards the edge
+                k = if t >= k as f64 * h { k + 1 } else { k - 1 };
+            }
             let theta = k as f64 * h;
             if anchors.iter().any(|a| a.0 == theta) {
                 return Err(MeshError::InvalidParameter {
@@ -64,35 +70,22 @@ impl HoopMap {
             return Err(MeshError::InvalidParameter {
                 name: "contact edge angle",
                 value: f64::NAN,
-                requirement: "the fitted node lines must stay in their order around the tube",
+                requirement:
+                    "the fitted node lines must keep their order around the tube (refine `around`)",
             });
         }
         Ok(Self { anchors })
     }
 
-    /// φ(θ) in the first quadrant.
-    fn quadrant(&self, theta: f64) -> f64 {
+    /// φ(θ).
+    pub fn map(&self, theta: f64) -> f64 {
+        let t = theta.rem_euclid(2.0 * PI);
         let i = self
             .anchors
-            .partition_point(|a| a.0 <= theta)
+            .partition_point(|a| a.0 <= t)
             .clamp(1, self.anchors.len() - 1);
         let (a, b) = (self.anchors[i - 1], self.anchors[i]);
-        a.1 + (b.1 - a.1) * (theta - a.0) / (b.0 - a.0)
-    }
-
-    /// φ(θ) for any θ (mirrored across x = 0 and y = 0).
-    pub fn map(&self, theta: f64) -> f64 {
-        use std::f64::consts::PI;
-        let t = theta.rem_euclid(2.0 * PI);
-        if t <= FRAC_PI_2 {
-            self.quadrant(t)
-        } else if t <= PI {
-            PI - self.quadrant(PI - t)
-        } else if t <= 1.5 * PI {
-            PI + self.quadrant(t - PI)
-        } else {
-            2.0 * PI - self.quadrant(2.0 * PI - t)
-        }
+        a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0)
     }
 }
 

@@ -336,3 +336,85 @@ fn rings_of_a_capped_tube_are_its_cylinder_rows() {
         assert!(angles.windows(2).all(|w| w[1] > w[0]), "{angles:?}");
     }
 }
+
+/// The hoop fit (`hoop`): the node line nearest each target lands on it exactly; the symmetry
+/// lines, the end rings (shared with the caps) and the caps stay bit for bit as in the uniform
+/// mesh; every cylinder node stays on the circle; the 9-node mid-side lines sit at their
+/// corners' mean angle; no element shrinks below half its uniform width (the map's bound
+/// 1 − 1/(2k)); a target nearest a symmetry line moves its neighbour instead.
+#[test]
+fn a_fitted_hoop_puts_a_node_line_on_each_edge() {
+    use crate::hoop::HoopMap;
+    use crate::tube::{capped_tube_fitted_of, capped_tube_with_cap_rows_of};
+    use crate::ElementKind;
+    let (around, along, len) = (32, 40, 20.0);
+    let a = 0.5255; // from the plates' symmetry line, as the 9-node squeeze's edge
+    let edges = [PI / 2.0 - a, PI / 2.0 + a, 1.5 * PI - a, 1.5 * PI + a];
+    let map = HoopMap::fitted(around, &edges).unwrap();
+    let h = 2.0 * PI / around as f64;
+    for &t in &edges {
+        let k = (t / h).round();
+        assert_eq!(map.map(k * h), t, "the line nearest {t} lands on it");
+    }
+    for q in 0..4 {
+        assert_eq!(map.map(q as f64 * PI / 2.0), q as f64 * PI / 2.0);
+    }
+    let widths: Vec<f64> = (0..around)
+        .map(|k| map.map((k + 1) as f64 * h) - map.map(k as f64 * h))
+        .map(|w| if w < 0.0 { w + 2.0 * PI } else { w })
+        .collect();
+    assert!(
+        widths.iter().all(|&w| w > 0.5 * h && w < 1.5 * h),
+        "{widths:?}"
+    );
+    for kind in [ElementKind::Quad4, ElementKind::Quad9] {
+        let uniform =
+            capped_tube_with_cap_rows_of(kind, 1.0, len, around, along, 4, Symmetry::None).unwrap();
+        let fitted =
+            capped_tube_fitted_of(kind, 1.0, len, around, along, 4, Symmetry::None, Some(&map))
+                .unwrap();
+        assert_eq!(uniform.quads, fitted.quads);
+        assert_eq!(uniform.nodes.len(), fitted.nodes.len());
+        let mut on_edge = 0;
+        for (u, f) in uniform.nodes.iter().zip(&fitted.nodes) {
+            let z = u[2];
+            let on_symmetry_line = u[0] == 0.0 || u[1] == 0.0;
+            if z.abs() >= 0.5 * len - 1.0 || on_symmetry_line {
+                assert_eq!(u, f, "end rings, caps and symmetry lines stay");
+                continue;
+            }
+            assert_eq!(u[2], f[2]);
+            assert!((f[0].hypot(f[1]) - 1.0).abs() < 1e-15);
+            if z.abs() <= 0.5 * len - 2.0 {
+                let theta = f[1].atan2(f[0]).rem_euclid(2.0 * PI);
+                if edges.iter().any(|t| (theta - t).abs() < 1e-14) {
+                    on_edge += 1;
+                }
+            }
+        }
+        // every full-fit ring (|z| ≤ 8 of L/2 = 10) has the four edge lines
+        let rings = (0..=along * kind.gauss_per_direction().saturating_sub(1).max(1))
+            .map(|l| {
+                -0.5 * len + len * l as f64 / (along * (kind.gauss_per_direction() - 1)) as f64
+            })
+            .filter(|z| z.abs() <= 0.5 * len - 2.0 + 1e-12)
+            .count();
+        assert_eq!(on_edge, 4 * rings, "{kind:?}");
+        if kind == ElementKind::Quad9 {
+            // a mid-side node at its corners' mean angle (the ring at mid-span)
+            let mid: Vec<&[f64; 3]> = fitted.nodes.iter().filter(|p| p[2] == 0.0).collect();
+            let angle = |p: &[f64; 3]| p[1].atan2(p[0]).rem_euclid(2.0 * PI);
+            let mut ang: Vec<f64> = mid.iter().map(|p| angle(p)).collect();
+            ang.sort_by(f64::total_cmp);
+            for k in (1..ang.len() - 1).step_by(2) {
+                assert!((ang[k] - 0.5 * (ang[k - 1] + ang[k + 1])).abs() < 1e-14);
+            }
+        }
+    }
+    // a target nearest the line y = 0 moves its neighbour, and two targets on one line fail
+    let m = HoopMap::fitted(around, &[0.01]).unwrap();
+    assert_eq!(m.map(h), 0.01);
+    assert!(HoopMap::fitted(around, &[0.9 * h, 1.1 * h]).is_err());
+    assert!(HoopMap::fitted(4, &[0.3]).is_err());
+    assert!(HoopMap::fitted(around, &[f64::NAN]).is_err());
+}
