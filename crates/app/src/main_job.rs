@@ -1,5 +1,5 @@
 //! The main job (`tubemem` with no arguments, the README's first command): the paper's example
-//! end to end on the embedded default case `cases/squeeze_abb30_ls1.3.toml`.
+//! end to end on the embedded default case `cases/squeeze_abb30_ls1.3_quad9.toml`.
 //!
 //! 1. The closed form: limit points and Maxwell pressure of the GPS inflation curve.
 //! 2. The 3D FE run: the capped tube inflated to λs* = 1.3, the gas closed in, squeezed to
@@ -19,7 +19,7 @@ use tubemem_gps::{flatten, Hypothesis};
 use tubemem_material::laws::AnssariBenamBucchi;
 
 /// The embedded default case.
-pub const DEFAULT_CASE: &str = include_str!("../../../cases/squeeze_abb30_ls1.3.toml");
+pub const DEFAULT_CASE: &str = include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml");
 
 /// One squeeze step of the main job's table.
 pub struct SqueezeRow {
@@ -72,7 +72,7 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
     all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
     let report = run(
         &case,
-        "embedded default: cases/squeeze_abb30_ls1.3.toml",
+        "embedded default: cases/squeeze_abb30_ls1.3_quad9.toml",
         &mut all,
     )
     .into_result()?;
@@ -131,9 +131,9 @@ impl MainJob {
             "ρ", "ϖ FE", "ϖ GPS", "ϖ PS", "FE−GPS", "force FE", "GPS", "PS", "FE−GPS", "FE−GPS(ϖ)"
         );
         for r in &self.rows {
-            let local = r.local_force.map_or("n/a".to_string(), |l| {
-                format!("{:+.2}%", 100.0 * (r.force / l - 1.0))
-            });
+            let local = r
+                .local_force
+                .map_or("n/a".to_string(), |l| format!("{:+.1e}", r.force / l - 1.0));
             let _ = writeln!(
                 t,
                 "{:>7.4} {:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {:>9.5} {:>9.5} {:>9.5} {:>+7.2}% {:>10}",
@@ -151,7 +151,8 @@ impl MainJob {
         }
         let _ = writeln!(
             t,
-            "(FE−GPS(ϖ): the force against the GPS section under the FE's own pressure, eq. 76 without the gas law.\n \
+            "(FE−GPS(ϖ): the force's relative error against the GPS section under the FE's own pressure, eq. 76 without the gas law;\n \
+             the mesh is fitted to the last step's contact edge, so that step verifies at the element's order and the earlier ones at order 1.\n \
              The FE differs from GPS mostly by the end effect, which acts through the gas: the ends keep gas the plates do not squeeze; see the README)"
         );
         t

@@ -502,7 +502,7 @@ fn run_writes_steps_summary_profiles_and_vtu() {
          gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,\
          local_lambda_s,local_lambda_z,local_chi,local_force,\
          arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
-         augmentations,augmentation_iterations,contact_gap,multiplier_change"
+         augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation"
     );
     let empty_for_inflation = [
         "rho",
@@ -710,13 +710,15 @@ fn squeeze_stage_writes_contact_outputs() {
         steps.num(last, "local_force"),
         num(&st["gps_at_fe_pressure"], "force")
     );
-    // the GPS section under the FE's own pressure: at this 16-around mesh the measured errors
-    // are λs −1.9e-3, λz −1.7e-3, χ −7.6 % (coarse contact edge); bounds 5e-3 for the stretches
-    // (the fem crate measures 4.3e-3 at 16 around for L/R = 20, ρ = 0.8) and 15 % for χ
+    // the GPS section under the FE's own pressure: at this 16-around mesh, with the default
+    // contact (augmented, at the nodes), the measured errors are λs +5.9e-4, λz −2.4e-3,
+    // χ −14.4 % (the flat zone is about one element wide at ρ = 1.0, and the nodes resolve its
+    // edge only to an element; the Gauss-point penalty gives −7.6 %); bounds 5e-3 for the
+    // stretches (the fem crate measures 4.3e-3 at 16 around for L/R = 20, ρ = 0.8) and 20 % for χ
     let loc = &st["relative_error_vs_gps_at_fe_pressure"];
     assert!(num(loc, "lambda_s").abs() < 5e-3, "{loc}");
     assert!(num(loc, "lambda_z").abs() < 5e-3, "{loc}");
-    assert!(num(loc, "chi").abs() < 0.15, "{loc}");
+    assert!(num(loc, "chi").abs() < 0.2, "{loc}");
     assert_eq!(num(&st["gps_at_fe_pressure"], "w"), num(&st["final"], "w"));
     assert_eq!(st["kind"], "squeeze");
     let (fin, gps) = (&st["final"], &st["gps"]);
@@ -733,7 +735,8 @@ fn squeeze_stage_writes_contact_outputs() {
     let ew = num(fin, "w") / num(gps, "w") - 1.0;
     let ef = num(fin, "force") / num(gps, "force") - 1.0;
     assert!(ew.abs() < 0.03, "ϖ error {ew}");
-    assert!(ef < 0.0 && ef > -0.12, "force error {ef}");
+    // measured −13.4 %: the end effect at L/R = 8 and the χ error above
+    assert!(ef < 0.0 && ef > -0.2, "force error {ef}");
     assert!((num(fin, "displacement") - (num(fin, "initial_stretch") - 1.0)).abs() < 1e-12);
     assert!(
         num(&st["ps"], "force") > num(gps, "force"),
@@ -1122,20 +1125,38 @@ fn an_interrupted_run_says_so_and_keeps_its_steps() {
 #[test]
 fn nonsense_is_refused_and_small_targets_work() {
     let d = tmp("nonsense");
-    for (extra, rho) in [("penalty = 1e-300\n", "1.0"), ("", "1e-9")] {
-        let case = d.join(format!("sq{rho}.toml"));
+    for (k, (extra, rho, expect)) in [
+        (
+            "penalty = 1e-300\ncontact_method = \"penalty\"\n",
+            "1.0",
+            &["penetrate", "plate half-gap"][..],
+        ),
+        (
+            "contact_method = \"penalty\"\n",
+            "1e-9",
+            &["penetrate", "plate half-gap"],
+        ),
+        // the augmented contact (the default) with that penalty: its updates cannot move the
+        // multipliers, and the error says so
+        (
+            "penalty = 1e-300\n",
+            "1.0",
+            &["did not settle", "penalty κ = 1.000e-300"],
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let case = d.join(format!("sq{k}.toml"));
         std::fs::write(
             &case,
             format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = {rho}\n{extra}"),
         )
         .unwrap();
-        let o = run_in(&case, &d.join(format!("o{rho}")), &[]);
+        let o = run_in(&case, &d.join(format!("o{k}")), &[]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{err}");
-        assert!(
-            err.contains("penetrate") && err.contains("plate half-gap"),
-            "{err}"
-        );
+        assert!(expect.iter().all(|e| err.contains(e)), "{err}");
     }
     for (k, (from, to)) in [
         ("target_stretch = 1.2", "target_stretch = 1.00001"),

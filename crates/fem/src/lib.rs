@@ -127,11 +127,14 @@ pub enum FemError {
         source: Option<Box<newton::NewtonError<FemError>>>,
     },
     /// The augmented Lagrangian's multipliers did not settle within their update limit.
-    #[error("the contact multipliers did not settle: after {updates} augmentations a plane still pushes where the gap is {gap:.3e} R, above the gap tolerance {tolerance:.1e} R (raise `max_augmentations` or `gap_tolerance`)")]
+    #[error("the contact multipliers did not settle: after {updates} augmentations a plane still pushes where the gap is {gap:.3e} R (penetration {penetration:.3e} R), above the gap tolerance {tolerance:.1e} R; the last update moved a multiplier by {change:.3e}, and the regularizing penalty κ = {penalty:.3e} sets how far an update moves one (raise `max_augmentations` or `gap_tolerance`, or give a larger `penalty` or a smaller `penetration_tolerance`)")]
     Augmentation {
         updates: usize,
         gap: f64,
+        penetration: f64,
+        change: f64,
         tolerance: f64,
+        penalty: f64,
     },
     /// A bulge could not be moved along the tube ([`slide`]).
     #[error("cannot move the bulge: {what}")]

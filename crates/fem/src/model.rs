@@ -679,7 +679,10 @@ impl Model {
                     source: FemError::Augmentation {
                         updates: aug.updates,
                         gap: size.gap,
+                        penetration: size.penetration,
+                        change: size.change,
                         tolerance: gap_tolerance,
+                        penalty: contact.penalty,
                     },
                 });
             }

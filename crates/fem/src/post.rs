@@ -768,11 +768,12 @@ pub struct ContactValues {
     /// plate force per unit current length at mid-span over πμH (the FE counterpart of ϖχ,
     /// eq. 80)
     pub force: f64,
-    /// mean contact pressure per current area on the flat zone next to Z = 0: at the contact
-    /// points of the elements next to the ring that are wholly in contact (at nodal points, not
-    /// at the flat zone's last nodes, which carry the edge's share) (GPS: equal to ϖ)
+    /// mean contact pressure per current area at the contact points in contact of the elements
+    /// next to Z = 0 (`Contact::point_pressures`; GPS: equal to ϖ in the flat zone)
     pub contact_pressure: f64,
-    /// the largest |p_c/ϖ − 1| over those points (`None`: no element wholly in contact)
+    /// the largest |p_c/ϖ − 1| over the flat zone's interior next to Z = 0: the contact points
+    /// of the elements there that are wholly in contact, at nodal points without the flat
+    /// zone's last nodes, which carry the edge's share (`None`: no element wholly in contact)
     #[serde(default)]
     pub flat_pressure_deviation: Option<f64>,
     /// largest penetration anywhere
@@ -809,7 +810,6 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
         let mut fe = 0.0;
         let samples = contact_samples(model, e, &state.x, contact);
         let lambda = contact.element_history(&state.multipliers, e, samples.len());
-        let mut pressures = Vec::with_capacity(samples.len());
         for (g, sp) in samples.iter().enumerate() {
             let gp_gap = gap(sp.x.into());
             let t = contact.traction_at(gp_gap, contact.point(lambda, g, top));
@@ -819,8 +819,15 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             if t > 0.0 {
                 fe += sp.w * t;
             }
-            pressures.push(t / sp.area_ratio());
         }
+        let pressures = if touches {
+            with_elements!(model.elements(), els => {
+                let el = &els[e];
+                contact.point_pressures(el, &el.gather(&state.x), lambda, top)
+            })
+        } else {
+            vec![]
+        };
         total += fe;
         forces[e] = fe;
         if touches {
@@ -831,7 +838,8 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
     }
     // the flat zone's interior: the points of elements wholly in contact, and at nodal points
     // only nodes whose every element next to the ring is wholly in contact (the last node of
-    // the flat zone carries the edge's share, not a pressure)
+    // the flat zone carries the edge's share, not a pressure); pressures per current area as
+    // `Contact::point_pressures` (at a node: its force over its share of the current area)
     let nodal = contact.points == ContactPoints::Nodal;
     let mut edge_nodes = std::collections::HashSet::new();
     if nodal {
@@ -841,18 +849,19 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
             }
         }
     }
-    let (mut pc_sum, mut pc_n, mut deviation) = (0.0, 0usize, 0.0f64);
+    let (mut pc_sum, mut pc_n) = (0.0, 0usize);
+    let (mut deviation, mut flat_points) = (0.0f64, 0usize);
     for (e, pressures, full) in &points {
-        if !full {
-            continue;
-        }
         let nodes = model.elements().nodes(*e);
         for (g, &pc) in pressures.iter().enumerate() {
-            if nodal && edge_nodes.contains(&nodes[g]) {
+            if pc > 0.0 {
+                pc_sum += pc;
+                pc_n += 1;
+            }
+            if !full || (nodal && edge_nodes.contains(&nodes[g])) {
                 continue;
             }
-            pc_sum += pc;
-            pc_n += 1;
+            flat_points += 1;
             if state.p > 0.0 {
                 deviation = deviation.max((pc / state.p - 1.0).abs());
             }
@@ -866,7 +875,11 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
         chi_geometric,
         force,
         contact_pressure: if pc_n > 0 { pc_sum / pc_n as f64 } else { 0.0 },
-        flat_pressure_deviation: if pc_n > 0 { Some(deviation) } else { None },
+        flat_pressure_deviation: if flat_points > 0 {
+            Some(deviation)
+        } else {
+            None
+        },
         penetration,
         total_force: x_copies * z_copies * total,
     })

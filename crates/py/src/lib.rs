@@ -564,7 +564,7 @@ fn run_case_text<'py>(
     to_py(py, &report.summary())
 }
 
-/// The embedded default case (`cases/squeeze_abb30_ls1.3.toml`, the main job's) as TOML text.
+/// The embedded default case (`cases/squeeze_abb30_ls1.3_quad9.toml`, the main job's) as TOML text.
 #[pyfunction]
 fn default_case() -> &'static str {
     tubemem_app::main_job::DEFAULT_CASE

@@ -400,6 +400,10 @@ pub fn step_pair(s: &StepRecord, q: &str) -> Option<(f64, f64)> {
             "local_lambda_s" => cf.local_confine.as_ref().map(|l| (m.lambda_s, l.lambda_s)),
             "local_lambda_z" => cf.local_confine.as_ref().map(|l| (m.lambda_z, l.lambda_z)),
             "local_wall_force" => cf.local_confine.as_ref().and_then(worst_wall),
+            "penetration" => Some((
+                1.0 + s.walls.iter().map(|w| w.penetration).fold(0.0, f64::max),
+                1.0,
+            )),
             _ => None,
         };
     }
@@ -414,6 +418,12 @@ pub fn step_pair(s: &StepRecord, q: &str) -> Option<(f64, f64)> {
         };
     }
     let c = s.contact.as_ref()?;
+    // deviations, compared as they are: (1 + d, 1) gives FE/GPS − 1 = d
+    match q {
+        "flat_pressure" => return c.values.flat_pressure_deviation.map(|d| (1.0 + d, 1.0)),
+        "penetration" => return Some((1.0 + c.values.penetration, 1.0)),
+        _ => {}
+    }
     if let Some(local) = q.strip_prefix("local_") {
         let l = cf.local.as_ref()?.as_ref().ok()?;
         return match local {
@@ -526,7 +536,11 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                 // the closed form is a uniform tube: not compared where the run found the tube
                 // not uniform (a bulge), or a squeeze that started from such a tube
                 _ if s.gps_applicable == Some(false) => None,
-                _ => step_pair(s, q),
+                _ => match q.strip_prefix("final_") {
+                    Some(inner) if i + 1 == steps.len() => step_pair(s, inner),
+                    Some(_) => None,
+                    None => step_pair(s, q),
+                },
             };
             if let Some((fe, cf)) = pair {
                 let e = rel(fe, cf);

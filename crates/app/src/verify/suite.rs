@@ -162,6 +162,17 @@ pub const CLOSED_FORM_QUANTITIES: &[&str] = &[
     "maxwell_lambda_s",
     "wall_force",
     "local_wall_force",
+    // the flat zone's contact pressure, max |p_c/ϖ − 1| at mid-span, and the largest
+    // penetration (in R): deviations, compared as they are
+    "flat_pressure",
+    "penetration",
+    // the run's last step only (a mesh fitted to the contact edge at the end verifies there)
+    "final_local_lambda_s",
+    "final_local_lambda_z",
+    "final_local_chi",
+    "final_local_force",
+    "final_local_wall_force",
+    "final_flat_pressure",
 ];
 /// The quantities of a reference check (FE against scikit-fem).
 pub const REFERENCE_QUANTITIES: &[&str] = &[
