@@ -800,6 +800,26 @@ impl Case {
             (None, Some(_), Some(_)) => {}
             (None, ..) => invalid!("[mesh] needs `around` and `along` (a generated tube) or `file` (a user mesh)"),
         }
+        if (m.fit_contact_edge || m.contact_edge_angle.is_some()) && m.file.is_some() {
+            invalid!(
+                "[mesh] `fit_contact_edge` and `contact_edge_angle` fit the generated tube's node lines; a user mesh (`file`) places its own"
+            );
+        }
+        if (m.fit_contact_edge || m.contact_edge_angle.is_some())
+            && self.geometry.caps != Caps::Hemisphere
+        {
+            invalid!(
+                "[mesh] `fit_contact_edge` and `contact_edge_angle` fit the capped tube (caps = \"hemisphere\"); the plugged tube is not fitted"
+            );
+        }
+        if let Some(a) = m.contact_edge_angle {
+            if !(a.is_finite() && a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
+                invalid!(
+                    "[mesh] `contact_edge_angle` = {}: must be in (0, π/2), radians from the plates' symmetry line x = 0",
+                    tubemem_material::Num(a)
+                );
+            }
+        }
         if self.stages.is_empty() {
             invalid!("the case has no [[stage]]");
         }
@@ -824,6 +844,15 @@ impl Case {
         }
         if self.output.vtu_every == 0 {
             invalid!("[output] `vtu_every` must be ≥ 1");
+        }
+        if self.mesh.fit_contact_edge
+            && !plan
+                .iter()
+                .any(|p| matches!(p.target, Target::Rho(_) | Target::Confine(_)))
+        {
+            invalid!(
+                "[mesh] `fit_contact_edge` fits the mesh to a contact edge: the case has no squeeze or confine stage"
+            );
         }
         Ok(plan)
     }

@@ -47,6 +47,15 @@ pub fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
 /// Where the case's mesh is fitted to the contact edges of its last contact stage, or `None`
 /// without `fit_contact_edge` or `contact_edge_angle`.
 pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
+    if !case.mesh.fit_contact_edge && case.mesh.contact_edge_angle.is_none() {
+        return Ok(None);
+    }
+    if case.mesh.file.is_some() || case.geometry.caps != crate::case::Caps::Hemisphere {
+        return Err(CaseError::Invalid(
+            "[mesh] `fit_contact_edge` fits the generated capped tube (caps = \"hemisphere\"); a user mesh places its own node lines (see the README's contact section)".into(),
+        )
+        .into());
+    }
     if let Some(a) = case.mesh.contact_edge_angle {
         return Ok(Some(Fit {
             edges: plate_edges(a),
@@ -56,12 +65,6 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
     }
     if !case.mesh.fit_contact_edge {
         return Ok(None);
-    }
-    if case.mesh.file.is_some() || case.geometry.caps != crate::case::Caps::Hemisphere {
-        return Err(CaseError::Invalid(
-            "[mesh] `fit_contact_edge` fits the generated capped tube (caps = \"hemisphere\"); a user mesh places its own node lines (see the README's contact section)".into(),
-        )
-        .into());
     }
     let plan = case.plan();
     let Some(k) = plan

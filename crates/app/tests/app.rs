@@ -830,18 +830,31 @@ fn a_squeeze_on_a_mesh_fitted_to_its_contact_edge_converges_fast() {
     );
 }
 
-/// `fit_contact_edge` refuses what it cannot fit, naming the key: a user mesh, a case without
-/// a contact stage; `contact_points` belongs to contact stages.
+/// `fit_contact_edge` refuses what it cannot fit, naming the key: a case without a contact
+/// stage, an edge angle outside the quadrant; `contact_points` belongs to contact stages.
 #[test]
 fn an_edge_fit_it_cannot_make_is_a_clear_error() {
+    // refused by validation, before anything is written
     let no_contact = SMALL.replace("[mesh]", "[mesh]\nfit_contact_edge = true");
-    let case = Case::parse(&no_contact).unwrap();
-    let e = run(&case, "x", &mut []).into_result().unwrap_err();
-    let msg = e.chain();
+    let msg = Case::parse(&no_contact).unwrap_err().to_string();
     assert!(
         msg.contains("fit_contact_edge") && msg.contains("no squeeze or confine"),
         "{msg}"
     );
+    let plugs = format!("{SMALL}{SQUEEZE}")
+        .replace("[mesh]", "[mesh]\nfit_contact_edge = true")
+        .replace("[geometry]", "[geometry]\ncaps = \"rigid-plug\"");
+    let msg = Case::parse(&plugs).unwrap_err().to_string();
+    assert!(msg.contains("plugged tube is not fitted"), "{msg}");
+    for key in ["contact_edge_angle = 2.0", "contact_edge_angle = -0.1"] {
+        let e = Case::parse(&SMALL.replace("[mesh]", &format!("[mesh]\n{key}")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("contact_edge_angle") && e.contains("must be in (0, π/2)"),
+            "{e}"
+        );
+    }
     let points = SMALL.replace(
         "kind = \"inflate\"",
         "kind = \"inflate\"\ncontact_points = \"nodal\"",

@@ -1277,6 +1277,45 @@ fn a_killed_run_resumes_bit_identical() {
     }
 }
 
+/// Restart of a run on a mesh fitted to its contact edge (`fit_contact_edge`, the main job's
+/// 9-node case): the resumed run rebuilds the same mesh from its locating solve
+/// (deterministic), takes the augmented contact's multipliers from the checkpoint, and ends
+/// bit-identical to an uninterrupted run (steps.csv, summary.json with its `contact_edge_fit`).
+#[test]
+fn a_killed_fitted_run_resumes_bit_identical() {
+    let d = tmp("resume-fitted");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml").to_string()
+            + "\n[output]\nvtu = \"none\"\n",
+    )
+    .unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    assert!(run_in(&case, &reference, &[]).status.success());
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
+    });
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["steps.csv", "summary.json"] {
+        assert!(
+            std::fs::read(reference.join(f)).unwrap() == std::fs::read(killed.join(f)).unwrap(),
+            "{f} differs after the restart"
+        );
+    }
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        s["mesh"]["contact_edge_fit"]["edges"]
+            .as_array()
+            .unwrap()
+            .len(),
+        4
+    );
+}
+
 /// Restart of an arc-length stage: the bulge case killed (SIGKILL) after its tenth step, past
 /// the located pressure maximum, and resumed. The continuation starts afresh from the
 /// checkpointed state (its step lengths differ), so the steps are not bit-identical; what must
