@@ -815,6 +815,30 @@ pub fn fe_moving_planes(planes: &[crate::case::PlaneSpec], penalty: f64) -> Movi
     }
 }
 
+/// Whether some confine stage of `case` has planes that are not symmetric about x = 0
+/// (`[0]`) or y = 0 (`[1]`): such planes push the tube sideways, which the rigid-mode pins on
+/// the axis x = y = 0 (the caps' poles) must not resist (`Model::soften_rigid_pins`).
+pub fn sideways_planes(case: &Case) -> [bool; 2] {
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
+    let mut out = [false, false];
+    for stage in &case.stages {
+        for (axis, flag) in out.iter_mut().enumerate() {
+            let mirrored = stage.plane.iter().all(|p| {
+                let mut m = p.normal;
+                m[axis] = -m[axis];
+                stage.plane.iter().any(|q| {
+                    close(q.normal[0], m[0])
+                        && close(q.normal[1], m[1])
+                        && close(q.offset, p.offset)
+                        && close(q.target, p.target)
+                })
+            });
+            *flag |= !mirrored;
+        }
+    }
+    out
+}
+
 /// The FE contact of a confine stage at load parameter `t`: each wall n·x ≤ d as the kernel's
 /// plane with gap −n·x + d ≥ 0 (unit normal, in the cross-section plane).
 pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Contact {
@@ -909,6 +933,14 @@ fn run_inner(
     let gps_limits =
         tubemem_gps::limits::limit_points(closed_form_law.as_ref(), Hypothesis::Gps).ok();
     let mut model = Model::new(mesh, law).map_err(AppError::Model)?;
+    // planes that move the tube sideways: the rigid-mode pins on the axis would hold the caps'
+    // poles against them, so springs hold those modes instead
+    let soft = sideways_planes(case);
+    if soft.iter().any(|s| *s) {
+        model
+            .soften_rigid_pins(soft, tubemem_fem::dofs::SOFT_PIN_STIFFNESS)
+            .map_err(AppError::Model)?;
+    }
     model.set_interrupt(options.interrupt.clone());
     model.set_settings(NewtonSettings {
         rtol: case.solver.rtol,

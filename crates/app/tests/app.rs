@@ -865,3 +865,17 @@ fn an_edge_fit_it_cannot_make_is_a_clear_error() {
         "{e}"
     );
 }
+
+/// Which stages push the tube sideways (`run::sideways_planes`): the V-groove's walls are not
+/// symmetric about x = 0 (so the rigid x translation is held by a spring, not by pinning the
+/// caps' poles), the channel's and the plates' are symmetric about both planes.
+#[test]
+fn sideways_planes_are_found_from_the_case() {
+    use tubemem_app::run::sideways_planes;
+    let groove = Case::parse(include_str!("../../../cases/vgroove_abb30_ls1.3.toml")).unwrap();
+    let channel = Case::parse(include_str!("../../../cases/channel_abb30_ls1.3.toml")).unwrap();
+    let plates = Case::parse(include_str!("../../../cases/squeeze_abb30_ls1.3.toml")).unwrap();
+    assert_eq!(sideways_planes(&groove), [true, false]);
+    assert_eq!(sideways_planes(&channel), [false, false]);
+    assert_eq!(sideways_planes(&plates), [false, false]);
+}

@@ -5,10 +5,34 @@
 //! * Rigid-body modes left by the symmetry are pinned on nodes whose motion the symmetry of the
 //!   problem already forbids (so the pins carry no load): u_x = u_y = 0 on the axis x = y = 0,
 //!   u_x = 0 at the node of largest y on the line x = z = 0, u_z = 0 at one node on z = 0.
+//!   Where the problem does not forbid that motion (planes not symmetric about x = 0 or y = 0,
+//!   such as a V-groove, move the tube sideways), [`DofMap::with_soft_pins`] leaves those
+//!   components free and lists them as [`SoftPin`]s, held by a spring (of stiffness
+//!   [`SOFT_PIN_STIFFNESS`] in runs) to their reference position instead (the model assembles
+//!   it): the
+//!   rigid mode stays removed while nothing else holds it, and the spring's force, κ_s times
+//!   the translation, is negligible once the planes do.
 //! * Rigid plugs: the ring nodes keep x and y (tied to the disc) and share one axial equation,
 //!   the disc's translation.
 
 use tubemem_mesh::Mesh;
+
+/// The stiffness (per μH/R², a spring per node) of a soft rigid-mode pin: 1e-8, so that a
+/// translation of 0.1 R costs a force of 1e-9 μH, far below the Newton tolerance on forces of
+/// order μH, while the tangent keeps a positive pivot of that size (the factorization's pivots
+/// reach 1e2: a condition number of about 1e10, within double precision).
+pub const SOFT_PIN_STIFFNESS: f64 = 1e-8;
+
+/// A rigid-mode pin turned into a spring: node `node`'s component `component` (equation `eq`)
+/// is held to its reference position by a spring of stiffness `stiffness`
+/// ([`SOFT_PIN_STIFFNESS`] in runs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftPin {
+    pub node: usize,
+    pub component: usize,
+    pub eq: usize,
+    pub stiffness: f64,
+}
 
 /// The equation number of every dof (3 per node) and of every plug's axial translation.
 #[derive(Clone, Debug)]
@@ -16,13 +40,23 @@ pub struct DofMap {
     eq: Vec<Option<usize>>,
     n_eq: usize,
     plug_eq: Vec<Option<usize>>,
+    soft: Vec<SoftPin>,
 }
 
 impl DofMap {
     /// Number the dofs of a checked mesh.
     pub fn new(mesh: &Mesh) -> Self {
+        Self::with_soft_pins(mesh, [false, false], SOFT_PIN_STIFFNESS)
+    }
+
+    /// [`DofMap::new`] with the rigid-mode pins of component x (`soft[0]`) and y (`soft[1]`)
+    /// made springs of stiffness `stiffness` ([`SoftPin`]); symmetry-plane conditions stay
+    /// fixed.
+    pub fn with_soft_pins(mesh: &Mesh, soft: [bool; 2], stiffness: f64) -> Self {
         let nn = mesh.nodes.len();
         let mut fixed = vec![false; 3 * nn];
+        // the rigid-mode pins, which `soft` may make springs
+        let mut pinned = vec![false; 3 * nn];
         let on: Vec<Vec<bool>> = (0..3).map(|ax| mesh.on_plane(ax)).collect();
         let planes = mesh.symmetry.planes();
         for &ax in planes {
@@ -36,8 +70,11 @@ impl DofMap {
         if !planes.contains(&0) || !planes.contains(&1) {
             for i in 0..nn {
                 if on[0][i] && on[1][i] {
-                    fixed[3 * i] = true;
-                    fixed[3 * i + 1] = true;
+                    for c in 0..2 {
+                        if !fixed[3 * i + c] {
+                            pinned[3 * i + c] = true;
+                        }
+                    }
                 }
             }
         }
@@ -47,13 +84,22 @@ impl DofMap {
                 .filter(|&i| on[0][i] && on[2][i])
                 .max_by(|&a, &b| mesh.nodes[a][1].total_cmp(&mesh.nodes[b][1]))
             {
-                fixed[3 * i] = true;
+                pinned[3 * i] = !fixed[3 * i];
             }
         }
         // translation z
         if !planes.contains(&2) {
             if let Some(i) = (0..nn).find(|&i| on[2][i]) {
                 fixed[3 * i + 2] = true;
+            }
+        }
+        let mut soft_dofs = vec![false; 3 * nn];
+        for d in 0..3 * nn {
+            if pinned[d] {
+                match soft.get(d % 3) {
+                    Some(true) => soft_dofs[d] = true,
+                    _ => fixed[d] = true,
+                }
             }
         }
         let mut plug_of = vec![None; nn];
@@ -84,7 +130,28 @@ impl DofMap {
                 }
             }
         }
-        Self { eq, n_eq, plug_eq }
+        let soft = (0..3 * nn)
+            .filter(|&d| soft_dofs[d])
+            .filter_map(|d| {
+                eq[d].map(|e| SoftPin {
+                    node: d / 3,
+                    component: d % 3,
+                    eq: e,
+                    stiffness,
+                })
+            })
+            .collect();
+        Self {
+            eq,
+            n_eq,
+            plug_eq,
+            soft,
+        }
+    }
+
+    /// The rigid-mode pins held by springs ([`DofMap::with_soft_pins`]).
+    pub fn soft_pins(&self) -> &[SoftPin] {
+        &self.soft
     }
 
     /// The number of equations.

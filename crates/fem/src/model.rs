@@ -276,6 +276,24 @@ impl Model {
         })
     }
 
+    /// Hold the rigid-mode pins of component x (`soft[0]`) and y (`soft[1]`) by springs of
+    /// stiffness `stiffness` instead ([`DofMap::with_soft_pins`]; runs use
+    /// [`crate::dofs::SOFT_PIN_STIFFNESS`]), for problems whose planes move the tube sideways
+    /// (not symmetric about x = 0 or y = 0): renumbers the dofs and rebuilds the pattern and
+    /// the symbolic factorization. Call it before solving.
+    pub fn soften_rigid_pins(&mut self, soft: [bool; 2], stiffness: f64) -> Result<(), FemError> {
+        let dofs = DofMap::with_soft_pins(&self.mesh, soft, stiffness);
+        let pattern = Pattern::new(
+            &dofs,
+            (0..self.elements.len()).map(|e| self.elements.nodes(e)),
+        );
+        let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
+        self.dofs = dofs;
+        self.pattern = pattern;
+        self.ldlt = ldlt;
+        Ok(())
+    }
+
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
     }
@@ -490,6 +508,16 @@ impl Model {
             out.volume += face.volume();
             if let Some(k) = eq {
                 out.g[*k] += face.area * face.sign / 3.0;
+            }
+        }
+        // soft rigid-mode pins: E = κ_s/2 (x − X)², r = κ_s (x − X), K += κ_s on the diagonal
+        let diagonal = self.pattern.diagonal();
+        for pin in self.dofs.soft_pins() {
+            let u = x[pin.node][pin.component] - self.mesh.nodes[pin.node][pin.component];
+            out.energy += 0.5 * pin.stiffness * u * u;
+            out.f_int[pin.eq] += pin.stiffness * u;
+            if tangent {
+                out.k_int[diagonal[pin.eq]] += pin.stiffness;
             }
         }
         Ok(out)
