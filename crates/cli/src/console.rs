@@ -147,35 +147,35 @@ impl Observer for Console {
             )?;
             if let Some(LocalSection::Solved(l)) = &s.gps_at_fe_pressure {
                 say!(
-                    "         GPS section at the FE's pressure ϖ = {:.6} (eq. 76, no gas law): λs {:+.3}%, λz {:+.3}%, χ {:+.3}%, force {:+.3}%",
+                    "         GPS section at the FE's pressure ϖ = {:.6} (eq. 76, no gas law), relative: λs {:+.2e}, λz {:+.2e}, χ {:+.2e}, force {:+.2e}",
                     ms.w,
-                    100.0 * rel(ms.lambda_s, l.lambda_s),
-                    100.0 * rel(ms.lambda_z, l.lambda_z),
-                    100.0 * rel(c.chi, l.chi),
-                    100.0 * rel(c.force, l.force)
+                    rel(ms.lambda_s, l.lambda_s),
+                    rel(ms.lambda_z, l.lambda_z),
+                    rel(c.chi, l.chi),
+                    rel(c.force, l.force)
                 )?;
             }
         }
         if let (false, Some(e)) = (s.walls.is_empty(), &s.relative_error_vs_gps_at_fe_pressure) {
             say!(
-                "         GPS in the same walls at the FE's pressure ϖ = {:.6}: λs {:+.3}%, λz {:+.3}%",
+                "         GPS in the same walls at the FE's pressure ϖ = {:.6}, relative: λs {:+.2e}, λz {:+.2e}",
                 ms.w,
-                100.0 * e.lambda_s.unwrap_or(f64::NAN),
-                100.0 * e.lambda_z.unwrap_or(f64::NAN)
+                e.lambda_s.unwrap_or(f64::NAN),
+                e.lambda_z.unwrap_or(f64::NAN)
             )?;
         }
         for (k, w) in s.walls.iter().enumerate() {
             let gps = w.gps.map_or(f64::NAN, |g| g.force);
             let local = w.local.map_or(f64::NAN, |g| g.force);
             say!(
-                "         wall {}: contact {:.5} R, force {:.5} (GPS {:.5}, {:+.2}%; GPS at the FE's pressure {:.5}, {:+.2}%), penetration {:.1e}",
+                "         wall {}: contact {:.5} R, force {:.5} (GPS {:.5}, {:+.2}%; GPS at the FE's pressure {:.5}, relative {:+.2e}), penetration {:.1e}",
                 k + 1,
                 w.fe.contact_length,
                 w.fe.force,
                 gps,
                 100.0 * w.force_error_vs_gps.unwrap_or(f64::NAN),
                 local,
-                100.0 * w.force_error_vs_gps_at_fe_pressure.unwrap_or(f64::NAN),
+                w.force_error_vs_gps_at_fe_pressure.unwrap_or(f64::NAN),
                 w.fe.penetration
             )?;
         }

@@ -844,6 +844,16 @@ mod tests {
     use crate::{flatten, Hypothesis};
     use tubemem_material::laws::AnssariBenamBucchi;
 
+    /// The walls |x|, |y| ≤ h.
+    fn square_channel(h: f64) -> [Wall; 4] {
+        [
+            Wall::new(1.0, 0.0, h).unwrap(),
+            Wall::new(-1.0, 0.0, h).unwrap(),
+            Wall::new(0.0, 1.0, h).unwrap(),
+            Wall::new(0.0, -1.0, h).unwrap(),
+        ]
+    }
+
     fn abb() -> AnssariBenamBucchi {
         AnssariBenamBucchi::new(1.0, 30.0).unwrap()
     }
@@ -945,12 +955,7 @@ mod tests {
     fn square_channel_matches_the_hand_calculation() {
         let law = abb();
         let h = 1.1;
-        let walls = [
-            Wall::new(1.0, 0.0, h).unwrap(),
-            Wall::new(-1.0, 0.0, h).unwrap(),
-            Wall::new(0.0, 1.0, h).unwrap(),
-            Wall::new(0.0, -1.0, h).unwrap(),
-        ];
+        let walls = square_channel(h);
         let c = confine(&law, Hypothesis::Gps, &walls, 1.3).unwrap();
         assert_eq!(c.regime, Regime::Polygon);
         let [w, r, lz] = hand_polygon(
@@ -1102,12 +1107,7 @@ mod tests {
         }
         // the square channel: flats of 2(h − r) centred on 0, π/2, π, 3π/2
         let h = 1.1;
-        let walls = [
-            Wall::new(1.0, 0.0, h).unwrap(),
-            Wall::new(-1.0, 0.0, h).unwrap(),
-            Wall::new(0.0, 1.0, h).unwrap(),
-            Wall::new(0.0, -1.0, h).unwrap(),
-        ];
+        let walls = square_channel(h);
         let s = confine(&law, Hypothesis::Gps, &walls, 1.3).unwrap();
         let half = (h - s.r) / s.lambda_s;
         let quarter = (s.r * PI / 2.0 + 2.0 * (h - s.r)) / s.lambda_s;
