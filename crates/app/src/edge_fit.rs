@@ -117,10 +117,11 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
     }))
 }
 
-/// Elements around of the locating solve: 16, where the 9-node element's mid-span pressure
-/// at the squeeze's end is within 1e-4 of its value at 64 around (measured on the shipped
-/// 9-node squeeze, README "Contact"), which moves the edge by 3e-5 rad, 3e-4 of an element at
-/// 64 around.
+/// Elements around of the locating solve: 16. On the shipped 9-node squeeze its mid-span
+/// pressure at the end, 0.82030, is 1.1e-3 below the fitted 32-around run's 0.82121; the edge
+/// moves by about 0.32 rad per unit of ϖ there, so by 3e-4 rad: 0.0015 of an element at 32
+/// around and 0.006 at 128, against the 0.02 of an element within which the node line must
+/// lie (the fitted runs converge at order 4.5 up to 128 around, README "Contact").
 pub const LOCATOR_AROUND: usize = 16;
 
 /// The mid-span state at the end of stage `k` (0-based) of `case` solved on the coarse
