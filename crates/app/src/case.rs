@@ -321,9 +321,24 @@ pub enum Kind {
 #[derive(Debug, Deserialize, Serialize, Clone, Copy, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneSpec {
+    /// [nx, ny]: the plane is parallel to the tube's axis, so its normal has two components
+    /// (three are refused, not truncated)
+    #[serde(deserialize_with = "two_components")]
     pub normal: [f64; 2],
     pub offset: f64,
     pub target: f64,
+}
+
+/// A plane's `normal`: exactly two numbers.
+fn two_components<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v: Vec<f64> = Deserialize::deserialize(d)?;
+    match v.as_slice() {
+        [a, b] => Ok([*a, *b]),
+        _ => Err(serde::de::Error::custom(format!(
+            "`normal` has {} components: give [nx, ny] (a plane is parallel to the tube's axis z)",
+            v.len()
+        ))),
+    }
 }
 
 impl PlaneSpec {
@@ -622,6 +637,15 @@ impl StageSpec {
                         k + 1
                     );
                 }
+                if !(p.offset > 0.0 && p.target > 0.0) {
+                    invalid!(
+                        "[[stage]] {}, plane {}: `offset` = {} and `target` = {} must be > 0: the tube's axis must stay on the membrane's side of every plane (as `tubemem gps confine` requires)",
+                        i + 1,
+                        k + 1,
+                        tubemem_material::Num(p.offset),
+                        tubemem_material::Num(p.target)
+                    );
+                }
             }
             let walls = self
                 .plane
@@ -656,6 +680,12 @@ impl StageSpec {
         }
         if self.steps == 0 {
             invalid!("[[stage]] {}: `steps` must be ≥ 1", i + 1);
+        }
+        if self.penalty.is_some() && self.penetration_tolerance.is_some() {
+            invalid!(
+                "[[stage]] {}: `penalty` and `penetration_tolerance` both set the penalty κ: give one",
+                i + 1
+            );
         }
         if self.kind == Kind::Inflate
             && (self.penalty.is_some() || self.penetration_tolerance.is_some())

@@ -879,3 +879,26 @@ fn sideways_planes_are_found_from_the_case() {
     assert_eq!(sideways_planes(&channel), [false, false]);
     assert_eq!(sideways_planes(&plates), [false, false]);
 }
+
+/// Issue #25, class 5 (values silently changed or nonsense accepted), refused by validation
+/// with the stage, plane and key: a plane normal of three components (was truncated to two),
+/// `penalty` with `penetration_tolerance` (one was ignored), a confine target ≤ 0 (failed
+/// later with an unrelated error).
+#[test]
+fn contradictory_contact_keys_are_refused_not_changed() {
+    let channel = include_str!("../../../cases/channel_abb30_ls1.3.toml");
+    let err = |text: String| Case::parse(&text).unwrap_err().to_string();
+    let e = err(channel.replacen("normal = [1, 0]", "normal = [1, 0, 0]", 1));
+    assert!(
+        e.contains("line") && e.contains("`normal` has 3 components"),
+        "{e}"
+    );
+    let e = err(channel.replacen("target = 1.1", "target = -0.1", 1));
+    assert!(e.contains("plane 1") && e.contains("must be > 0"), "{e}");
+    let e = err(channel.replacen(
+        "steps = 8",
+        "steps = 8\npenalty = 100\npenetration_tolerance = 1e-3",
+        1,
+    ));
+    assert!(e.contains("[[stage]] 2") && e.contains("give one"), "{e}");
+}

@@ -167,15 +167,24 @@ impl Observer for Console {
         for (k, w) in s.walls.iter().enumerate() {
             let gps = w.gps.map_or(f64::NAN, |g| g.force);
             let local = w.local.map_or(f64::NAN, |g| g.force);
+            // a wall that carries nothing in GPS has no relative error
+            let pct = |e: Option<f64>| match e {
+                Some(e) if e.is_finite() => format!("{:+.2}%", 100.0 * e),
+                _ => "none in GPS".to_string(),
+            };
+            let relative = |e: Option<f64>| match e {
+                Some(e) if e.is_finite() => format!("relative {e:+.2e}"),
+                _ => "none in GPS".to_string(),
+            };
             say!(
-                "         wall {}: contact {:.5} R, force {:.5} (GPS {:.5}, {:+.2}%; GPS at the FE's pressure {:.5}, relative {:+.2e}), penetration {:.1e}",
+                "         wall {}: contact {:.5} R, force {:.5} (GPS {:.5}, {}; GPS at the FE's pressure {:.5}, {}), penetration {:.1e}",
                 k + 1,
                 w.fe.contact_length,
                 w.fe.force,
                 gps,
-                100.0 * w.force_error_vs_gps.unwrap_or(f64::NAN),
+                pct(w.force_error_vs_gps),
                 local,
-                w.force_error_vs_gps_at_fe_pressure.unwrap_or(f64::NAN),
+                relative(w.force_error_vs_gps_at_fe_pressure),
                 w.fe.penetration
             )?;
         }

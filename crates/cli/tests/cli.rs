@@ -1277,6 +1277,30 @@ fn a_killed_run_resumes_bit_identical() {
     }
 }
 
+/// Issue #25, class 5: a confine stage whose walls never touch the tube prints no `NaN%` (the
+/// relative errors of a wall that carries nothing in GPS read "none in GPS").
+#[test]
+fn walls_that_never_touch_print_no_nan() {
+    let d = tmp("far-walls");
+    let case = d.join("far.toml");
+    let text = include_str!("../../../cases/channel_abb30_ls1.3.toml")
+        .replace("element = \"quad9\"", "")
+        .replace("fit_contact_edge = true", "")
+        .replace("around = 32", "around = 16")
+        .replace("along = 80", "along = 40")
+        .replace("target = 1.1", "target = 1.34")
+        + "\n[output]\nvtu = \"none\"\n";
+    std::fs::write(&case, text).unwrap();
+    let o = run_in(&case, &d.join("out"), &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        out.contains("wall 1") && out.contains("none in GPS"),
+        "{out}"
+    );
+    assert!(!out.contains("NaN"), "{out}");
+}
+
 /// Restart of a run on a mesh fitted to its contact edge (`fit_contact_edge`, the main job's
 /// 9-node case): the resumed run rebuilds the same mesh from its locating solve
 /// (deterministic), takes the augmented contact's multipliers from the checkpoint, and ends
