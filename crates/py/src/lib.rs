@@ -149,6 +149,16 @@ fn vectorized<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
     let np = py.import("numpy")?;
+    // complex values would be truncated to their real parts by the float conversion
+    let kind: String = np
+        .call_method1("asarray", (input,))
+        .and_then(|a| a.getattr("dtype")?.getattr("kind")?.extract())
+        .unwrap_or_default();
+    if kind == "c" {
+        return Err(PyValueError::new_err(format!(
+            "{what}: complex numbers are not stretches or pressures (give real numbers)"
+        )));
+    }
     let arr = np
         .call_method1("asarray", (input, "float64"))
         .map_err(|_| PyValueError::new_err(format!("{what}: a number or an array of numbers")))?;

@@ -120,6 +120,9 @@ def test_resultants_are_eq_58_and_take_any_material():
         (lambda: tubemem.gps_flattening_curve(1.3, 0.8, points=10**9), "at most 10,000,000 points"),
         # a NaN in a material dict is named as such, not as a JSON column
         (lambda: tubemem.gps_inflate(1.3, material={"model": "abb", "shear_modulus": 1.0, "kuhn": math.nan}), "not a finite number"),
+        # complex values are refused, not truncated to their real parts (issue #25, class 5)
+        (lambda: tubemem.gps_inflate(np.array([1.3 + 0.1j])), "complex"),
+        (lambda: tubemem.gps_inflate(1.3 + 0j), "complex"),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(call, needle):
