@@ -11,6 +11,7 @@ import math
 import pathlib
 import sys
 
+import numpy as np
 import pytest
 
 import tubemem
