@@ -902,3 +902,40 @@ fn contradictory_contact_keys_are_refused_not_changed() {
     ));
     assert!(e.contains("[[stage]] 2") && e.contains("give one"), "{e}");
 }
+
+/// The memory guard's count (`run::equations_estimate`) before anything is built: within 3 %
+/// of the built shipped cases on both elements (it counted the 9-node tube's lattice once, a
+/// quarter of its nodes), and `cap_rows` enters it, so that a huge `cap_rows` (10⁶, 2⁶³ − 1) is
+/// refused by the guard at once instead of growing memory until the process aborts (issue #25,
+/// class 2).
+#[test]
+fn the_memory_guard_counts_every_node_before_building() {
+    use tubemem_app::run::{build_mesh, equations_estimate};
+    for text in [
+        include_str!("../../../cases/squeeze_abb30_ls1.3.toml"),
+        include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml"),
+        include_str!("../../../cases/vgroove_abb30_ls1.3.toml"),
+    ] {
+        let case = Case::parse(&text.replace("fit_contact_edge = true", "")).unwrap();
+        let built = tubemem_fem::model::Model::new(
+            build_mesh(&case).unwrap(),
+            case.material.build().unwrap(),
+        )
+        .unwrap()
+        .n_eq();
+        let estimate = equations_estimate(&case).unwrap();
+        let r = estimate as f64 / built as f64 - 1.0;
+        assert!(
+            r.abs() < 0.03,
+            "estimate {estimate} against {built} equations"
+        );
+    }
+    for rows in ["1000000", "9223372036854775807"] {
+        let case =
+            Case::parse(&SMALL.replace("[mesh]", &format!("[mesh]\ncap_rows = {rows}"))).unwrap();
+        let t = std::time::Instant::now();
+        let e = run(&case, "x", &mut []).into_result().unwrap_err().chain();
+        assert!(e.contains("too large for this machine"), "{e}");
+        assert!(t.elapsed().as_secs() < 10, "refused at once");
+    }
+}
