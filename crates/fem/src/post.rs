@@ -473,6 +473,10 @@ pub fn ring_profile(
     }
     let half_gap = contact.and_then(Contact::half_gap);
     let top = contact.and_then(Contact::top_plate);
+    let offsets = match (contact, top) {
+        (Some(c), Some(k)) => nodal_offsets(model, state, c, k),
+        _ => vec![],
+    };
     // every element's projected resultants once (in parallel; collected in element order, so
     // the result does not depend on the thread count), and the volume once
     // each element's Gauss points once: its projected resultants and, against plates, its
@@ -537,7 +541,8 @@ pub fn ring_profile(
                     |_, e| projected[e].as_slice(),
                     volume,
                 )?,
-                contact_width: half_gap.map_or(0.0, |h| contact_width(model, state, &ring, h)),
+                contact_width: half_gap
+                    .map_or(0.0, |h| contact_width(model, state, &ring, h, &offsets)),
                 contact_force: if forces.is_empty() {
                     0.0
                 } else {
@@ -548,11 +553,14 @@ pub fn ring_profile(
         .collect()
 }
 
-/// The geometric contact width of `ring` against the plate y = `h`: the penetrated length of the
-/// ring polygon (zero crossings of the nodal gap interpolated linearly, O(h) accurate), over π,
-/// for all copies across the x = 0 symmetry plane.
-fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64) -> f64 {
-    let c = penetrated_length(state, ring, |p| h - p[1]);
+/// The geometric contact width of `ring` against the plate y = `h` (plane `top` of `contact`):
+/// the length of the ring polygon in contact (zero crossings of the nodes' contact indicator,
+/// [`nodal_offsets`], interpolated linearly, O(h) accurate), over π, for all copies across the
+/// x = 0 symmetry plane.
+fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64, offsets: &[f64]) -> f64 {
+    let c = penetrated_length(state, ring, |i, p| {
+        h - p[1] - offsets.get(i).copied().unwrap_or(0.0)
+    });
     let x_copies = if model.mesh().symmetry.planes().contains(&0) {
         2.0
     } else {
@@ -561,12 +569,36 @@ fn contact_width(model: &Model, state: &State, ring: &Ring, h: f64) -> f64 {
     x_copies * c / std::f64::consts::PI
 }
 
-/// The length of the ring polygon where `gap` < 0 (zero crossings interpolated linearly).
-fn penetrated_length(state: &State, ring: &Ring, gap: impl Fn([f64; 3]) -> f64) -> f64 {
+/// The nodes' contact-indicator offsets against plane `k` of `contact`: λ/κ_g at each node
+/// where the contact acts at the nodes with multipliers (the augmented Lagrangian pushes where
+/// g − λ/κ_g < 0, so a node in contact sits at g ≈ 0 and its gap's sign says nothing), 0
+/// elsewhere (the penalty alone, or Gauss points: there the gap's sign is the indicator).
+pub fn nodal_offsets(model: &Model, state: &State, contact: &Contact, k: usize) -> Vec<f64> {
+    let mut out = vec![0.0; model.mesh().nodes.len()];
+    if contact.points != ContactPoints::Nodal || state.multipliers.is_empty() {
+        return out;
+    }
+    with_elements!(model.elements(), els => {
+        for (e, el) in els.iter().enumerate() {
+            let h = contact.element_history(&state.multipliers, e, el.nodal.len());
+            for (a, &node) in el.nodes.iter().enumerate() {
+                let at = contact.point(h, a, k);
+                if at.lambda > 0.0 {
+                    out[node] = out[node].max(at.lambda / at.penalty);
+                }
+            }
+        }
+    });
+    out
+}
+
+/// The length of the ring polygon where `gap` (of the node index and position) < 0 (zero
+/// crossings interpolated linearly).
+fn penetrated_length(state: &State, ring: &Ring, gap: impl Fn(usize, [f64; 3]) -> f64) -> f64 {
     let mut c = 0.0;
     for (ia, ib) in ring.segments() {
         let (a, b) = (state.x[ia], state.x[ib]);
-        let (ga, gb) = (gap(a), gap(b));
+        let (ga, gb) = (gap(ia, a), gap(ib, b));
         let len = dist(a, b);
         c += match (ga < 0.0, gb < 0.0) {
             (true, true) => len,
@@ -687,7 +719,8 @@ pub fn midspan_walls(model: &Model, state: &State, contact: &Contact) -> Vec<Wal
         .iter()
         .enumerate()
         .map(|(kp, plane)| {
-            let c = penetrated_length(state, &ring, |p| plane.gap(p));
+            let offsets = nodal_offsets(model, state, contact, kp);
+            let c = penetrated_length(state, &ring, |i, p| plane.gap(p) - offsets[i]);
             let mut penetration = 0.0f64;
             let forces: Vec<f64> = (0..model.elements().len())
                 .map(|e| {
@@ -793,7 +826,13 @@ pub fn midspan_contact(model: &Model, state: &State, contact: &Contact) -> Optio
     let z_copies = if planes.contains(&2) { 2.0 } else { 1.0 };
     let gap = |p: [f64; 3]| h - p[1];
     let ring = Ring::midspan(model);
-    let chi_geometric = contact_width(model, state, &ring, h);
+    let chi_geometric = contact_width(
+        model,
+        state,
+        &ring,
+        h,
+        &nodal_offsets(model, state, contact, top),
+    );
     let on_ring = ring.contains_set();
     let (mut total, mut penetration) = (0.0, 0.0_f64);
     let mut forces = vec![0.0; model.elements().len()];
