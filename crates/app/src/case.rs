@@ -884,6 +884,30 @@ impl Case {
                 "[mesh] `fit_contact_edge` fits the mesh to a contact edge: the case has no squeeze or confine stage"
             );
         }
+        // the fit of a confine stage needs its walls symmetric about y = 0 (the closed form
+        // leaves the section's rotation against the material free otherwise)
+        if let Some(k) = plan
+            .iter()
+            .rposition(|p| matches!(p.target, Target::Rho(_) | Target::Confine(_)))
+            .filter(|&k| self.mesh.fit_contact_edge && matches!(plan[k].target, Target::Confine(_)))
+        {
+            let planes = &self.stages[k].plane;
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
+            let mirrored = planes.iter().all(|p| {
+                planes.iter().any(|q| {
+                    close(q.normal[0], p.normal[0])
+                        && close(q.normal[1], -p.normal[1])
+                        && close(q.offset, p.offset)
+                        && close(q.target, p.target)
+                })
+            });
+            if !mirrored {
+                invalid!(
+                    "[mesh] `fit_contact_edge`: the planes of [[stage]] {} are not symmetric about y = 0 (each plane's mirror image among them), which the fit of their contact edges needs",
+                    k + 1
+                );
+            }
+        }
         Ok(plan)
     }
 }

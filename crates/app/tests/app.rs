@@ -846,6 +846,14 @@ fn an_edge_fit_it_cannot_make_is_a_clear_error() {
         .replace("[geometry]", "[geometry]\ncaps = \"rigid-plug\"");
     let msg = Case::parse(&plugs).unwrap_err().to_string();
     assert!(msg.contains("plugged tube is not fitted"), "{msg}");
+    // a confine stage's walls not symmetric about y = 0: the channel with one wall moved
+    let lopsided = include_str!("../../../cases/channel_abb30_ls1.3.toml").replacen(
+        "normal = [0, -1]\noffset = 1.35\ntarget = 1.1",
+        "normal = [0, -1]\noffset = 1.35\ntarget = 1.2",
+        1,
+    );
+    let msg = Case::parse(&lopsided).unwrap_err().to_string();
+    assert!(msg.contains("not symmetric about y = 0"), "{msg}");
     for key in ["contact_edge_angle = 2.0", "contact_edge_angle = -0.1"] {
         let e = Case::parse(&SMALL.replace("[mesh]", &format!("[mesh]\n{key}")))
             .unwrap_err()
