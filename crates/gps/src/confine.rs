@@ -567,14 +567,9 @@ pub fn confine_path(
     initial_stretch: f64,
     points: usize,
 ) -> Result<Vec<ConfineState>, GpsError> {
+    // the curves' size guard (it had none: `gps confine --points` of 10⁹ grew memory)
+    crate::check_points(points)?;
     let hold = check(walls, initial_stretch)?;
-    if points < 2 {
-        return Err(crate::invalid(
-            "points",
-            points as f64,
-            "a path needs at least 2 points",
-        ));
-    }
     let ws = Walls { walls, hold };
     let initial = inflate(law, hyp, initial_stretch)?;
     let s0 = first_contact(&ws, initial_stretch)?;
@@ -1131,6 +1126,20 @@ mod tests {
         lopsided[3] = Wall::new(0.0, -1.0, 1.3).unwrap();
         let s1 = confine_at_pressure(&law, Hypothesis::Gps, &lopsided, 0.8).unwrap();
         assert!(contact_edges(&lopsided, &s1).is_err());
+    }
+
+    /// Issue #25, class 2: a confinement path is capped like the curves (at most 10,000,000
+    /// points, refused before anything is allocated) and needs at least 2.
+    #[test]
+    fn a_confine_path_has_the_curves_size_guard() {
+        let law = abb();
+        let walls = square_channel(1.1);
+        for (points, needle) in [(1, "at least 2"), (1usize << 40, "at most 10,000,000")] {
+            let e = confine_path(&law, Hypothesis::Gps, &walls, 1.3, points)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(needle), "{e}");
+        }
     }
 
     #[test]

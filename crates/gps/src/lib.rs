@@ -193,7 +193,9 @@ pub fn inflate(
 /// 2.5 s). A request for more is refused before anything is allocated.
 pub const MAX_CURVE_POINTS: usize = 10_000_000;
 
-fn check_points(points: usize) -> Result<(), GpsError> {
+/// The one size guard of every curve and path: at least 2 points and at most
+/// [`MAX_CURVE_POINTS`].
+pub(crate) fn check_points(points: usize) -> Result<(), GpsError> {
     if points < 2 {
         return Err(invalid(
             "points",

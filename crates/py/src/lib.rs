@@ -166,6 +166,13 @@ fn vectorized<'py>(
         .cast::<PyArrayDyn<f64>>()
         .map_err(|_| PyValueError::new_err(format!("{what}: a number or an array of numbers")))?;
     let shape = arr.shape().to_vec();
+    // the curves' size cap, before the values are copied or solved
+    let count: usize = shape.iter().product();
+    if count > tubemem_gps::MAX_CURVE_POINTS {
+        return Err(PyValueError::new_err(format!(
+            "{what}: {count} values; an array may have at most 10,000,000 (as a curve's points)"
+        )));
+    }
     let values: Vec<f64> = arr.to_vec().map_err(|_| {
         PyValueError::new_err(format!("{what}: the array must be contiguous numbers"))
     })?;

@@ -124,6 +124,8 @@ def test_resultants_are_eq_58_and_take_any_material():
         # complex values are refused, not truncated to their real parts (issue #25, class 5)
         (lambda: tubemem.gps_inflate(np.array([1.3 + 0.1j])), "complex"),
         (lambda: tubemem.gps_inflate(1.3 + 0j), "complex"),
+        # arrays are capped like curves (issue #25, class 2)
+        (lambda: tubemem.gps_inflate(np.full(10_000_001, 1.3)), "at most 10,000,000"),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(call, needle):
