@@ -342,6 +342,20 @@ fn two_components<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D:
 }
 
 impl PlaneSpec {
+    /// Whether the plane's mirror image across x = 0 (`axis` 0) or y = 0 (`axis` 1), with the
+    /// same offset and target, is among `planes` (to 1e-12 relative).
+    pub fn mirrored_in(&self, planes: &[PlaneSpec], axis: usize) -> bool {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
+        let mut m = self.normal;
+        m[axis] = -m[axis];
+        planes.iter().any(|q| {
+            close(m[0], q.normal[0])
+                && close(m[1], q.normal[1])
+                && close(self.offset, q.offset)
+                && close(self.target, q.target)
+        })
+    }
+
     /// The wall at load parameter `t` ∈ [0, 1] (the closed form's convention, unit normal).
     pub fn wall_at(&self, t: f64) -> Result<tubemem_gps::confine::Wall, tubemem_gps::GpsError> {
         tubemem_gps::confine::Wall::new(
@@ -892,15 +906,7 @@ impl Case {
             .filter(|&k| self.mesh.fit_contact_edge && matches!(plan[k].target, Target::Confine(_)))
         {
             let planes = &self.stages[k].plane;
-            let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
-            let mirrored = planes.iter().all(|p| {
-                planes.iter().any(|q| {
-                    close(q.normal[0], p.normal[0])
-                        && close(q.normal[1], -p.normal[1])
-                        && close(q.offset, p.offset)
-                        && close(q.target, p.target)
-                })
-            });
+            let mirrored = planes.iter().all(|p| p.mirrored_in(planes, 1));
             if !mirrored {
                 invalid!(
                     "[mesh] `fit_contact_edge`: the planes of [[stage]] {} are not symmetric about y = 0 (each plane's mirror image among them), which the fit of their contact edges needs",

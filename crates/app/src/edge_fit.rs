@@ -50,21 +50,13 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
     if !case.mesh.fit_contact_edge && case.mesh.contact_edge_angle.is_none() {
         return Ok(None);
     }
-    if case.mesh.file.is_some() || case.geometry.caps != crate::case::Caps::Hemisphere {
-        return Err(CaseError::Invalid(
-            "[mesh] `fit_contact_edge` fits the generated capped tube (caps = \"hemisphere\"); a user mesh places its own node lines (see the README's contact section)".into(),
-        )
-        .into());
-    }
+    // a user mesh, plugs and a case without a contact stage are refused by validation
     if let Some(a) = case.mesh.contact_edge_angle {
         return Ok(Some(Fit {
             edges: plate_edges(a),
             pressure: None,
             locator_around: None,
         }));
-    }
-    if !case.mesh.fit_contact_edge {
-        return Ok(None);
     }
     let plan = case.plan();
     let Some(k) = plan

@@ -771,15 +771,7 @@ fn setup_stage(
                     continue;
                 }
                 for (k, p) in planes.iter().enumerate() {
-                    let mut m = p.normal;
-                    m[axis] = -m[axis];
-                    let mirrored = planes.iter().any(|q| {
-                        (q.normal[0] - m[0]).abs() <= 1e-12 * (1.0 + m[0].abs())
-                            && (q.normal[1] - m[1]).abs() <= 1e-12 * (1.0 + m[1].abs())
-                            && (q.offset - p.offset).abs() <= 1e-12 * (1.0 + p.offset.abs())
-                            && (q.target - p.target).abs() <= 1e-12 * (1.0 + p.target.abs())
-                    });
-                    if !mirrored {
+                    if !p.mirrored_in(planes, axis) {
                         return Err(fail_input(report, format!(
                             "plane {} has no mirror image across {name}, a symmetry plane of the model (symmetry = {:?}): give its mirror plane too, or use a model without that symmetry",
                             k + 1,
@@ -833,21 +825,13 @@ pub fn fe_moving_planes(planes: &[crate::case::PlaneSpec], penalty: f64) -> Movi
 /// (`[0]`) or y = 0 (`[1]`): such planes push the tube sideways, which the rigid-mode pins on
 /// the axis x = y = 0 (the caps' poles) must not resist (`Model::soften_rigid_pins`).
 pub fn sideways_planes(case: &Case) -> [bool; 2] {
-    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
     let mut out = [false, false];
     for stage in &case.stages {
         for (axis, flag) in out.iter_mut().enumerate() {
-            let mirrored = stage.plane.iter().all(|p| {
-                let mut m = p.normal;
-                m[axis] = -m[axis];
-                stage.plane.iter().any(|q| {
-                    close(q.normal[0], m[0])
-                        && close(q.normal[1], m[1])
-                        && close(q.offset, p.offset)
-                        && close(q.target, p.target)
-                })
-            });
-            *flag |= !mirrored;
+            *flag |= !stage
+                .plane
+                .iter()
+                .all(|p| p.mirrored_in(&stage.plane, axis));
         }
     }
     out

@@ -912,8 +912,10 @@ fn contradictory_contact_keys_are_refused_not_changed() {
 }
 
 /// The memory guard's count (`run::equations_estimate`) before anything is built: within 3 %
-/// of the built shipped cases on both elements (it counted the 9-node tube's lattice once, a
-/// quarter of its nodes), and `cap_rows` enters it, so that a huge `cap_rows` (10⁶, 2⁶³ − 1) is
+/// of the built shipped cases on both elements (measured −2.3 % on the eighth models, −1.3 % on
+/// the V-groove's quarter model: it takes a node per cell, and the tube has a ring of nodes more
+/// than rows of cells; it had counted the 9-node tube's lattice once, a quarter of its nodes), and
+/// `cap_rows` enters it, so that a huge `cap_rows` (10⁶, 2⁶³ − 1) is
 /// refused by the guard at once instead of growing memory until the process aborts (issue #25,
 /// class 2).
 #[test]

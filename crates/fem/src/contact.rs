@@ -408,14 +408,10 @@ impl Contact {
     ) -> Vec<f64> {
         let plane = &self.planes[k];
         let points = self.samples(re);
-        let area_ratio = |gp: &GaussPoint<N>| {
-            let f = gp.gradient(xe);
-            f[0].cross(&f[1]).norm()
-        };
         let nodal_area: Vec<f64> = match self.points {
             ContactPoints::Gauss => vec![],
             ContactPoints::Nodal => {
-                let j: Vec<f64> = re.gauss.iter().map(area_ratio).collect();
+                let j: Vec<f64> = re.gauss.iter().map(|gp| gp.area_ratio(xe)).collect();
                 (0..N)
                     .map(|a| {
                         re.gauss
@@ -433,7 +429,7 @@ impl Contact {
             .map(|(g, gp)| {
                 let t = self.traction_at(plane.gap_at(&gp.position(xe)), self.point(lambda, g, k));
                 match self.points {
-                    ContactPoints::Gauss => t / area_ratio(gp),
+                    ContactPoints::Gauss => t / gp.area_ratio(xe),
                     ContactPoints::Nodal => t * gp.w / nodal_area[g],
                 }
             })
@@ -456,8 +452,7 @@ impl Contact {
                 let share = 1.0 / points.len() as f64;
                 for (g, gp) in points.iter().enumerate() {
                     let p = gp.position(xe);
-                    let f = gp.gradient(xe);
-                    let da = f[0].cross(&f[1]).norm();
+                    let da = gp.area_ratio(xe);
                     for (kp, pl) in self.planes.iter().enumerate() {
                         s +=
                             share * self.traction_at(pl.gap_at(&p), self.point(lambda, g, kp)) / da;
@@ -466,14 +461,7 @@ impl Contact {
                 s
             }
             ContactPoints::Nodal => {
-                let area: f64 = re
-                    .gauss
-                    .iter()
-                    .map(|gp| {
-                        let f = gp.gradient(xe);
-                        gp.w * f[0].cross(&f[1]).norm()
-                    })
-                    .sum();
+                let area: f64 = re.gauss.iter().map(|gp| gp.w * gp.area_ratio(xe)).sum();
                 for (g, gp) in points.iter().enumerate() {
                     for (kp, pl) in self.planes.iter().enumerate() {
                         s += gp.w

@@ -57,6 +57,12 @@ impl<const N: usize> GaussPoint<N> {
         }
         f
     }
+
+    /// The area ratio J = da/dA0 = |f_1 × f_2| at the point.
+    pub fn area_ratio(&self, xe: &[Vec3; N]) -> f64 {
+        let f = self.gradient(xe);
+        f[0].cross(&f[1]).norm()
+    }
 }
 
 /// Reference data of one element at its Gauss points.
@@ -196,20 +202,12 @@ impl<const N: usize> RefElement<N> {
 
     /// The in-plane deformation gradient columns f_1, f_2 at Gauss point `g`.
     pub fn gradient(&self, g: usize, xe: &[Vec3; N]) -> [Vec3; 2] {
-        let dn = &self.gauss[g].dn;
-        let mut f = [Vec3::zeros(); 2];
-        for a in 0..N {
-            for i in 0..2 {
-                f[i] += xe[a] * dn[a][i];
-            }
-        }
-        f
+        self.gauss[g].gradient(xe)
     }
 
     /// The area ratio J = da/dA0 = |f_1 × f_2| at Gauss point `g`.
     pub fn area_ratio(&self, g: usize, xe: &[Vec3; N]) -> f64 {
-        let f = self.gradient(g, xe);
-        f[0].cross(&f[1]).norm()
+        self.gauss[g].area_ratio(xe)
     }
 
     /// The image F v of a vector v of the reference tangent plane at Gauss point `g`.

@@ -255,14 +255,7 @@ impl Model {
                     .collect::<Result<Vec<_>, _>>()?,
             ),
         };
-        let pattern = Pattern::new(&dofs, (0..elements.len()).map(|e| elements.nodes(e)));
-        if let Some(k) = pattern.diagonal().iter().position(|&d| d == usize::MAX) {
-            let node = (0..mesh.nodes.len())
-                .find(|&i| (0..3).any(|c| dofs.eq(i, c) == Some(k)))
-                .unwrap_or(usize::MAX);
-            return Err(FemError::UnusedNode { node });
-        }
-        let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
+        let (pattern, ldlt) = Self::numbering(&mesh, &elements, &dofs)?;
         Ok(Self {
             interrupt: None,
             mesh,
@@ -283,15 +276,29 @@ impl Model {
     /// the symbolic factorization. Call it before solving.
     pub fn soften_rigid_pins(&mut self, soft: [bool; 2], stiffness: f64) -> Result<(), FemError> {
         let dofs = DofMap::with_soft_pins(&self.mesh, soft, stiffness);
-        let pattern = Pattern::new(
-            &dofs,
-            (0..self.elements.len()).map(|e| self.elements.nodes(e)),
-        );
-        let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
+        let (pattern, ldlt) = Self::numbering(&self.mesh, &self.elements, &dofs)?;
         self.dofs = dofs;
         self.pattern = pattern;
         self.ldlt = ldlt;
         Ok(())
+    }
+
+    /// The sparsity pattern of `dofs` over `elements` and its symbolic factorization; a node
+    /// that no element uses is an error.
+    fn numbering(
+        mesh: &Mesh,
+        elements: &Elements,
+        dofs: &DofMap,
+    ) -> Result<(Pattern, SparseLdlt), FemError> {
+        let pattern = Pattern::new(dofs, (0..elements.len()).map(|e| elements.nodes(e)));
+        if let Some(k) = pattern.diagonal().iter().position(|&d| d == usize::MAX) {
+            let node = (0..mesh.nodes.len())
+                .find(|&i| (0..3).any(|c| dofs.eq(i, c) == Some(k)))
+                .unwrap_or(usize::MAX);
+            return Err(FemError::UnusedNode { node });
+        }
+        let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
+        Ok((pattern, ldlt))
     }
 
     pub fn mesh(&self) -> &Mesh {

@@ -489,12 +489,17 @@ pub fn ring_profile(
                 let samples = gauss_samples(model, e, &state.x);
                 let force = match (contact, top) {
                     (Some(c), Some(top)) => {
+                        // the Gauss points already at hand, or the nodes
+                        let nodal;
                         let points = match c.points {
-                            ContactPoints::Gauss => samples.clone(),
-                            ContactPoints::Nodal => contact_samples(model, e, &state.x, c),
+                            ContactPoints::Gauss => &samples,
+                            ContactPoints::Nodal => {
+                                nodal = contact_samples(model, e, &state.x, c);
+                                &nodal
+                            }
                         };
                         element_contact_force(
-                            &points,
+                            points,
                             c,
                             top,
                             c.element_history(&state.multipliers, e, points.len()),

@@ -948,7 +948,8 @@ fn nodal_contact_tangent_matches_finite_differences() {
 /// the area, and on a flat 9-node rectangle they are Simpson's, 1/36, 4/36 and 16/36 of the
 /// area at the corners, the mid-sides and the centre; on any element they sum to its area (the
 /// Gauss rule's). A flat membrane lying δ inside a plane then carries the exact force κδA at
-/// nodal points too, along n only.
+/// nodal points too, along n only. Tolerances 1e-14 and 1e-12 relative: rounding only (the
+/// weights are exact for these affine elements).
 #[test]
 fn nodal_weights_are_the_shape_function_integrals() {
     use crate::contact::ContactPoints;

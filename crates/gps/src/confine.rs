@@ -1082,7 +1082,9 @@ mod tests {
     /// plates, π/2 ± πχ/(2λs) and their mirror images with χ and λs from eq. 76's section
     /// (`section_at_pressure`, its own solver); in the square channel the hand calculation's
     /// flats 2(h − r) centred on the walls' normals, at (α_j r ± (h − r) + Σ of the flats
-    /// before)/λs; walls not symmetric about y = 0 are refused.
+    /// before)/λs; walls not symmetric about y = 0 are refused. Tolerance 1e-9 rad: the two
+    /// solvers' Newton tolerances (1e-10 relative on their states, as in
+    /// `pressure_control_matches_the_section_at_pressure`).
     #[test]
     fn contact_edges_match_the_section_geometry() {
         let law = abb();

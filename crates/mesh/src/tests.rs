@@ -341,7 +341,8 @@ fn rings_of_a_capped_tube_are_its_cylinder_rows() {
 /// lines, the end rings (shared with the caps) and the caps stay bit for bit as in the uniform
 /// mesh; every cylinder node stays on the circle; the 9-node mid-side lines sit at their
 /// corners' mean angle; no element shrinks below half its uniform width (the map's bound
-/// 1 − 1/(2k)); a target nearest a symmetry line moves its neighbour instead.
+/// 1 − 1/(2k)); a target nearest a symmetry line moves its neighbour instead. Tolerances
+/// 1e-14/1e-15: rounding of cos, sin and atan2 near angles of order 1.
 #[test]
 fn a_fitted_hoop_puts_a_node_line_on_each_edge() {
     use crate::hoop::HoopMap;

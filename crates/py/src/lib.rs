@@ -149,10 +149,14 @@ fn vectorized<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
     let np = py.import("numpy")?;
-    // complex values would be truncated to their real parts by the float conversion
-    let kind: String = np
-        .call_method1("asarray", (input,))
-        .and_then(|a| a.getattr("dtype")?.getattr("kind")?.extract())
+    let bad = || PyValueError::new_err(format!("{what}: a number or an array of numbers"));
+    // one conversion to an array; complex values would be truncated to their real parts by the
+    // float conversion that follows (no copy where it is float64 already)
+    let raw = np.call_method1("asarray", (input,)).map_err(|_| bad())?;
+    let kind: String = raw
+        .getattr("dtype")
+        .and_then(|d| d.getattr("kind"))
+        .and_then(|k| k.extract())
         .unwrap_or_default();
     if kind == "c" {
         return Err(PyValueError::new_err(format!(
@@ -160,11 +164,9 @@ fn vectorized<'py>(
         )));
     }
     let arr = np
-        .call_method1("asarray", (input, "float64"))
-        .map_err(|_| PyValueError::new_err(format!("{what}: a number or an array of numbers")))?;
-    let arr = arr
-        .cast::<PyArrayDyn<f64>>()
-        .map_err(|_| PyValueError::new_err(format!("{what}: a number or an array of numbers")))?;
+        .call_method1("asarray", (raw, "float64"))
+        .map_err(|_| bad())?;
+    let arr = arr.cast::<PyArrayDyn<f64>>().map_err(|_| bad())?;
     let shape = arr.shape().to_vec();
     // the curves' size cap, before the values are copied or solved
     let count: usize = shape.iter().product();
