@@ -41,7 +41,8 @@ impl HoopMap {
         let mut anchors: Vec<(f64, f64)> = (0..=4)
             .map(|q| (q as f64 * FRAC_PI_2, q as f64 * FRAC_PI_2))
             .collect();
-        for &t in edges {
+        let mut sorted = edges.to_vec();
+        for &t in &sorted {
             if !(t.is_finite() && (0.0..2.0 * PI).contains(&t)) {
                 return Err(MeshError::InvalidParameter {
                     name: "contact edge angle",
@@ -49,22 +50,42 @@ impl HoopMap {
                     requirement: "must be an angle in [0, 2π) from the x axis",
                 });
             }
+        }
+        sorted.sort_by(f64::total_cmp);
+        // the node lines taken by the edges so far, in order
+        let mut lines: Vec<(usize, f64)> = Vec::with_capacity(sorted.len());
+        for &t in &sorted {
             let mut k = (t / h).round() as usize;
             if k.is_multiple_of(quarter) {
                 // on x = 0 or y = 0: its neighbour towards the edge
                 k = if t >= k as f64 * h { k + 1 } else { k - 1 };
             }
-            let theta = k as f64 * h;
-            if anchors.iter().any(|a| a.0 == theta) {
-                return Err(MeshError::InvalidParameter {
-                    name: "contact edge angle",
-                    value: t,
-                    requirement:
-                        "two contact edges are nearest the same node line: refine `around`",
-                });
+            // a contact zone narrower than an element: its second edge takes the next line (the
+            // element between the two lines spans the zone), or, where the next is a symmetry
+            // line, its first edge the line before
+            if let Some(&(l, _)) = lines.last().filter(|&&(l, _)| k <= l) {
+                k = l + 1;
+                if k.is_multiple_of(quarter) {
+                    let before = lines.len().checked_sub(2).map(|i| lines[i].0);
+                    let free = l >= 1
+                        && !(l - 1).is_multiple_of(quarter)
+                        && before.is_none_or(|b| b < l - 1);
+                    if !free {
+                        return Err(MeshError::InvalidParameter {
+                            name: "contact edge angle",
+                            value: t,
+                            requirement: "two contact edges are nearest the same node line between two symmetry lines: refine `around`",
+                        });
+                    }
+                    if let Some(last) = lines.last_mut() {
+                        last.0 = l - 1;
+                    }
+                    k = l;
+                }
             }
-            anchors.push((theta, t));
+            lines.push((k, t));
         }
+        anchors.extend(lines.iter().map(|&(k, t)| (k as f64 * h, t)));
         anchors.sort_by(|a, b| a.0.total_cmp(&b.0));
         if anchors.windows(2).any(|w| !(w[1].1 > w[0].1)) {
             return Err(MeshError::InvalidParameter {
@@ -104,4 +125,169 @@ pub fn blend(z: f64, half: f64, radius: f64) -> f64 {
         let s = (a - z1) / (z2 - z1);
         1.0 - s * s * (3.0 - 2.0 * s)
     }
+}
+
+/// The interpolation of nodal fields from a mesh onto the same mesh with some nodes moved along
+/// their hoops (a refitted [`HoopMap`]): for each node, the old nodes and weights whose
+/// combination gives the field at its new place.
+///
+/// ```text
+/// a node that did not move:  f'(n) = f(n)
+/// a moved node at (θ', z):   f'(n) = Σ_b w_b f(b), over the old element row that holds θ'
+///   on the ring of old nodes at the same z: linear in θ through its 2 nodes (4-node
+///   elements) or quadratic through its 3 (9-node), so that a field linear (quadratic) in θ
+///   along the ring is carried exactly
+/// ```
+/// A hyperelastic membrane has no history: its state is the map from the reference surface to
+/// the current one, so moving the reference nodes and evaluating that map at their new places
+/// (this transfer) gives a state of the new mesh, exact up to the interpolation's error, from
+/// which Newton finds the new mesh's equilibrium.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transfer {
+    weights: Vec<Vec<(usize, f64)>>,
+}
+
+impl Transfer {
+    /// The transfer from `old` to the same mesh with the nodes `moved` (same count; a node
+    /// whose coordinates differ, by more than 1e-13 R, must keep its z and move along the ring
+    /// of old nodes at that z).
+    pub fn between(old: &crate::Mesh, moved: &[[f64; 3]]) -> Result<Self, MeshError> {
+        if moved.len() != old.nodes.len() {
+            return Err(MeshError::InvalidParameter {
+                name: "moved nodes",
+                value: moved.len() as f64,
+                requirement: "a refitted mesh must have the old mesh's node count",
+            });
+        }
+        let order = match old.element() {
+            crate::ElementKind::Quad4 => 1,
+            crate::ElementKind::Quad9 => 2,
+        };
+        let angle = |p: &[f64; 3]| p[1].atan2(p[0]).rem_euclid(2.0 * PI);
+        // the rings (old nodes at one z, by angle) that hold a moved node
+        let mut rings: std::collections::HashMap<u64, Vec<(f64, usize)>> = Default::default();
+        // a node moved by rounding only (the map's arithmetic at a line it keeps) did not move
+        let still = |a: &[f64; 3], b: &[f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() <= 1e-13);
+        for (n, (a, b)) in old.nodes.iter().zip(moved).enumerate() {
+            if !still(a, b) {
+                if a[2] != b[2] {
+                    return Err(MeshError::InvalidParameter {
+                        name: "moved node",
+                        value: n as f64,
+                        requirement: "a refitted node keeps its z (it moves along its hoop)",
+                    });
+                }
+                rings.entry(a[2].to_bits()).or_default();
+            }
+        }
+        for (n, p) in old.nodes.iter().enumerate() {
+            if let Some(r) = rings.get_mut(&p[2].to_bits()) {
+                r.push((angle(p), n));
+            }
+        }
+        for r in rings.values_mut() {
+            r.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+        let full = old.symmetry.rings_closed();
+        let mut weights = Vec::with_capacity(moved.len());
+        for (n, (a, b)) in old.nodes.iter().zip(moved).enumerate() {
+            if still(a, b) {
+                weights.push(vec![(n, 1.0)]);
+                continue;
+            }
+            let ring = &rings[&a[2].to_bits()];
+            weights.push(ring_weights(ring, angle(b), order, full).ok_or(
+                MeshError::InvalidParameter {
+                    name: "moved node",
+                    value: n as f64,
+                    requirement: "a refitted node must stay within its ring's elements",
+                },
+            )?);
+        }
+        Ok(Self { weights })
+    }
+
+    /// The identity on `nodes` nodes.
+    pub fn identity(nodes: usize) -> Self {
+        Self {
+            weights: (0..nodes).map(|n| vec![(n, 1.0)]).collect(),
+        }
+    }
+
+    /// Node `n`'s old nodes and weights.
+    pub fn weights(&self, n: usize) -> &[(usize, f64)] {
+        &self.weights[n]
+    }
+
+    /// The field `f` (one value per old node) at the new nodes.
+    pub fn apply<T: Copy + Default + std::ops::Add<Output = T> + std::ops::Mul<f64, Output = T>>(
+        &self,
+        f: &[T],
+    ) -> Vec<T> {
+        self.weights
+            .iter()
+            .map(|w| w.iter().fold(T::default(), |s, &(b, c)| s + f[b] * c))
+            .collect()
+    }
+
+    /// [`Transfer::apply`] on points.
+    pub fn apply_points(&self, f: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        self.weights
+            .iter()
+            .map(|w| {
+                let mut p = [0.0; 3];
+                for &(b, c) in w {
+                    for k in 0..3 {
+                        p[k] += c * f[b][k];
+                    }
+                }
+                p
+            })
+            .collect()
+    }
+}
+
+/// The weights at angle `t` on `ring` (old (θ, node) sorted by θ, its first node on the
+/// element corner line θ = 0), element rows of `order` + 1 nodes; `full`: the ring closes
+/// (its last row runs from its last corner to the first at 2π).
+fn ring_weights(
+    ring: &[(f64, usize)],
+    t: f64,
+    order: usize,
+    full: bool,
+) -> Option<Vec<(usize, f64)>> {
+    let len = ring.len();
+    let first = ring.first()?;
+    if first.0 > 1e-12 {
+        return None;
+    }
+    // the row's nodes as (θ, node), its first at a corner (index multiple of `order`)
+    let at = |i: usize| -> (f64, usize) {
+        if i < len {
+            ring[i]
+        } else {
+            (ring[i - len].0 + 2.0 * PI, ring[i - len].1)
+        }
+    };
+    let rows = if full { len / order } else { (len - 1) / order };
+    let row = (0..rows).find(|&r| {
+        let (a, b) = (at(r * order).0, at((r + 1) * order).0);
+        a <= t && t <= b
+    })?;
+    let pts: Vec<(f64, usize)> = (0..=order).map(|k| at(row * order + k)).collect();
+    // Lagrange weights through the row's nodes
+    Some(
+        pts.iter()
+            .enumerate()
+            .map(|(i, &(ti, node))| {
+                let w = pts
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, _)| j != i)
+                    .map(|(_, &(tj, _))| (t - tj) / (ti - tj))
+                    .product::<f64>();
+                (node, w)
+            })
+            .collect(),
+    )
 }

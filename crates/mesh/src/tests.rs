@@ -412,10 +412,97 @@ fn a_fitted_hoop_puts_a_node_line_on_each_edge() {
             }
         }
     }
-    // a target nearest the line y = 0 moves its neighbour, and two targets on one line fail
+    // a target nearest the line y = 0 moves its neighbour; two targets nearest one line take
+    // it and the next (the element between spans a contact zone narrower than an element),
+    // unless the next is a symmetry line
     let m = HoopMap::fitted(around, &[0.01]).unwrap();
     assert_eq!(m.map(h), 0.01);
-    assert!(HoopMap::fitted(around, &[0.9 * h, 1.1 * h]).is_err());
+    let m = HoopMap::fitted(around, &[0.9 * h, 1.1 * h]).unwrap();
+    assert_eq!((m.map(h), m.map(2.0 * h)), (0.9 * h, 1.1 * h));
+    // next to a symmetry line the first edge takes the line before instead
+    let q = around as f64 / 4.0;
+    let m = HoopMap::fitted(around, &[(q - 1.1) * h, (q - 0.9) * h]).unwrap();
+    assert_eq!(
+        (m.map((q - 2.0) * h), m.map((q - 1.0) * h)),
+        ((q - 1.1) * h, (q - 0.9) * h)
+    );
+    // with no line left between two symmetry lines: an error
+    assert!(HoopMap::fitted(8, &[0.9 * PI / 4.0, 1.1 * PI / 4.0, 1.2 * PI / 4.0]).is_err());
     assert!(HoopMap::fitted(4, &[0.3]).is_err());
     assert!(HoopMap::fitted(around, &[f64::NAN]).is_err());
+}
+
+/// The hoop transfer ([`crate::hoop::Transfer`]) between two fits of one tube carries a field
+/// linear in the angle exactly on the 4-node tube and a quadratic one on the 9-node tube (to
+/// rounding, 1e-12), leaves the nodes that did not move as they were, and refuses a node moved
+/// off its ring.
+#[test]
+fn the_hoop_transfer_is_exact_for_fields_of_its_order() {
+    use crate::hoop::{HoopMap, Transfer};
+    use crate::tube::capped_tube_fitted_of;
+    use std::f64::consts::FRAC_PI_2;
+    let edges = |a: f64| [FRAC_PI_2 - a, FRAC_PI_2 + a, 1.5 * PI - a, 1.5 * PI + a];
+    for (kind, f) in [
+        (
+            ElementKind::Quad4,
+            (|t: f64| 2.0 * t + 1.0) as fn(f64) -> f64,
+        ),
+        (ElementKind::Quad9, |t: f64| t * t - 3.0 * t + 0.5),
+    ] {
+        for sym in [Symmetry::Eighth, Symmetry::Quarter, Symmetry::None] {
+            let mesh = |a: f64| {
+                let map = HoopMap::fitted(16, &edges(a)).unwrap();
+                capped_tube_fitted_of(kind, 1.0, 8.0, 16, 16, 2, sym, Some(&map)).unwrap()
+            };
+            let (old, new) = (mesh(0.3), mesh(0.42));
+            let t = Transfer::between(&old, &new.nodes).unwrap();
+            let angle = |p: &[f64; 3]| p[1].atan2(p[0]).rem_euclid(2.0 * PI);
+            let field: Vec<f64> = old.nodes.iter().map(|p| f(angle(p))).collect();
+            let carried = t.apply(&field);
+            let mut moved = 0;
+            for (n, (p, q)) in old.nodes.iter().zip(&new.nodes).enumerate() {
+                if p == q {
+                    assert_eq!(t.weights(n), &[(n, 1.0)]);
+                } else {
+                    moved += 1;
+                    // a closed ring's last row, from its last node back to θ = 0, joins f(2π⁻)
+                    // to f(0): no field of θ is polynomial across it
+                    let a = angle(q);
+                    let mut ring: Vec<f64> = old
+                        .nodes
+                        .iter()
+                        .filter(|o| o[2] == q[2])
+                        .map(angle)
+                        .collect();
+                    ring.sort_by(f64::total_cmp);
+                    let order = if kind == ElementKind::Quad9 { 2 } else { 1 };
+                    let last = ring[ring.len() - order];
+                    if a > last {
+                        continue;
+                    }
+                    assert!(
+                        (carried[n] - f(a)).abs() < 1e-12,
+                        "{kind:?} {sym:?} node {n}: {} vs {}",
+                        carried[n],
+                        f(a)
+                    );
+                }
+            }
+            assert!(moved > 0);
+        }
+    }
+    let old = capped_tube_fitted_of(
+        ElementKind::Quad4,
+        1.0,
+        8.0,
+        16,
+        16,
+        2,
+        Symmetry::Eighth,
+        None,
+    )
+    .unwrap();
+    let mut off = old.nodes.clone();
+    off[5][2] += 0.1;
+    assert!(Transfer::between(&old, &off).is_err());
 }
