@@ -1225,6 +1225,7 @@ pub fn run_arc_stage<E>(
                         dw_ds: s.tl,
                         negative_conjugate: Some(s.negative_pivots_conjugate),
                         previous: None,
+                        refits: 0,
                     };
                     *state = s.state.clone();
                     on_step(path.model, s.state, &info)

@@ -44,6 +44,8 @@ pub use newton::NewtonSettings;
 mod tests;
 #[cfg(test)]
 mod tests_quad9;
+#[cfg(test)]
+mod tests_remap;
 
 use thiserror::Error;
 use tubemem_material::MaterialError;
@@ -59,6 +61,10 @@ pub enum FemError {
     DegenerateElement { element: usize, gauss_point: usize },
     #[error("element {element} is degenerate at its node {node} (of 0..N, in element order) in the reference configuration")]
     DegenerateNode { element: usize, node: usize },
+    #[error("the state cannot be carried to the moved mesh: {reason}")]
+    Remap { reason: String },
+    #[error("the mesh cannot follow the contact edge: {reason}")]
+    Refit { reason: String },
     #[error("element {element}, Gauss point {gauss_point}")]
     Material {
         element: usize,

@@ -99,6 +99,49 @@ pub struct StepInfo<'a> {
     /// the converged state before this one in the stage (the secant predictor's other point,
     /// at `progress.previous_lambda`), for checkpoints
     pub previous: Option<&'a State>,
+    /// the times the reference mesh moved after this step's first solve, each followed by a
+    /// re-solve ([`Refit`]; 0 without one)
+    pub refits: usize,
+}
+
+/// A reference mesh that follows the solution through a stage ([`run_stage_refitted`]): the
+/// tube's hoop node lines kept on the contact edges as they move. Before each step's solve
+/// (on the secant prediction) and after it converges, the stepping asks for the nodes the
+/// model should have; when they differ it moves the model there
+/// ([`Model::move_reference`]), carries the states over and, after a converged solve, solves
+/// again, up to [`MAX_REFITS`] times a step.
+pub trait Refit {
+    /// The reference nodes the model should have at load value `value` with `state`, or
+    /// `None` when the current ones do.
+    fn nodes(
+        &mut self,
+        model: &Model,
+        state: &State,
+        value: f64,
+    ) -> Result<Option<Vec<[f64; 3]>>, FemError>;
+}
+
+/// The re-solves after moving the mesh allowed in one step: 3. Each move follows the
+/// converged pressure, which the re-solve changes far less than the step did, so the shipped
+/// cases need at most one (README "Contact").
+pub const MAX_REFITS: usize = 3;
+
+/// Move `model` to the nodes `refit` asks for at `value` with `at` (if it asks), carrying
+/// `states` over; whether it moved.
+fn follow(
+    model: &mut Model,
+    refit: &mut dyn Refit,
+    value: f64,
+    at: &State,
+    load: &Load,
+    states: &mut [&mut State],
+) -> Result<bool, FemError> {
+    let Some(nodes) = refit.nodes(model, at, value)? else {
+        return Ok(false);
+    };
+    let transfer = tubemem_mesh::hoop::Transfer::between(model.mesh(), &nodes)?;
+    model.move_reference(nodes, &transfer, load.contact.as_ref(), states)?;
+    Ok(true)
 }
 
 /// Run one stage: the load parameter moves linearly from `stage.from` to `stage.to` (the load
@@ -141,7 +184,22 @@ pub fn run_stage_from<E>(
     stage: &Stage,
     resume: Option<(StepState, Option<State>)>,
     load: impl Fn(f64) -> Load,
+    on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
+) -> Result<(), StageError<E>> {
+    run_stage_refitted(model, state, stage, resume, load, on_step, None)
+}
+
+/// [`run_stage_from`] with the reference mesh following the solution by `refit` (see
+/// [`Refit`]). A step whose re-solve on the moved mesh fails is cut back like any other, from
+/// the last converged state carried to the moved mesh.
+pub fn run_stage_refitted<E>(
+    model: &mut Model,
+    state: &mut State,
+    stage: &Stage,
+    resume: Option<(StepState, Option<State>)>,
+    load: impl Fn(f64) -> Load,
     mut on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
+    mut refit: Option<&mut dyn Refit>,
 ) -> Result<(), StageError<E>> {
     let (from, to) = (stage.from, stage.to);
     let set = &stage.settings;
@@ -196,14 +254,60 @@ pub fn run_stage_from<E>(
             _ => state.clone(),
         };
         let l = load(value);
-        match model.solve(&mut trial, &l) {
+        let mut refits = 0;
+        let moved = |source: FemError| crate::newton::NewtonError::Problem {
+            iteration: 0,
+            source,
+        };
+        // the step's difficulty for the step-size control: its first solve's iterations
+        let mut difficulty = 0;
+        let solved: Result<NewtonReport, crate::newton::NewtonError<FemError>> = (|| {
+            if let Some(r) = refit.as_deref_mut() {
+                let at = trial.clone();
+                let mut carried: Vec<&mut State> = vec![&mut trial, &mut *state];
+                if let Some(p) = previous.as_mut() {
+                    carried.push(p);
+                }
+                follow(model, r, value, &at, &l, &mut carried).map_err(moved)?;
+            }
+            let mut report = model.solve(&mut trial, &l)?;
+            difficulty = report.load_iterations();
+            while let Some(r) = refit.as_deref_mut() {
+                if refits == MAX_REFITS {
+                    break;
+                }
+                let at = trial.clone();
+                let mut carried: Vec<&mut State> = vec![&mut trial, &mut *state];
+                if let Some(p) = previous.as_mut() {
+                    carried.push(p);
+                }
+                if !follow(model, r, value, &at, &l, &mut carried).map_err(moved)? {
+                    break;
+                }
+                refits += 1;
+                let again = model.solve(&mut trial, &l)?;
+                // the step's iterations and updates are all its solves'; the state's own
+                // measures (residual, inertia, gap) the last one's
+                let (iterations, updates, augmenting) = (
+                    report.iterations + again.iterations,
+                    report.augmentation.updates + again.augmentation.updates,
+                    report.augmentation.iterations + again.augmentation.iterations,
+                );
+                report = again;
+                report.iterations = iterations;
+                report.augmentation.updates = updates;
+                report.augmentation.iterations = augmenting;
+            }
+            Ok(report)
+        })();
+        match solved {
             Ok(report) => {
                 material = None;
                 step += 1;
                 previous_lambda = Some(lambda);
                 lambda = next;
                 previous = Some(std::mem::replace(state, trial));
-                if report.load_iterations() <= set.easy_iterations {
+                if difficulty <= set.easy_iterations {
                     dl = (dl * set.growth).min(set.max_fraction);
                 }
                 let info = StepInfo {
@@ -222,6 +326,7 @@ pub fn run_stage_from<E>(
                     dw_ds: f64::NAN,
                     negative_conjugate: None,
                     previous: previous.as_ref(),
+                    refits,
                 };
                 on_step(model, state, &info).map_err(|source| StageError::Observer {
                     stage: stage.index,
