@@ -20,6 +20,10 @@
 //! cap_rows = 8          # optional: rows in each cap from equator to top face (default around/8)
 //! symmetry = "eighth"   # "none" | "half" | "quarter" | "eighth"
 //! element = "quad4"     # "quad4" (bilinear, default) | "quad9" (biquadratic, curved geometry)
+//! track_contact_edge = true # optional: hoop node lines on the contact edges at every squeeze
+//!                       # and confine step (the state carried to the moved mesh)
+//! fit_contact_edge = true   # optional, instead: fitted once, to the last contact stage's end
+//! contact_edge_angle = 0.5  # optional, instead: fitted once at this angle from x = 0 (rad)
 //!
 //! [solver]              # optional
 //! wrinkling = "relaxed" # tension-field relaxation (default) | "none"
@@ -288,6 +292,11 @@ pub struct MeshSpec {
     /// the reference angle (radians, from the plates' symmetry line x = 0) where the fitted
     /// node line goes, instead of the one `fit_contact_edge` finds
     pub contact_edge_angle: Option<f64>,
+    /// the generated tube's hoop node lines moved onto the closed form's contact edges at
+    /// every step of each squeeze and confine stage (under the FE's own pressure), the state
+    /// carried over to the moved mesh ([`crate::edge_track`])
+    #[serde(default)]
+    pub track_contact_edge: bool,
 }
 
 impl MeshSpec {
@@ -856,6 +865,23 @@ impl Case {
                 "[mesh] `fit_contact_edge` and `contact_edge_angle` fit the capped tube (caps = \"hemisphere\"); the plugged tube is not fitted"
             );
         }
+        if m.track_contact_edge {
+            if m.file.is_some() {
+                invalid!(
+                    "[mesh] `track_contact_edge` moves the generated tube's node lines; a user mesh (`file`) places its own"
+                );
+            }
+            if self.geometry.caps != Caps::Hemisphere {
+                invalid!(
+                    "[mesh] `track_contact_edge` moves the capped tube's node lines (caps = \"hemisphere\"); the plugged tube is not fitted"
+                );
+            }
+            if m.fit_contact_edge || m.contact_edge_angle.is_some() {
+                invalid!(
+                    "[mesh] `track_contact_edge` fits the mesh at every step: drop `fit_contact_edge` and `contact_edge_angle`, which fit it once for the last stage's end"
+                );
+            }
+        }
         if let Some(a) = m.contact_edge_angle {
             if !(a.is_finite() && a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
                 invalid!(
@@ -897,6 +923,44 @@ impl Case {
             invalid!(
                 "[mesh] `fit_contact_edge` fits the mesh to a contact edge: the case has no squeeze or confine stage"
             );
+        }
+        if self.mesh.track_contact_edge {
+            let contact: Vec<usize> = (0..plan.len())
+                .filter(|&k| matches!(plan[k].target, Target::Rho(_) | Target::Confine(_)))
+                .collect();
+            if contact.is_empty() {
+                invalid!(
+                    "[mesh] `track_contact_edge` follows contact edges: the case has no squeeze or confine stage"
+                );
+            }
+            for &k in &contact {
+                let p = &plan[k];
+                if p.arc_length {
+                    invalid!(
+                        "[[stage]] {}: `control = \"arc-length\"` with `[mesh] track_contact_edge`: the tracked mesh moves between load steps, which the arc-length path does not take; use load stepping, or `fit_contact_edge`",
+                        k + 1
+                    );
+                }
+                if matches!(
+                    p.enforcement,
+                    Some(tubemem_fem::contact::Enforcement::Augmented { .. })
+                ) && p.contact_points != tubemem_fem::contact::ContactPoints::Nodal
+                {
+                    invalid!(
+                        "[[stage]] {}: `contact_points = \"gauss\"` with the augmented Lagrangian and `[mesh] track_contact_edge`: Gauss-point multipliers cannot be carried to a moved mesh; use the nodal points (the default)",
+                        k + 1
+                    );
+                }
+                if matches!(p.target, Target::Confine(_)) {
+                    let planes = &self.stages[k].plane;
+                    if !planes.iter().all(|q| q.mirrored_in(planes, 1)) {
+                        invalid!(
+                            "[mesh] `track_contact_edge`: the planes of [[stage]] {} are not symmetric about y = 0 (each plane's mirror image among them), which the closed form's contact edges need",
+                            k + 1
+                        );
+                    }
+                }
+            }
         }
         // the fit of a confine stage needs its walls symmetric about y = 0 (the closed form
         // leaves the section's rotation against the material free otherwise)

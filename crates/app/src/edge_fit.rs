@@ -35,7 +35,7 @@ pub struct Fit {
 }
 
 /// The plates' four edges (from the x axis) at `a` from their symmetry line x = 0.
-fn plate_edges(a: f64) -> Vec<f64> {
+pub(crate) fn plate_edges(a: f64) -> Vec<f64> {
     vec![FRAC_PI_2 - a, FRAC_PI_2 + a, 1.5 * PI - a, 1.5 * PI + a]
 }
 

@@ -22,6 +22,7 @@
 pub mod case;
 pub mod curves;
 pub mod edge_fit;
+pub mod edge_track;
 pub mod export;
 pub mod figures;
 pub mod main_job;

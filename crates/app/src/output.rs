@@ -32,7 +32,8 @@ use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
 arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
-augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation";
+augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,\
+mesh_refits";
 
 /// The `critical` column of steps.csv: the kind of a critical point located between the
 /// previous step and this one (empty: none).
@@ -186,6 +187,7 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
             .as_ref()
             .and_then(|c| c.values.flat_pressure_deviation),
     );
+    v.push(r.edge_tracking.as_ref().map(|t| t.refits as f64));
     v
 }
 

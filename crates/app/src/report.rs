@@ -120,6 +120,21 @@ pub struct StepRecord {
     /// last multiplier change
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub augmentation: Option<tubemem_fem::newton::Augmentation>,
+    /// a step of a squeeze or confine stage with `[mesh] track_contact_edge`: where the hoop
+    /// node lines were fitted at this step, and how often the mesh moved after its first solve
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_tracking: Option<EdgeTracking>,
+}
+
+/// Where the mesh of a step with `[mesh] track_contact_edge` was fitted
+/// ([`crate::edge_track`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EdgeTracking {
+    /// the contact edges the hoop node lines lie on (reference angles from the x axis,
+    /// radians; empty: the uniform mesh, no contact)
+    pub edges: Vec<f64>,
+    /// the times the mesh moved after the step's first solve, each followed by a re-solve
+    pub refits: usize,
 }
 
 /// A profile holds a bulge when its largest hoop stretch exceeds its smallest by more than this

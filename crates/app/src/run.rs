@@ -8,7 +8,7 @@ use tubemem_fem::contact::{penalty_for, Contact, Enforcement, MovingPlanes};
 use tubemem_fem::continuation::{run_arc_stage, ArcLoading, Critical, CriticalKind};
 use tubemem_fem::model::{nearest_node, Load, Loading, Model, State};
 use tubemem_fem::post::{cell_values, midspan, midspan_contact, ring_profile, Regime};
-use tubemem_fem::stepping::{run_stage_from, Stage, StageError, StepInfo, StepSettings};
+use tubemem_fem::stepping::{run_stage_refitted, Stage, StageError, StepInfo, StepSettings};
 use tubemem_fem::NewtonSettings;
 use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
@@ -226,6 +226,24 @@ impl RunOutcome {
             Some(e) => Err(e),
         }
     }
+}
+
+/// The contact edges a tracked mesh had at a checkpoint's step: its own stage's last record
+/// with them, else the finished stages' (`None`: never fitted, the uniform mesh).
+fn checkpoint_edges(ck: &Checkpoint) -> Option<Vec<f64>> {
+    ck.steps
+        .iter()
+        .rev()
+        .chain(
+            ck.report
+                .stages
+                .iter()
+                .rev()
+                .flat_map(|s| s.steps.iter().rev()),
+        )
+        .find_map(|r| r.edge_tracking.as_ref())
+        .map(|t| t.edges.clone())
+        .filter(|e| !e.is_empty())
 }
 
 /// Build the mesh a case asks for.
@@ -948,6 +966,20 @@ fn run_inner(
     model.set_factor_threads(case.solver.factor_threads);
     model.set_iteration_log(case.output.iterations);
     let mut state = model.reference_state();
+    // `[mesh] track_contact_edge`: the tube the tracker refits, and the edges it is fitted to
+    let tracking = case.mesh.track_contact_edge;
+    let tube = match (tracking, case.mesh.around, case.mesh.along) {
+        (true, Some(around), Some(along)) => Some(crate::edge_track::TubeSpec {
+            kind: case.mesh.element,
+            length: g.length / g.radius,
+            around,
+            along,
+            cap_rows: case.mesh.cap_rows.unwrap_or(around / 8),
+            symmetry: case.mesh.symmetry,
+        }),
+        _ => None,
+    };
+    let tracked_edges: crate::edge_track::Edges = Default::default();
     let v0 = model.multiplicity() * model.mesh().volume();
     let node = nearest_node(model.mesh(), [1.0, 0.0, 0.0]);
     let report = slot.insert(RunReport {
@@ -995,6 +1027,20 @@ fn run_inner(
         state.x.clone_from(&ck.x);
         state.p = ck.p;
         state.multipliers.clone_from(&ck.multipliers);
+        // a tracked mesh: fitted where the checkpoint's step had it
+        if let (Some(tube), Some(edges)) = (tube, checkpoint_edges(ck)) {
+            let nodes = tube.nodes(&edges).map_err(AppError::Mesh)?;
+            let n = nodes.len();
+            model
+                .move_reference(
+                    nodes,
+                    &tubemem_mesh::hoop::Transfer::identity(n),
+                    None,
+                    &mut [],
+                )
+                .map_err(AppError::Model)?;
+            *tracked_edges.borrow_mut() = edges;
+        }
     }
     for o in observers.iter_mut() {
         o.started(report, &model, &state)
@@ -1267,6 +1313,10 @@ fn run_inner(
                     fronts: step_fronts,
                     augmentation: matches!(plan.enforcement, Some(Enforcement::Augmented { .. }))
                         .then_some(info.newton.augmentation),
+                    edge_tracking: (tracking && closed_gas).then(|| crate::report::EdgeTracking {
+                        edges: tracked_edges.borrow().clone(),
+                        refits: info.refits,
+                    }),
                 };
                 steps.push(record);
                 let view = StepView {
@@ -1347,13 +1397,27 @@ fn run_inner(
             );
             found.map(|_| ())
         } else {
-            run_stage_from(
+            let mut tracker = tube
+                .filter(|_| closed_gas)
+                .map(|tube| crate::edge_track::Tracker {
+                    tube,
+                    law: closed_form_law.as_ref(),
+                    pressing: match &confine_planes {
+                        Some(planes) => crate::edge_track::Pressing::Walls(planes.clone()),
+                        None => crate::edge_track::Pressing::Plates,
+                    },
+                    edges: tracked_edges.clone(),
+                });
+            run_stage_refitted(
                 &mut model,
                 &mut state,
                 &stage,
                 progress,
                 &load,
                 &mut on_step,
+                tracker
+                    .as_mut()
+                    .map(|t| t as &mut dyn tubemem_fem::stepping::Refit),
             )
         };
         if let Err(e) = result {
