@@ -1,6 +1,7 @@
 """Convergence tables of the two membrane elements, inflation and contact, from one command:
 
     .venv/bin/python scripts/convergence-tables.py [--bin target/release/tubemem] [--out runs/convergence] [--quick]
+        [--part squeeze,squeeze6,confine] [--variants augmented+track,...]
 
 Every run is a case of the paper's tube (ABB N = 30, L/R = 20, eighth model unless said, along
 = 2.5 × around) on each mesh of each element's family (4-node bilinear, 9-node biquadratic:
@@ -12,19 +13,22 @@ Every run is a case of the paper's tube (ABB N = 30, L/R = 20, eighth model unle
      tolerance 1e-3), uniform mesh;
    - `augmented`: the default contact (augmented Lagrangian at the nodes, gap ≤ 1e-9 R),
      uniform mesh;
-   - `augmented+fit`: the same on the mesh fitted to the contact edge (`fit_contact_edge`), the
-     shipped case;
+   - `augmented+fit`: the same on the mesh fitted once to the contact edge at the squeeze's end
+     (`fit_contact_edge`);
+   - `augmented+track`: the same with the node lines following the contact edges at every
+     step (`track_contact_edge`), the shipped case;
    - `augmented-gauss+fit` (9-node, 16 and 32 around only): the augmented Lagrangian at the
      Gauss points, to show where it stalls.
    Columns: inflation ϖ, λz, N_z against GPS (eq. 66 at the FE's λs), the end-cap profile's
    largest |Δλs| against python_ref's scikit-fem axisymmetric tube (P2, 640 + 128 elements), and
    at the squeeze's end λs, λz, χ and the force against the GPS section under the FE's own
-   mid-span pressure (eq. 76 without the gas law), the flat zone's max |p_c/ϖ − 1| at
-   mid-span, the largest penetration over the squeeze's steps and the most multiplier updates
-   in a step.
+   mid-span pressure (eq. 76 without the gas law), the largest χ error over the squeeze's steps,
+   the flat zone's max |p_c/ϖ − 1| at mid-span, the largest penetration over the squeeze's
+   steps and the most multiplier updates in a step.
 2. **Squeeze, λs* = 6 → ρ = 3** (`cases/squeeze_abb30_ls6.0.toml`, default contact, uniform).
 3. **Confinement**: the channel and the V-groove (`cases/channel_abb30_ls1.3.toml`,
-   `cases/vgroove_abb30_ls1.3.toml`, default contact, fitted), λs, λz and every wall's force
+   `cases/vgroove_abb30_ls1.3.toml`, default contact; `track` as shipped, `fit` fitted once
+   at the end), λs, λz and every wall's force
    against the section in the same walls under the FE's pressure: at the end (worst wall) and
    the worst over the steps where the walls carry a flat; and the V-groove at L/R = 40 (32 and
    64 around), to separate the end effect from the discretization.
@@ -161,9 +165,13 @@ def squeeze_row(d, s):
     last = np.where(sq)[0][-1]
     e = lambda q: float(st[q][last] / st[f"local_{q}"][last] - 1.0)
     aug = st["augmentations"][sq]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        steps = st["chi"][sq] / st["local_chi"][sq] - 1.0
+    steps = steps[np.isfinite(steps)]
     return {
         "sq_lambda_s": e("lambda_s"), "sq_lambda_z": e("lambda_z"),
         "sq_chi": e("chi"), "sq_force": e("force"),
+        "sq_chi_steps": float(steps[np.argmax(np.abs(steps))]) if steps.size else math.nan,
         "flat_pressure": float(st["flat_pressure_deviation"][last]),
         "penetration": float(np.nanmax(st["penetration"][sq])),
         "updates": float(np.nanmax(aug)) if np.isfinite(aug).any() else math.nan,
@@ -223,12 +231,16 @@ def table(title, rows, cols, names, arounds_key="around"):
     return lines
 
 
+UNIFORM = {"fit_contact_edge": None, "track_contact_edge": None}
+FIT = {"fit_contact_edge": True, "track_contact_edge": None}
 VARIANTS = {
-    "penalty": ({"fit_contact_edge": None}, {"contact_method": "penalty"}),
-    "augmented": ({"fit_contact_edge": None}, {}),
-    "augmented+fit": ({"fit_contact_edge": True}, {}),
-    "augmented-gauss+fit": ({"fit_contact_edge": True}, {"contact_points": "gauss"}),
+    "penalty": (UNIFORM, {"contact_method": "penalty"}),
+    "augmented": (UNIFORM, {}),
+    "augmented+fit": (FIT, {}),
+    "augmented+track": ({}, {}),
+    "augmented-gauss+fit": (FIT, {"contact_points": "gauss"}),
 }
+CONFINE_VARIANTS = {"track": {}, "fit": FIT}
 
 
 def main(argv=None):
@@ -236,9 +248,16 @@ def main(argv=None):
     ap.add_argument("--bin", default=str(ROOT / "target/release/tubemem"))
     ap.add_argument("--out", default=str(ROOT / "runs/convergence"))
     ap.add_argument("--quick", action="store_true", help="16, 32, 64 around only")
+    ap.add_argument("--part", default="squeeze,squeeze6,confine",
+                    help="which tables: squeeze, squeeze6, confine (comma-separated)")
+    ap.add_argument("--variants", default=",".join(VARIANTS),
+                    help="the squeeze's contact variants (comma-separated)")
+    ap.add_argument("--elements", default="quad4,quad9", help="comma-separated")
     a = ap.parse_args(argv)
+    parts = set(a.part.split(","))
+    variants = {k: VARIANTS[k] for k in a.variants.split(",")}
     out = pathlib.Path(a.out)
-    fams = QUICK if a.quick else FAMILIES
+    fams = {k: v for k, v in (QUICK if a.quick else FAMILIES).items() if k in a.elements.split(",")}
     ref = reference_profile(640, 128)
     ref_half = reference_profile(320, 64)
     ref_err = float(np.abs(np.interp(ref_half[0], *ref) - ref_half[1]).max())
@@ -249,11 +268,12 @@ def main(argv=None):
              "penetration's (in R); p is the observed order between a mesh and the one before it.",
              f"The axisymmetric reference (640 + 128 P2 elements) differs from itself at half resolution by {ref_err:.1e} in λs.", ""]
     base = "squeeze_abb30_ls1.3_quad9.toml"
-    sq_cols = ["sq_lambda_s", "sq_lambda_z", "sq_chi", "sq_force", "flat_pressure", "penetration", "updates"]
-    sq_names = ["λs", "λz", "χ", "force", "max abs(p_c/ϖ − 1)", "max penetration", "updates/step"]
+    sq_cols = ["sq_lambda_s", "sq_lambda_z", "sq_chi", "sq_force", "sq_chi_steps", "flat_pressure", "penetration",
+               "updates"]
+    sq_names = ["λs", "λz", "χ", "force", "χ, worst step", "max abs(p_c/ϖ − 1)", "max penetration", "updates/step"]
     inf_cols = ["w", "lambda_z", "n_z", "profile"]
-    for element, arounds in fams.items():
-        for variant, (mesh, stage) in VARIANTS.items():
+    for element, arounds in (fams if "squeeze" in parts else {}).items():
+        for variant, (mesh, stage) in variants.items():
             ns = arounds if variant != "augmented-gauss+fit" else ([16, 32] if element == "quad9" else [])
             rows = []
             for n in ns:
@@ -270,12 +290,12 @@ def main(argv=None):
             if not rows:
                 continue
             results["squeeze"].setdefault(element, {})[variant] = rows
-            if variant == "augmented+fit":
+            if variant == "augmented+track":
                 lines += table(f"{element}: inflation to λs* = 1.3 (against GPS) and its end-cap profile",
                                rows, inf_cols, ["ϖ", "λz", "N_z", "profile max Δλs"])
             lines += table(f"{element}, squeeze to ρ = 0.8, {variant}: the end against the section at the FE's pressure",
                            rows, sq_cols, sq_names)
-    for element, arounds in fams.items():
+    for element, arounds in (fams if "squeeze6" in parts else {}).items():
         rows = []
         for n in arounds:
             d, wall, s, err = run_one(a.bin, out, f"sq6_{element}_{n}",
@@ -289,21 +309,24 @@ def main(argv=None):
         lines += table(f"{element}, λs* = 6 squeezed to ρ = 3 (default contact, uniform mesh)", rows, sq_cols, sq_names)
     c_cols = ["lambda_s", "lambda_z", "wall_force_end", "wall_force_steps", "penetration", "updates"]
     c_names = ["λs", "λz", "wall force, end", "wall force, worst step", "max penetration", "updates/step"]
-    for base, label in [("channel_abb30_ls1.3.toml", "channel"), ("vgroove_abb30_ls1.3.toml", "V-groove")]:
+    confine = [("channel_abb30_ls1.3.toml", "channel"), ("vgroove_abb30_ls1.3.toml", "V-groove")]
+    for base, label in (confine if "confine" in parts else []):
         for element, arounds in fams.items():
-            rows = []
-            for n in arounds:
-                d, wall, s, err = run_one(a.bin, out, f"{label}_{element}_{n}", case_text(base, element, n))
-                row = {"around": n, "wall_s": wall, "error": err}
-                if s is not None:
-                    row["equations"] = s["mesh"]["equations"]
-                    row.update(confine_row(d, s))
-                rows.append(row)
-            results["confine"].setdefault(label, {})[element] = rows
-            lines += table(f"{element}, {label} (fitted): the end against the section in the walls at the FE's pressure",
-                           rows, c_cols, c_names)
+            for variant, mesh in CONFINE_VARIANTS.items():
+                rows = []
+                for n in arounds:
+                    d, wall, s, err = run_one(a.bin, out, f"{label}_{element}_{variant}_{n}",
+                                              case_text(base, element, n, mesh))
+                    row = {"around": n, "wall_s": wall, "error": err}
+                    if s is not None:
+                        row["equations"] = s["mesh"]["equations"]
+                        row.update(confine_row(d, s))
+                    rows.append(row)
+                results["confine"].setdefault(label, {}).setdefault(element, {})[variant] = rows
+                lines += table(f"{element}, {label} ({variant}): the end against the section in the walls at the "
+                               "FE's pressure", rows, c_cols, c_names)
     rows = []
-    for n in [32, 64]:
+    for n in ([32, 64] if "confine" in parts else []):
         d, wall, s, err = run_one(a.bin, out, f"V-groove_quad9_{n}_lr40",
                                   case_text("vgroove_abb30_ls1.3.toml", "quad9", n, length=40.0))
         row = {"around": n, "wall_s": wall, "error": err}
@@ -311,8 +334,9 @@ def main(argv=None):
             row["equations"] = s["mesh"]["equations"]
             row.update(confine_row(d, s))
         rows.append(row)
-    results["confine"]["V-groove L/R = 40"] = {"quad9": rows}
-    lines += table("quad9, V-groove at L/R = 40 (along = 5 × around)", rows, c_cols, c_names)
+    if rows:
+        results["confine"]["V-groove L/R = 40"] = {"quad9": rows}
+        lines += table("quad9, V-groove at L/R = 40 (along = 5 × around, tracked)", rows, c_cols, c_names)
     text = "\n".join(lines)
     print(text)
     out.mkdir(parents=True, exist_ok=True)

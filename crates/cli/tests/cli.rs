@@ -1285,7 +1285,7 @@ fn walls_that_never_touch_print_no_nan() {
     let case = d.join("far.toml");
     let text = include_str!("../../../cases/channel_abb30_ls1.3.toml")
         .replace("element = \"quad9\"", "")
-        .replace("fit_contact_edge = true", "")
+        .replace("track_contact_edge = true", "")
         .replace("around = 32", "around = 16")
         .replace("along = 80", "along = 40")
         .replace("target = 1.1", "target = 1.34")
@@ -1301,8 +1301,47 @@ fn walls_that_never_touch_print_no_nan() {
     assert!(!out.contains("NaN"), "{out}");
 }
 
-/// Restart of a run on a mesh fitted to its contact edge (`fit_contact_edge`, the main job's
-/// 9-node case): the resumed run rebuilds the same mesh from its locating solve
+/// Restart of a run whose node lines follow the contact edges (`track_contact_edge`, the main
+/// job's case as shipped): killed after its second squeeze step, the resumed run rebuilds the
+/// mesh where the checkpoint's step had fitted it and continues bit-identical to an
+/// uninterrupted run: steps.csv (with its `mesh_refits`), summary.json, the PVD index and every
+/// VTU frame (each frame is drawn on its own step's mesh).
+#[test]
+fn a_killed_tracked_run_resumes_bit_identical() {
+    let d = tmp("resume-tracked");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml"),
+    )
+    .unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    assert!(run_in(&case, &reference, &[]).status.success());
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
+    });
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let steps = std::fs::read_to_string(killed.join("steps.csv")).unwrap();
+    assert!(steps.lines().next().unwrap().ends_with(",mesh_refits"));
+    for f in ["steps.csv", "summary.json", "tube.pvd"] {
+        assert!(
+            std::fs::read(reference.join(f)).unwrap() == std::fs::read(killed.join(f)).unwrap(),
+            "{f} differs after the restart"
+        );
+    }
+    for f in std::fs::read_dir(reference.join("vtu")).unwrap() {
+        let name = f.unwrap().file_name();
+        assert!(
+            std::fs::read(reference.join("vtu").join(&name)).unwrap()
+                == std::fs::read(killed.join("vtu").join(&name)).unwrap(),
+            "{name:?} differs"
+        );
+    }
+}
+
+/// Restart of a run on a mesh fitted once to its contact edge (`fit_contact_edge`, on the main
+/// job's 9-node case): the resumed run rebuilds the same mesh from its locating solve
 /// (deterministic), takes the augmented contact's multipliers from the checkpoint, and ends
 /// bit-identical to an uninterrupted run (steps.csv, summary.json with its `contact_edge_fit`).
 #[test]
@@ -1311,7 +1350,8 @@ fn a_killed_fitted_run_resumes_bit_identical() {
     let case = d.join("case.toml");
     std::fs::write(
         &case,
-        include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml").to_string()
+        include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml")
+            .replace("track_contact_edge = true", "fit_contact_edge = true")
             + "\n[output]\nvtu = \"none\"\n",
     )
     .unwrap();
