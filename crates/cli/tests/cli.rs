@@ -502,7 +502,7 @@ fn run_writes_steps_summary_profiles_and_vtu() {
          gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,\
          local_lambda_s,local_lambda_z,local_chi,local_force,\
          arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
-         augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation"
+         augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,mesh_refits"
     );
     let empty_for_inflation = [
         "rho",
