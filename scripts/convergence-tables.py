@@ -1,7 +1,7 @@
 """Convergence tables of the two membrane elements, inflation and contact, from one command:
 
     .venv/bin/python scripts/convergence-tables.py [--bin target/release/tubemem] [--out runs/convergence] [--quick]
-        [--part squeeze,squeeze6,confine] [--variants augmented+track,...]
+        [--part squeeze,squeeze6,confine] [--variants augmented+track,...] [--confine-variants track,fit]
 
 Every run is a case of the paper's tube (ABB N = 30, L/R = 20, eighth model unless said, along
 = 2.5 × around) on each mesh of each element's family (4-node bilinear, 9-node biquadratic:
@@ -253,6 +253,8 @@ def main(argv=None):
     ap.add_argument("--variants", default=",".join(VARIANTS),
                     help="the squeeze's contact variants (comma-separated)")
     ap.add_argument("--elements", default="quad4,quad9", help="comma-separated")
+    ap.add_argument("--confine-variants", default=",".join(CONFINE_VARIANTS),
+                    help="the confinement's mesh variants: track, fit (comma-separated)")
     a = ap.parse_args(argv)
     parts = set(a.part.split(","))
     variants = {k: VARIANTS[k] for k in a.variants.split(",")}
@@ -312,7 +314,7 @@ def main(argv=None):
     confine = [("channel_abb30_ls1.3.toml", "channel"), ("vgroove_abb30_ls1.3.toml", "V-groove")]
     for base, label in (confine if "confine" in parts else []):
         for element, arounds in fams.items():
-            for variant, mesh in CONFINE_VARIANTS.items():
+            for variant, mesh in ((k, CONFINE_VARIANTS[k]) for k in a.confine_variants.split(",")):
                 rows = []
                 for n in arounds:
                     d, wall, s, err = run_one(a.bin, out, f"{label}_{element}_{variant}_{n}",

@@ -161,4 +161,12 @@ impl tubemem_fem::stepping::Refit for Tracker<'_> {
         *self.edges.borrow_mut() = edges;
         Ok(Some(nodes))
     }
+
+    fn snapshot(&self) -> Vec<f64> {
+        self.edges.borrow().clone()
+    }
+
+    fn restore(&mut self, snapshot: &[f64]) {
+        *self.edges.borrow_mut() = snapshot.to_vec();
+    }
 }

@@ -109,7 +109,9 @@ pub struct StepInfo<'a> {
 /// (on the secant prediction) and after it converges, the stepping asks for the nodes the
 /// model should have; when they differ it moves the model there
 /// ([`Model::move_reference`]), carries the states over and, after a converged solve, solves
-/// again, up to [`MAX_REFITS`] times a step.
+/// again, up to [`MAX_REFITS`] times a step. Where a solve on a moved mesh fails, the step goes
+/// back to the mesh it came from: a failed first solve is tried again there (then cut back as
+/// any other), a failed re-solve keeps the step's converged state on its own mesh.
 pub trait Refit {
     /// The reference nodes the model should have at load value `value` with `state`, or
     /// `None` when the current ones do.
@@ -119,6 +121,52 @@ pub trait Refit {
         state: &State,
         value: f64,
     ) -> Result<Option<Vec<[f64; 3]>>, FemError>;
+    /// What the refit needs to go back to the mesh it has now (its fitted edges).
+    fn snapshot(&self) -> Vec<f64>;
+    /// Go back to a [`Refit::snapshot`] (the stepping has put the model's mesh back).
+    fn restore(&mut self, snapshot: &[f64]);
+}
+
+/// A reference mesh and the states on it, kept to go back to ([`run_stage_refitted`]).
+struct Fixed {
+    nodes: Vec<[f64; 3]>,
+    refit: Vec<f64>,
+    state: State,
+    previous: Option<State>,
+}
+
+impl Fixed {
+    fn take(model: &Model, refit: &dyn Refit, state: &State, previous: &Option<State>) -> Self {
+        Self {
+            nodes: model.mesh().nodes.clone(),
+            refit: refit.snapshot(),
+            state: state.clone(),
+            previous: previous.clone(),
+        }
+    }
+
+    /// Whether the model's mesh is no longer this one.
+    fn moved(&self, model: &Model) -> bool {
+        model.mesh().nodes != self.nodes
+    }
+
+    /// Put the model, the refit and the states back.
+    fn restore(
+        &self,
+        model: &mut Model,
+        refit: &mut dyn Refit,
+        state: &mut State,
+        previous: &mut Option<State>,
+    ) -> Result<(), FemError> {
+        if self.moved(model) {
+            let identity = tubemem_mesh::hoop::Transfer::identity(self.nodes.len());
+            model.move_reference(self.nodes.clone(), &identity, None, &mut [])?;
+        }
+        refit.restore(&self.refit);
+        state.clone_from(&self.state);
+        previous.clone_from(&self.previous);
+        Ok(())
+    }
 }
 
 /// The re-solves after moving the mesh allowed in one step: 3. Each move follows the
@@ -249,10 +297,11 @@ pub fn run_stage_refitted<E>(
             lambda + dl
         };
         let value = from + (to - from) * next;
-        let mut trial = match (&previous, previous_lambda) {
+        let predict = |state: &State, previous: &Option<State>| match (previous, previous_lambda) {
             (Some(prev), Some(l0)) if lambda > l0 => secant(state, prev, l0, lambda, next),
             _ => state.clone(),
         };
+        let mut trial = predict(state, &previous);
         let l = load(value);
         let mut refits = 0;
         let moved = |source: FemError| crate::newton::NewtonError::Problem {
@@ -262,6 +311,11 @@ pub fn run_stage_refitted<E>(
         // the step's difficulty for the step-size control: its first solve's iterations
         let mut difficulty = 0;
         let solved: Result<NewtonReport, crate::newton::NewtonError<FemError>> = (|| {
+            // the mesh before the step's first move, to go back to where a solve on a moved
+            // mesh fails: the step is then solved (or cut back) on the mesh it came from
+            let before = refit
+                .as_deref()
+                .map(|r| Fixed::take(model, r, state, &previous));
             if let Some(r) = refit.as_deref_mut() {
                 let at = trial.clone();
                 let mut carried: Vec<&mut State> = vec![&mut trial, &mut *state];
@@ -270,12 +324,27 @@ pub fn run_stage_refitted<E>(
                 }
                 follow(model, r, value, &at, &l, &mut carried).map_err(moved)?;
             }
-            let mut report = model.solve(&mut trial, &l)?;
+            let mut report = match model.solve(&mut trial, &l) {
+                Ok(r) => r,
+                Err(e) => {
+                    let (Some(b), Some(r)) = (&before, refit.as_deref_mut()) else {
+                        return Err(e);
+                    };
+                    if !b.moved(model) || matches!(e.cause(), Some(FemError::Interrupted)) {
+                        return Err(e);
+                    }
+                    b.restore(model, r, state, &mut previous).map_err(moved)?;
+                    trial = predict(state, &previous);
+                    model.solve(&mut trial, &l)?
+                }
+            };
             difficulty = report.load_iterations();
             while let Some(r) = refit.as_deref_mut() {
                 if refits == MAX_REFITS {
                     break;
                 }
+                let converged = Fixed::take(model, r, state, &previous);
+                let kept = trial.clone();
                 let at = trial.clone();
                 let mut carried: Vec<&mut State> = vec![&mut trial, &mut *state];
                 if let Some(p) = previous.as_mut() {
@@ -284,8 +353,20 @@ pub fn run_stage_refitted<E>(
                 if !follow(model, r, value, &at, &l, &mut carried).map_err(moved)? {
                     break;
                 }
+                let again = match model.solve(&mut trial, &l) {
+                    Ok(again) => again,
+                    Err(e) if matches!(e.cause(), Some(FemError::Interrupted)) => return Err(e),
+                    Err(_) => {
+                        // the re-solve on the moved mesh failed: keep the step's converged
+                        // state on the mesh it converged on
+                        converged
+                            .restore(model, r, state, &mut previous)
+                            .map_err(moved)?;
+                        trial = kept;
+                        break;
+                    }
+                };
                 refits += 1;
-                let again = model.solve(&mut trial, &l)?;
                 // the step's iterations and updates are all its solves'; the state's own
                 // measures (residual, inertia, gap) the last one's
                 let (iterations, updates, augmenting) = (
