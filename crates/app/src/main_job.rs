@@ -152,7 +152,7 @@ impl MainJob {
         let _ = writeln!(
             t,
             "(FE−GPS(ϖ): the force's relative error against the GPS section under the FE's own pressure, eq. 76 without the gas law;\n \
-             the mesh is fitted to the last step's contact edge, so that step verifies at the element's order and the earlier ones at order 1.\n \
+             the hoop node lines follow the contact edges at every step, so every step verifies at the element's order, the first (its flat a fraction of an element wide) least.\n \
              The FE differs from GPS mostly by the end effect, which acts through the gas: the ends keep gas the plates do not squeeze; see the README)"
         );
         t

@@ -22,7 +22,7 @@ use tubemem_cli::gps_cmd;
     name = "tubemem",
     version,
     about = "Verification suite for pressurized membrane tubes: closed-form generalized plane strain (GPS) and plane strain (PS)",
-    long_about = "Verification suite for pressurized membrane tubes.\n\nWith no subcommand, runs the main job: the paper's example (Anssari-Benam–Bucchi law, 𝒩 = 30) in 3D on the embedded default case cases/squeeze_abb30_ls1.3_quad9.toml (9-node elements fitted to the contact edge; inflation to λs* = 1.3, gas closed in, squeeze to ρ = 0.8), compared with the GPS and PS closed forms, and the figures with the FE points, all written to ./tubemem-out."
+    long_about = "Verification suite for pressurized membrane tubes.\n\nWith no subcommand, runs the main job: the paper's example (Anssari-Benam–Bucchi law, 𝒩 = 30) in 3D on the embedded default case cases/squeeze_abb30_ls1.3_quad9.toml (9-node elements, the node lines following the contact edges; inflation to λs* = 1.3, gas closed in, squeeze to ρ = 0.8), compared with the GPS and PS closed forms, and the figures with the FE points, all written to ./tubemem-out."
 )]
 struct Cli {
     #[command(subcommand)]
