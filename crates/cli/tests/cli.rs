@@ -1201,6 +1201,26 @@ fn nonsense_is_refused_and_small_targets_work() {
     }
 }
 
+/// `files` of run folder `b` byte-identical to `a`'s, and with `frames` every VTU frame too.
+fn assert_same_run(a: &Path, b: &Path, files: &[&str], frames: bool) {
+    for f in files {
+        assert!(
+            std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
+            "{f} differs after the restart"
+        );
+    }
+    if frames {
+        for f in std::fs::read_dir(a.join("vtu")).unwrap() {
+            let name = f.unwrap().file_name();
+            assert!(
+                std::fs::read(a.join("vtu").join(&name)).unwrap()
+                    == std::fs::read(b.join("vtu").join(&name)).unwrap(),
+                "{name:?} differs"
+            );
+        }
+    }
+}
+
 /// Start `tubemem run CASE --out OUT` and kill it (SIGKILL) once its steps.csv satisfies `done`
 /// (or after 60 s); a run that finished meanwhile has nothing to kill.
 fn run_and_kill(case: &Path, out: &Path, done: impl Fn(&str) -> bool) {
@@ -1260,21 +1280,12 @@ fn a_killed_run_resumes_bit_identical() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("the case has changed"));
     let o = run_in(&case, &killed, &["--resume"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["steps.csv", "summary.json", "tube.pvd"] {
-        assert!(
-            std::fs::read(reference.join(f)).unwrap() == std::fs::read(killed.join(f)).unwrap(),
-            "{f} differs after the restart"
-        );
-    }
-    let frames: Vec<_> = std::fs::read_dir(reference.join("vtu")).unwrap().collect();
-    for f in frames {
-        let name = f.unwrap().file_name();
-        assert!(
-            std::fs::read(reference.join("vtu").join(&name)).unwrap()
-                == std::fs::read(killed.join("vtu").join(&name)).unwrap(),
-            "{name:?} differs"
-        );
-    }
+    assert_same_run(
+        &reference,
+        &killed,
+        &["steps.csv", "summary.json", "tube.pvd"],
+        true,
+    );
 }
 
 /// Issue #25, class 5: a confine stage whose walls never touch the tube prints no `NaN%` (the
@@ -1324,20 +1335,12 @@ fn a_killed_tracked_run_resumes_bit_identical() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let steps = std::fs::read_to_string(killed.join("steps.csv")).unwrap();
     assert!(steps.lines().next().unwrap().ends_with(",mesh_refits"));
-    for f in ["steps.csv", "summary.json", "tube.pvd"] {
-        assert!(
-            std::fs::read(reference.join(f)).unwrap() == std::fs::read(killed.join(f)).unwrap(),
-            "{f} differs after the restart"
-        );
-    }
-    for f in std::fs::read_dir(reference.join("vtu")).unwrap() {
-        let name = f.unwrap().file_name();
-        assert!(
-            std::fs::read(reference.join("vtu").join(&name)).unwrap()
-                == std::fs::read(killed.join("vtu").join(&name)).unwrap(),
-            "{name:?} differs"
-        );
-    }
+    assert_same_run(
+        &reference,
+        &killed,
+        &["steps.csv", "summary.json", "tube.pvd"],
+        true,
+    );
 }
 
 /// Restart of a run on a mesh fitted once to its contact edge (`fit_contact_edge`, on the main
@@ -1362,12 +1365,7 @@ fn a_killed_fitted_run_resumes_bit_identical() {
     });
     let o = run_in(&case, &killed, &["--resume"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["steps.csv", "summary.json"] {
-        assert!(
-            std::fs::read(reference.join(f)).unwrap() == std::fs::read(killed.join(f)).unwrap(),
-            "{f} differs after the restart"
-        );
-    }
+    assert_same_run(&reference, &killed, &["steps.csv", "summary.json"], false);
     let s: Value =
         serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())
             .unwrap();
