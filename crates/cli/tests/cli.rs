@@ -1201,6 +1201,21 @@ fn nonsense_is_refused_and_small_targets_work() {
     }
 }
 
+/// Run `text` (a case with a squeeze as its second stage) in a fresh folder `name` to the end
+/// (`ref`) and again killed (SIGKILL) after its second squeeze step (`killed`); returns the
+/// case file and both run folders.
+fn killed_in_its_squeeze(name: &str, text: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let d = tmp(name);
+    let case = d.join("case.toml");
+    std::fs::write(&case, text).unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    assert!(run_in(&case, &reference, &[]).status.success());
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
+    });
+    (case, reference, killed)
+}
+
 /// `files` of run folder `b` byte-identical to `a`'s, and with `frames` every VTU frame too.
 fn assert_same_run(a: &Path, b: &Path, files: &[&str], frames: bool) {
     for f in files {
@@ -1253,19 +1268,11 @@ fn run_and_kill(case: &Path, out: &Path, done: impl Fn(&str) -> bool) {
 /// refused on resume.
 #[test]
 fn a_killed_run_resumes_bit_identical() {
-    let d = tmp("resume");
-    let case = d.join("case.toml");
-    std::fs::write(
-        &case,
+    let (case, reference, killed) = killed_in_its_squeeze(
+        "resume",
         include_str!("../../../cases/squeeze_abb30_ls1.3.toml"),
-    )
-    .unwrap();
-    let (reference, killed) = (d.join("ref"), d.join("killed"));
-    assert!(run_in(&case, &reference, &[]).status.success());
-    // kill it after its second squeeze step
-    run_and_kill(&case, &killed, |steps| {
-        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
-    });
+    );
+    let d = case.parent().unwrap().to_path_buf();
     let o = run_in(&case, &killed, &[]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("was killed"));
     let changed = d.join("changed.toml");
@@ -1319,18 +1326,10 @@ fn walls_that_never_touch_print_no_nan() {
 /// VTU frame (each frame is drawn on its own step's mesh).
 #[test]
 fn a_killed_tracked_run_resumes_bit_identical() {
-    let d = tmp("resume-tracked");
-    let case = d.join("case.toml");
-    std::fs::write(
-        &case,
+    let (case, reference, killed) = killed_in_its_squeeze(
+        "resume-tracked",
         include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml"),
-    )
-    .unwrap();
-    let (reference, killed) = (d.join("ref"), d.join("killed"));
-    assert!(run_in(&case, &reference, &[]).status.success());
-    run_and_kill(&case, &killed, |steps| {
-        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
-    });
+    );
     let o = run_in(&case, &killed, &["--resume"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let steps = std::fs::read_to_string(killed.join("steps.csv")).unwrap();
