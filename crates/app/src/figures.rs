@@ -738,7 +738,7 @@ pub fn write_all(
             });
         }
     }
-    std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
+    crate::output_file::create_folder(dir)?;
     let built = spec.build()?;
     let law = built.as_ref();
     let name = law_label(&spec);

@@ -27,6 +27,7 @@ pub mod export;
 pub mod figures;
 pub mod main_job;
 pub mod output;
+pub mod output_file;
 pub mod report;
 pub mod run;
 pub mod verify;
@@ -135,6 +136,12 @@ pub enum AppError {
     Interrupted { stage: usize, steps: usize },
     #[error("output folder {}: {message}", path.display())]
     Folder { path: PathBuf, message: String },
+    #[error("{key} {}: {message}", path.display())]
+    OutputFile {
+        key: &'static str,
+        path: PathBuf,
+        message: String,
+    },
     #[error("an observer stopped the run at stage {stage}, step {step}")]
     Observer {
         stage: usize,
@@ -177,6 +184,7 @@ impl AppError {
                 | AppError::StageInput { .. }
                 | AppError::TooLarge { .. }
                 | AppError::Folder { .. }
+                | AppError::OutputFile { .. }
                 | AppError::Overlay { .. }
         )
     }

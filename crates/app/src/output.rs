@@ -394,7 +394,7 @@ impl RunWriter {
             path: dir.to_path_buf(),
             message,
         };
-        std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
+        crate::output_file::create_folder(dir)?;
         let writer = Self::create_locked(dir, case_hash)?;
         let present: Vec<&str> = RUN_ENTRIES
             .iter()

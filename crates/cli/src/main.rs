@@ -166,6 +166,38 @@ fn run_case(
     log: Option<&std::path::Path>,
 ) -> Result<()> {
     let case = Case::read(case_path).map_err(|e| app(e.into()))?;
+    // the log is checked before the run folder is touched
+    if let Some(path) = log {
+        let inputs = tubemem_app::output_file::case_inputs(case_path, &case);
+        let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+        tubemem_app::output_file::check("--log", path, &inputs, tubemem_app::output_file::is_log)
+            .map_err(app)?;
+        // the run folder may not exist yet: compare absolute paths, canonical where they exist
+        let resolved = |p: &std::path::Path| {
+            p.canonicalize()
+                .or_else(|_| {
+                    let parent = p.parent().filter(|d| !d.as_os_str().is_empty());
+                    match (parent.map(|d| d.canonicalize()), p.file_name()) {
+                        (Some(Ok(d)), Some(n)) => Ok(d.join(n)),
+                        _ => std::path::absolute(p),
+                    }
+                })
+                .ok()
+        };
+        if resolved(path)
+            .zip(resolved(out))
+            .is_some_and(|(p, o)| p.starts_with(o))
+        {
+            return Err(app(tubemem_app::AppError::OutputFile {
+                key: "--log",
+                path: path.to_path_buf(),
+                message: format!(
+                    "is inside the run folder {}, whose files the run writes and replaces: give a path outside it",
+                    out.display()
+                ),
+            }));
+        }
+    }
     let (mut writer, checkpoint) = if resume {
         let (w, ck) = RunWriter::resume(out, case.hash()).map_err(app)?;
         tubemem_cli::say!(
@@ -253,6 +285,15 @@ fn run(cli: Cli) -> Result<()> {
             bulk_ratio,
         }) => {
             let c = Case::read(&case).map_err(|e| app(e.into()))?;
+            let inputs = tubemem_app::output_file::case_inputs(&case, &c);
+            let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+            tubemem_app::output_file::check(
+                "export --out",
+                &out,
+                &inputs,
+                tubemem_app::output_file::is_deck,
+            )
+            .map_err(app)?;
             let shell = match element {
                 ExportElement::S4 => tubemem_app::export::ShellChoice::S4,
                 ExportElement::M3d4 => tubemem_app::export::ShellChoice::M3d4,

@@ -1876,3 +1876,88 @@ fn gps_confine_by_any_planes() {
         "expected three numbers nx,ny,d",
     );
 }
+
+/// Issue #25, class 4: `run --log` and `export --out` never write over an input (the case file,
+/// however spelled), a folder, a file tubemem did not write, or (the log) a file inside the run
+/// folder; each refusal comes before anything is written and names the key, the path and why.
+/// Their own earlier files are replaced. An output folder given as a file is refused as such.
+#[test]
+fn single_file_outputs_never_destroy_inputs_or_foreign_files() {
+    let case = write_case(
+        "output-files",
+        &SMALL_CASE
+            .replace("model = \"abb\"", "model = \"neo-hookean\"")
+            .replace("kuhn = 30\n", ""),
+    );
+    let d = case.parent().unwrap().to_path_buf();
+    let original = std::fs::read(&case).unwrap();
+    let foreign = d.join("notes.txt");
+    std::fs::write(&foreign, "my notes\n").unwrap();
+    let (c, out) = (case.to_str().unwrap(), d.join("run"));
+    let o = out.to_str().unwrap();
+    let dot_case = format!("{}/./case.toml", d.display());
+    for (log, why) in [
+        (c, "is the input"),
+        (dot_case.as_str(), "is the input"),
+        (
+            foreign.to_str().unwrap(),
+            "not written by this tubemem command",
+        ),
+        (d.to_str().unwrap(), "is a folder"),
+        (&*format!("{o}/steps.csv"), "inside the run folder"),
+    ] {
+        let r = tubemem(&["run", c, "--out", o, "--log", log]);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(
+            !r.status.success() && err.contains("--log") && err.contains(why),
+            "{log}: {err}"
+        );
+        assert!(
+            !out.exists(),
+            "{log}: the run folder was created before the refusal"
+        );
+    }
+    let log = d.join("run.log");
+    for _ in 0..2 {
+        let r = tubemem(&[
+            "run",
+            c,
+            "--out",
+            o,
+            "--overwrite",
+            "--log",
+            log.to_str().unwrap(),
+        ]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    for (deck, why) in [
+        (c, "is the input"),
+        (foreign.to_str().unwrap(), "not written by"),
+    ] {
+        let r = tubemem(&["export", c, "--out", deck]);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(
+            !r.status.success() && err.contains("export --out") && err.contains(why),
+            "{err}"
+        );
+    }
+    let deck = d.join("tube.inp");
+    for _ in 0..2 {
+        let r = tubemem(&["export", c, "--out", deck.to_str().unwrap()]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    // issue #25, class 6: an output folder that is a file says so (it said "File exists")
+    for args in [
+        vec!["run", c, "--out", foreign.to_str().unwrap()],
+        vec!["figures", "--out", foreign.to_str().unwrap()],
+    ] {
+        let r = tubemem(&args);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(
+            !r.status.success() && err.contains("is a file, not a folder"),
+            "{err}"
+        );
+    }
+    assert_eq!(std::fs::read(&case).unwrap(), original);
+    assert_eq!(std::fs::read_to_string(&foreign).unwrap(), "my notes\n");
+}

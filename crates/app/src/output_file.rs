@@ -1,0 +1,117 @@
+//! One policy for the paths a command writes: the output folders (`run --out`, `figures
+//! --out`) must be folders ([`create_folder`]), and the single files it writes beside a run
+//! folder (`run --log`, `export --out`): such a file is written only where it cannot destroy an input or a file
+//! tubemem did not write. Checked before anything is written:
+//! - a folder at the path is refused ("is a folder");
+//! - the path of an input (the case file, a user mesh file), however it is spelled, is refused;
+//! - an existing file is replaced only if it is one of the command's own earlier files, which
+//!   its first lines say (`ours`); anything else is refused, with what to do.
+
+use crate::{AppError, Result};
+use std::path::Path;
+
+/// Whether `a` and `b` name the same existing file (canonical paths; `false` if either is
+/// missing).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// The first 4 KiB of `path` as text (lossy).
+fn head(path: &Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut buf = vec![0u8; 4096];
+    let n = std::fs::File::open(path)?.read(&mut buf)?;
+    Ok(String::from_utf8_lossy(&buf[..n]).into_owned())
+}
+
+/// Check that the command's file `path` (given as `key`, e.g. "--log") may be written: not a
+/// folder, none of `inputs`, and, if it exists, a file whose first lines `ours` recognises.
+pub fn check(
+    key: &'static str,
+    path: &Path,
+    inputs: &[&Path],
+    ours: impl Fn(&str) -> bool,
+) -> Result<()> {
+    let refuse = |message: String| {
+        Err(AppError::OutputFile {
+            key,
+            path: path.to_path_buf(),
+            message,
+        })
+    };
+    if path.is_dir() {
+        return refuse("is a folder: give a file path".into());
+    }
+    if let Some(input) = inputs.iter().find(|i| same_file(path, i)) {
+        return refuse(format!(
+            "is the input {}: tubemem never writes over its inputs; give another path",
+            input.display()
+        ));
+    }
+    if path.exists() {
+        let text = head(path).map_err(|source| AppError::io(path, source))?;
+        if !ours(&text) {
+            return refuse(
+                "exists and was not written by this tubemem command: tubemem replaces only its own files; give another path, or remove the file yourself".into(),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The inputs of a case read from `case_path`: the case file and its user mesh file, if any.
+pub fn case_inputs(case_path: &Path, case: &crate::case::Case) -> Vec<std::path::PathBuf> {
+    let mut v = vec![case_path.to_path_buf()];
+    if let Some(f) = &case.mesh.file {
+        v.push(case.base_dir.join(f));
+    }
+    v
+}
+
+/// Whether `text` begins as a `run --log` file does (its column header).
+pub fn is_log(text: &str) -> bool {
+    text.lines().next().is_some_and(|l| {
+        l.split_whitespace().eq([
+            "stage",
+            "step",
+            "elapsed_s",
+            "w",
+            "lambda_s",
+            "newton",
+            "residual",
+            "fraction",
+        ])
+    })
+}
+
+/// Whether `text` begins as an `export` deck does (`*HEADING`, then "tubemem export of").
+pub fn is_deck(text: &str) -> bool {
+    let mut l = text.lines();
+    l.next() == Some("*HEADING") && l.next().is_some_and(|s| s.starts_with("tubemem export of"))
+}
+
+/// Create the output folder `dir` (and its parents), or refuse a path that is a file (or
+/// whose parent is one) as "not a folder" instead of the system's "File exists".
+pub fn create_folder(dir: &Path) -> Result<()> {
+    let mut p = Some(dir);
+    while let Some(q) = p.filter(|q| !q.as_os_str().is_empty()) {
+        if q.exists() {
+            if !q.is_dir() {
+                return Err(AppError::Folder {
+                    path: dir.to_path_buf(),
+                    message: if q == dir {
+                        "is a file, not a folder: give a folder path".into()
+                    } else {
+                        format!("{} is a file, not a folder", q.display())
+                    },
+                });
+            }
+            break;
+        }
+        p = q.parent();
+    }
+    std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))
+}
