@@ -649,6 +649,14 @@ impl StageSpec {
                     i + 1
                 );
             }
+            if self.plane.len() > tubemem_gps::confine::MAX_WALLS {
+                invalid!(
+                    "[[stage]] {}: {} [[stage.plane]]s: at most {} (the closed form every step compares with grows as about the 3.7th power of their number)",
+                    i + 1,
+                    self.plane.len(),
+                    tubemem_gps::confine::MAX_WALLS
+                );
+            }
             for (k, p) in self.plane.iter().enumerate() {
                 let finite = p.normal.iter().all(|v| v.is_finite())
                     && p.offset.is_finite()

@@ -1098,3 +1098,23 @@ fn the_tracked_confinements_run_on_their_coarsest_mesh() {
         }
     }
 }
+
+/// Issue #25, class 2: a confine stage with more planes than the closed form takes
+/// (`tubemem_gps::confine::MAX_WALLS`) is refused by validation, naming the stage and the limit.
+#[test]
+fn a_confine_stage_with_too_many_planes_is_refused() {
+    let mut text = format!("{SMALL}\n[[stage]]\nkind = \"confine\"\n");
+    for k in 0..33 {
+        let a = 2.0 * std::f64::consts::PI * k as f64 / 33.0;
+        text += &format!(
+            "[[stage.plane]]\nnormal = [{}, {}]\noffset = 1.3\ntarget = 1.1\n",
+            a.cos(),
+            a.sin()
+        );
+    }
+    let e = Case::parse(&text).unwrap_err().to_string();
+    assert!(
+        e.contains("[[stage]] 2") && e.contains("33") && e.contains("at most 32"),
+        "{e}"
+    );
+}

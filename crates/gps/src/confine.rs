@@ -185,7 +185,22 @@ enum Hold {
     Strip(usize, usize),
 }
 
+/// The most walls a section is confined by: 32. The closed form's cost grows as about n^3.7
+/// with n walls (a regular n-gon of walls at 1.1 from λs* = 1.3, `tubemem gps confine
+/// --json`, release, 2026-12-02: 0.07, 0.21, 1.9 and 25.7 s at 8, 16, 32 and 64 walls), and an
+/// FE confine stage evaluates it at every step; more walls are refused at once instead of
+/// running for minutes (issue #25, class 2).
+pub const MAX_WALLS: usize = 32;
+
 fn classify(walls: &[Wall]) -> Result<Hold, GpsError> {
+    if walls.len() > MAX_WALLS {
+        return Err(GpsError::Walls {
+            message: format!(
+                "{} planes given: at most {MAX_WALLS} (the closed form's cost grows as about the 3.7th power of their number: 1.9 s at 32, 26 s at 64)",
+                walls.len()
+            ),
+        });
+    }
     if walls.len() == 2 {
         let [a, b] = [walls[0].normal, walls[1].normal];
         if a[0] * b[0] + a[1] * b[1] < -1.0 + 1e-12 {
@@ -838,6 +853,30 @@ mod tests {
     use super::*;
     use crate::{flatten, Hypothesis};
     use tubemem_material::laws::AnssariBenamBucchi;
+
+    /// Issue #25, class 2: more than `MAX_WALLS` walls are refused at once, naming the
+    /// count and the limit (64 walls ran for 26 s); `MAX_WALLS` of them still solve.
+    #[test]
+    fn too_many_walls_are_refused_at_once() {
+        let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+        let gon = |n: usize| -> Vec<Wall> {
+            (0..n)
+                .map(|k| {
+                    let a = 2.0 * PI * k as f64 / n as f64;
+                    Wall::new(a.cos(), a.sin(), 1.1).unwrap()
+                })
+                .collect()
+        };
+        let e = confine(&law, Hypothesis::Gps, &gon(MAX_WALLS + 1), 1.3)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("33 planes given") && e.contains("at most 32"),
+            "{e}"
+        );
+        assert!(check_walls(&gon(64)).is_err());
+        assert!(confine(&law, Hypothesis::Gps, &gon(16), 1.3).is_ok());
+    }
 
     /// The walls |x|, |y| ≤ h.
     fn square_channel(h: f64) -> [Wall; 4] {
