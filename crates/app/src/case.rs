@@ -89,6 +89,11 @@ pub enum CaseError {
 /// element per radius along is 10,000 rings).
 pub const MAX_LENGTH_RATIO: f64 = 1e4;
 
+/// The shortest tube, in radii: 1e-3. The small case's 24 elements along run at L/R = 1e-3 and
+/// fail at 1e-4 (elements 4e-6 R long against 0.39 R around), where a huge `radius` under a
+/// unit `length` (9.2e18) had been reported as a degenerate element (issue #25, class 6).
+pub const MIN_LENGTH_RATIO: f64 = 1e-3;
+
 /// The largest case file read: 1 MiB (a case is a few hundred bytes; a larger file is not one).
 pub const MAX_CASE_FILE_BYTES: u64 = 1 << 20;
 
@@ -836,9 +841,9 @@ impl Case {
             }
         }
         let ratio = g.length / g.radius;
-        if !(ratio.is_finite() && ratio > 0.0 && ratio <= MAX_LENGTH_RATIO) {
+        if !(ratio.is_finite() && (MIN_LENGTH_RATIO..=MAX_LENGTH_RATIO).contains(&ratio)) {
             invalid!(
-                "[geometry] `length` / `radius` = {} / {}{}: L/R must be in (0, {}] (results are per R; a longer tube cannot be meshed)",
+                "[geometry] `length` / `radius` = {} / {}{}: L/R must be in [{}, {}] (results are per R; a longer or shorter tube cannot be meshed)",
                 tubemem_material::Num(g.length),
                 tubemem_material::Num(g.radius),
                 if ratio.is_finite() {
@@ -846,6 +851,7 @@ impl Case {
                 } else {
                     " overflows".to_string()
                 },
+                MIN_LENGTH_RATIO,
                 MAX_LENGTH_RATIO
             );
         }

@@ -1118,3 +1118,18 @@ fn a_confine_stage_with_too_many_planes_is_refused() {
         "{e}"
     );
 }
+
+/// Issue #25, class 6: a tube too short for its radius (`radius = 9.2e18` under `length = 8`)
+/// is refused by validation naming L/R and its range, not reported later as a degenerate
+/// element.
+#[test]
+fn a_tube_too_short_for_its_radius_names_its_length_ratio() {
+    let e = Case::parse(&SMALL.replace("radius = 1.0", "radius = 9.2e18"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("L/R must be in [0.001, 10000]") && e.contains("9.2e18"),
+        "{e}"
+    );
+    Case::parse(&SMALL.replace("length = 8.0", "length = 0.001")).unwrap();
+}
