@@ -163,8 +163,9 @@ fn vectorized<'py>(
             "{what}: complex numbers are not stretches or pressures (give real numbers)"
         )));
     }
+    // contiguous float64 (a strided view, e.g. `a[::2]`, is copied once)
     let arr = np
-        .call_method1("asarray", (raw, "float64"))
+        .call_method1("ascontiguousarray", (raw, "float64"))
         .map_err(|_| bad())?;
     let arr = arr.cast::<PyArrayDyn<f64>>().map_err(|_| bad())?;
     let shape = arr.shape().to_vec();
@@ -230,18 +231,55 @@ fn curve_table<'py, S: Send>(
     Ok(Bound::new(py, Table::from_columns(py, cols)?)?.into_any())
 }
 
+/// A curve's `points` (default 100): any Python or numpy integer; a negative or huge one is a
+/// ValueError naming it (not an OverflowError of the conversion), a non-integer a TypeError.
+fn point_count(points: Option<&Bound<'_, PyAny>>) -> PyResult<usize> {
+    let Some(p) = points else {
+        return Ok(100);
+    };
+    if p.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(
+            "points: an integer number of points, not a bool",
+        ));
+    }
+    let n: i128 = match p.call_method0("__index__").and_then(|i| i.extract::<i64>()) {
+        Ok(n) => n.into(),
+        // an integer beyond i64 (its __index__ works, the conversion overflows)
+        Err(_) if p.call_method0("__index__").is_ok() => i128::MAX,
+        Err(_) => {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "points = {p}: an integer number of points"
+            )))
+        }
+    };
+    if n < 2 {
+        return Err(PyValueError::new_err(format!(
+            "points = {p}: a curve needs at least 2 points"
+        )));
+    }
+    usize::try_from(n)
+        .ok()
+        .filter(|&n| n <= tubemem_gps::MAX_CURVE_POINTS)
+        .ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "points = {p}: a curve may have at most 10,000,000 points"
+            ))
+        })
+}
+
 /// `points` free-inflation states equally spaced in λs from `stretch_from` to `stretch_to`: a
 /// `Table` with the columns of `gps_inflate` (numpy arrays; `.to_pandas()`).
 #[pyfunction]
-#[pyo3(signature = (stretch_to, points=100, stretch_from=1.0, material=None, hypothesis="gps"))]
+#[pyo3(signature = (stretch_to, points=None, stretch_from=1.0, material=None, hypothesis="gps"))]
 fn gps_inflation_curve<'py>(
     py: Python<'py>,
     stretch_to: f64,
-    points: usize,
+    points: Option<&Bound<'py, PyAny>>,
     stretch_from: f64,
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let points = point_count(points)?;
     let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
     use tubemem_app::curves::{inflation_values, INFLATION_HEADER};
     curve_table(py, INFLATION_HEADER, inflation_values, || {
@@ -285,15 +323,16 @@ fn gps_flatten<'py>(
 /// `points` flattening states equally spaced in ρ from λs* down to `rho_to`: a `Table` with the
 /// columns of `gps_flatten` (the curves of the paper's Figs. 6–7).
 #[pyfunction]
-#[pyo3(signature = (initial_stretch, rho_to, points=100, material=None, hypothesis="gps"))]
+#[pyo3(signature = (initial_stretch, rho_to, points=None, material=None, hypothesis="gps"))]
 fn gps_flattening_curve<'py>(
     py: Python<'py>,
     initial_stretch: f64,
     rho_to: f64,
-    points: usize,
+    points: Option<&Bound<'py, PyAny>>,
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let points = point_count(points)?;
     let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
     use tubemem_app::curves::{flattening_values, FLATTENING_HEADER};
     curve_table(py, FLATTENING_HEADER, flattening_values, || {

@@ -126,6 +126,10 @@ def test_resultants_are_eq_58_and_take_any_material():
         (lambda: tubemem.gps_inflate(1.3 + 0j), "complex"),
         # arrays are capped like curves (issue #25, class 2)
         (lambda: tubemem.gps_inflate(np.full(10_000_001, 1.3)), "at most 10,000,000"),
+        # a negative or huge point count is a ValueError naming it, not an OverflowError
+        # (issue #25, class 6)
+        (lambda: tubemem.gps_inflation_curve(1.5, points=-1), "points = -1: a curve needs at least 2"),
+        (lambda: tubemem.gps_flattening_curve(1.3, 0.8, points=2**70), "at most 10,000,000 points"),
     ],
 )
 def test_bad_input_raises_value_error_naming_it(call, needle):
@@ -529,3 +533,16 @@ def test_a_quad9_case_runs_through_the_api_and_writes_quad9_cells(tmp_path):
     assert [c.type for c in m.cells] == ["quad9"] and m.cells[0].data.shape == (b.summary["mesh"]["elements"], 9)
     ratio = a.steps["w"][-1] / b.steps["w"][-1] * math.cos(math.pi / 16)
     assert abs(ratio - 1.0) < 5e-4, ratio
+
+
+def test_numpy_integers_and_strided_arrays_are_taken_as_numpy_users_pass_them():
+    """Issue #25, class 6: `points` as np.int64 and a strided view (`a[::2]`) as the stretch
+    array give what the plain int and the contiguous copy give."""
+    a = np.linspace(1.1, 1.5, 5)
+    strided = tubemem.gps_inflate(a[::2])["w"]
+    np.testing.assert_array_equal(strided, tubemem.gps_inflate(np.ascontiguousarray(a[::2]))["w"])
+    t = tubemem.gps_inflation_curve(1.5, points=np.int64(7)).to_pandas()
+    assert len(t) == 7
+    assert len(tubemem.gps_inflation_curve(1.5).to_pandas()) == 100
+    with pytest.raises(TypeError, match="an integer number of points"):
+        tubemem.gps_inflation_curve(1.5, points=2.5)
