@@ -43,6 +43,13 @@ fn setup(message: impl std::fmt::Display) -> u8 {
 }
 
 pub fn run(a: VerifyArgs) -> u8 {
+    // SIGINT or SIGTERM: the checks not started are skipped, the runs in progress stop at
+    // their next Newton iteration, the report of what ran is written, exit code 130
+    let flag = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let f = flag.clone();
+    if ctrlc::set_handler(move || f.store(true, std::sync::atomic::Ordering::Relaxed)).is_ok() {
+        verify::set_interrupt(flag);
+    }
     let opts = VerifyOptions {
         jobs: a.jobs,
         filter: a.filter.clone(),
@@ -131,6 +138,13 @@ pub fn run(a: VerifyArgs) -> u8 {
     let _ = writeln!(out, "{}", results.verdict);
     for p in written {
         let _ = writeln!(out, "wrote {}", p.display());
+    }
+    if verify::interrupted() {
+        let _ = writeln!(
+            std::io::stderr(),
+            "interrupted: the report holds the checks that ran; those not started are skipped"
+        );
+        return 130;
     }
     if results.ok() {
         0

@@ -1961,3 +1961,75 @@ fn single_file_outputs_never_destroy_inputs_or_foreign_files() {
     assert_eq!(std::fs::read(&case).unwrap(), original);
     assert_eq!(std::fs::read_to_string(&foreign).unwrap(), "my notes\n");
 }
+
+/// Issue #25, class 7: SIGINT stops `tubemem verify` as it stops a run: the check in progress
+/// ends (its FE run stops at the next Newton iteration: an error saying "interrupted"), the
+/// checks not started are skipped, the report of what ran is written, and the exit code is 130.
+#[test]
+fn an_interrupted_verification_writes_its_report_and_exits_130() {
+    let d = tmp("verify-sigint");
+    std::fs::write(
+        d.join("slow.toml"),
+        // a finer mesh than the small case's, so that its stage outlasts the signal's delivery
+        SMALL_CASE
+            .replace("steps = 4", "steps = 2000")
+            .replace("around = 16", "around = 64")
+            .replace("along = 24", "along = 96"),
+    )
+    .unwrap();
+    let check = |name: &str| {
+        format!(
+            "[[check]]\nname = \"{name}\"\ncase = \"slow.toml\"\nkind = \"closed-form\"\n\
+             tolerance.w = {{ value = 0.05, source = \"test: the 16-gon factor 1.96e-2 and the end effect\" }}\n"
+        )
+    };
+    let suite = d.join("suite.toml");
+    std::fs::write(
+        &suite,
+        format!(
+            "[suite]\nname = \"t\"\ndescription = \"interrupt\"\n\n{}{}{}",
+            check("first"),
+            check("second"),
+            check("third")
+        ),
+    )
+    .unwrap();
+    let out = d.join("out");
+    let child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "verify",
+            suite.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--jobs",
+            "1",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while t0.elapsed().as_secs() < 60 {
+        let rows = std::fs::read_to_string(out.join("first").join("run").join("steps.csv"))
+            .or_else(|_| std::fs::read_to_string(out.join("first").join("steps.csv")))
+            .map(|t| t.lines().count())
+            .unwrap_or(0);
+        if rows >= 4 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    let r: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(r["skipped"], 2, "{r}");
+    assert_eq!(r["errors"], 1, "{r}");
+    assert!(err.contains("interrupted"), "{err}");
+    assert!(out.join("report.md").exists() && out.join("junit.xml").exists());
+}

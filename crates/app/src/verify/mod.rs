@@ -28,12 +28,27 @@ use crate::case::Case;
 use crate::figures::{rasterize, render_svg, Figure, Markers, Series, Stroke};
 use crate::output::{FolderMode, RunWriter, STEPS_HEADER};
 use crate::report::{RunReport, StepRecord};
-use crate::run::run;
 use plotters::style::RGBColor;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
+
+/// Set (by a front end's signal handler) to stop a verification: the checks not started yet
+/// are skipped, the FE runs in progress stop at their next Newton iteration (their checks end
+/// in error, "interrupted"), and the report of what ran is written.
+static INTERRUPT: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+
+/// Install the verification's interrupt flag (once per process).
+pub fn set_interrupt(flag: Arc<AtomicBool>) {
+    let _ = INTERRUPT.set(flag);
+}
+
+/// Whether the verification was interrupted.
+pub fn interrupted() -> bool {
+    INTERRUPT.get().is_some_and(|f| f.load(Ordering::Relaxed))
+}
 use suite::{Check, CheckKind, Tol};
 use tubemem_gps::Hypothesis;
 
@@ -195,8 +210,15 @@ pub fn run_checks(
         .collect();
     let total = selected.len();
     let done = AtomicUsize::new(0);
+    // more threads than checks or cores gain nothing, and the FE runs inside the checks share
+    // the pool (`--jobs 1000` made a 0.1 s check take 10 s)
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = match opts.jobs {
+        0 => 0,
+        j => j.min(total.max(1)).min(cores),
+    };
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.jobs)
+        .num_threads(jobs)
         .build()
         .map_err(|e| crate::AppError::Output {
             what: "the check threads".into(),
@@ -212,7 +234,15 @@ pub fn run_checks(
                     total,
                     name: &c.spec.name,
                 });
-                let r = run_check(c, out, opts);
+                let r = if interrupted() {
+                    CheckResult {
+                        status: Status::Skipped,
+                        message: "not run: the verification was interrupted".into(),
+                        ..CheckResult::empty(c)
+                    }
+                } else {
+                    run_check(c, out, opts)
+                };
                 let d = done.fetch_add(1, Ordering::SeqCst) + 1;
                 progress(Event::Finished {
                     done: d,
@@ -226,23 +256,30 @@ pub fn run_checks(
     Ok(results)
 }
 
+impl CheckResult {
+    /// The result of check `c` before it ran: an error with no message, no runs, no measures.
+    fn empty(c: &Check) -> Self {
+        Self {
+            name: c.spec.name.clone(),
+            suite: c.suite.clone(),
+            kind: c.spec.kind,
+            status: Status::Error,
+            message: String::new(),
+            seconds: 0.0,
+            runs: vec![],
+            measures: vec![],
+            details: serde_json::Value::Null,
+            plot: None,
+            png: None,
+        }
+    }
+}
+
 /// Run one check; never panics on bad data, a failed member run is the check's error.
 pub fn run_check(c: &Check, out: &Path, opts: &VerifyOptions) -> CheckResult {
     let t0 = std::time::Instant::now();
     let dir = out.join(&c.spec.name);
-    let mut r = CheckResult {
-        name: c.spec.name.clone(),
-        suite: c.suite.clone(),
-        kind: c.spec.kind,
-        status: Status::Error,
-        message: String::new(),
-        seconds: 0.0,
-        runs: vec![],
-        measures: vec![],
-        details: serde_json::Value::Null,
-        plot: None,
-        png: None,
-    };
+    let mut r = CheckResult::empty(c);
     let outcome = match std::fs::create_dir_all(&dir) {
         Err(e) => Err(format!("cannot create {}: {e}", dir.display())),
         Ok(()) => match c.spec.kind {
@@ -365,7 +402,11 @@ pub fn run_member(
         .map_err(|e| e.chain())?
         .checkpoint_every(case.solver.checkpoint_every)
         .frames_of(case.output);
-    run(&case, label, &mut [&mut writer])
+    let options = crate::run::RunOptions {
+        interrupt: INTERRUPT.get().cloned(),
+        ..Default::default()
+    };
+    crate::run::run_with(&case, label, &options, &mut [&mut writer])
         .into_result()
         .map_err(|e| format!("{label}: {}", e.chain()))
 }
