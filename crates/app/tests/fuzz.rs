@@ -5,6 +5,10 @@
 //!
 //! * In the test command: `cargo test -p tubemem-app --test fuzz` runs 48 generated inputs (a few
 //!   seconds, from a fixed seed) plus the crash inputs found before as regression seeds.
+//! * The generators cover issue #25's classes that reach the application: user meshes scaled,
+//!   shifted, turned and doubled (class 1), extreme integer keys and confinement by up to 40
+//!   planes (class 2), and the contact-edge keys of issue #23 (tracked and fitted meshes).
+//!   Output paths that alias inputs are a front end's and are tested in `crates/cli/tests`.
 //! * The long run: `TUBEMEM_FUZZ_CASES=100000 TUBEMEM_FUZZ_SECONDS=1800 cargo test --release -p
 //!   tubemem-app --test fuzz -- --nocapture` (stops at whichever comes first, and prints how
 //!   many inputs it ran).
@@ -57,9 +61,30 @@ fn mesh_table() -> impl Strategy<Value = String> {
         Just("eighth"),
         Just("sixteenth")
     ];
+    // the contact-edge keys and the element (issue #23's mesh that follows the edges)
+    let extra = prop_oneof![
+        3 => Just(""),
+        1 => Just("\ntrack_contact_edge = true"),
+        1 => Just("\nfit_contact_edge = true"),
+        1 => Just("\ntrack_contact_edge = true\nelement = \"quad9\""),
+        1 => Just("\nelement = \"quad9\"\nfit_contact_edge = true\ntrack_contact_edge = true"),
+    ];
+    // extreme integer keys (issue #25, class 2)
+    let huge = prop_oneof![
+        Just("cap_rows = 9223372036854775807"),
+        Just("cap_rows = 1000000"),
+        Just("around = 1000000000\nalong = 2"),
+        Just("around = 8\nalong = 1000000000000"),
+        Just("around = 18446744073709551616\nalong = 2"),
+    ];
     prop_oneof![
-        5 => ((1usize..4).prop_map(|k| 8 * k), (1usize..12).prop_map(|k| 2 * k), sym.clone())
-            .prop_map(|(a, l, s)| format!("around = {a}\nalong = {l}\nsymmetry = \"{s}\"")),
+        5 => ((1usize..4).prop_map(|k| 8 * k), (1usize..12).prop_map(|k| 2 * k), sym.clone(), extra)
+            .prop_map(|(a, l, s, x)| format!("around = {a}\nalong = {l}\nsymmetry = \"{s}\"{x}")),
+        1 => (huge, sym.clone()).prop_map(|(h, s)| if h.contains("around") {
+            format!("{h}\nsymmetry = \"{s}\"")
+        } else {
+            format!("around = 8\nalong = 4\nsymmetry = \"{s}\"\n{h}")
+        }),
         1 => (0usize..30, 0usize..30).prop_map(|(a, l)| format!("around = {a}\nalong = {l}")),
         1 => Just("file = \"mesh.json\"".to_string()),
         1 => Just("file = \"/dev/zero\"".to_string()),
@@ -84,6 +109,21 @@ fn stage() -> impl Strategy<Value = String> {
             k.map(|k| format!("\npenalty = {k}")).unwrap_or_default()
         )),
         Just("[[stage]]\nkind = \"inflate\"".to_string()),
+        // confinement by 1 to 40 planes (issue #25, class 2: many planes)
+        (prop::collection::vec((0.0f64..6.3, 0.9f64..1.5), 1..40), steps.clone()).prop_map(
+            |(planes, n)| {
+                let mut t = format!("[[stage]]\nkind = \"confine\"\nsteps = {n}");
+                for (a, d) in planes {
+                    t += &format!(
+                        "\n[[stage.plane]]\nnormal = [{}, {}]\noffset = {d}\ntarget = {}",
+                        a.cos(),
+                        a.sin(),
+                        0.8 * d
+                    );
+                }
+                t
+            }
+        ),
     ]
 }
 
@@ -139,6 +179,30 @@ fn mesh_json() -> impl Strategy<Value = String> {
             let q = quads.replace(&format!("[{i},"), "[0,");
             format!(r#"{{"nodes": [{nodes}], "quads": [{q}]}}"#)
         }),
+        // transformed (issue #25, class 1): scaled, shifted, turned onto the x axis, doubled
+        Just(format!(
+            r#"{{"nodes": [{}], "quads": [{quads}]}}"#,
+            nodes.replace('1', "2")
+        )),
+        Just(format!(
+            r#"{{"nodes": [{}], "quads": [{quads}]}}"#,
+            nodes.replace("-1,-1,", "4,-1,").replace("1,-1,", "6,-1,")
+        )),
+        Just(format!(
+            r#"{{"nodes": [{nodes},{}], "quads": [{quads},{}]}}"#,
+            nodes.replace("-1,", "9,"),
+            quads
+                .split("],[")
+                .map(|q| q
+                    .trim_matches(|c| c == '[' || c == ']')
+                    .split(',')
+                    .map(|v| (v.parse::<usize>().unwrap() + 8).to_string())
+                    .collect::<Vec<_>>()
+                    .join(","))
+                .map(|q| format!("[{q}]"))
+                .collect::<Vec<_>>()
+                .join(",")
+        )),
     ]
 }
 
