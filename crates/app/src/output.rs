@@ -239,6 +239,61 @@ pub const RUN_ENTRIES: [&str; 13] = [
 
 const LOCK: &str = ".tubemem.lock";
 
+/// Whether `name` in the run's sub-folder `folder` (`vtu`, `profiles`, `checkpoints`) is a file
+/// the run writes there: the frames `step_NNNNN.vtu` and `critical_stage…_step….vtu`, the
+/// profiles `profiles.csv`, `stageN_final.csv` and `stageN_midspan_ring.csv`, the checkpoints
+/// `ckpt-a.bin`, `ckpt-b.bin` and `.ckpt.tmp`.
+fn own_file(folder: &str, name: &str) -> bool {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    match folder {
+        "vtu" => {
+            name.strip_prefix("step_")
+                .and_then(|r| r.strip_suffix(".vtu"))
+                .is_some_and(digits)
+                || name
+                    .strip_prefix("critical_stage")
+                    .and_then(|r| r.strip_suffix(".vtu"))
+                    .and_then(|r| r.split_once("_step"))
+                    .is_some_and(|(a, b)| digits(a) && digits(b))
+        }
+        "profiles" => {
+            name == "profiles.csv"
+                || name
+                    .strip_prefix("stage")
+                    .and_then(|r| {
+                        r.strip_suffix("_final.csv")
+                            .or_else(|| r.strip_suffix("_midspan_ring.csv"))
+                    })
+                    .is_some_and(digits)
+        }
+        "checkpoints" => matches!(name, "ckpt-a.bin" | "ckpt-b.bin" | ".ckpt.tmp"),
+        _ => false,
+    }
+}
+
+/// `--overwrite` of the run's sub-folder `path` (`folder`): remove the files the run writes
+/// there, and the folder if nothing else is left; files a user put there stay (issue #25,
+/// class 4: the whole folder was removed).
+fn remove_own_files(path: &Path, folder: &str) -> Result<()> {
+    let entries = std::fs::read_dir(path).map_err(|e| AppError::io(path, e))?;
+    let mut left = false;
+    for entry in entries {
+        let entry = entry.map_err(|e| AppError::io(path, e))?;
+        let name = entry.file_name();
+        let p = entry.path();
+        match name.to_str() {
+            Some(n) if own_file(folder, n) && p.is_file() => {
+                std::fs::remove_file(&p).map_err(|e| AppError::io(&p, e))?;
+            }
+            _ => left = true,
+        }
+    }
+    if !left {
+        std::fs::remove_dir(path).map_err(|e| AppError::io(path, e))?;
+    }
+    Ok(())
+}
+
 /// The most VTU output a run may write: 8 GiB (the L/R = 80 case writes 30 MB; a run that
 /// would pass this is asked to write fewer or smaller frames rather than fill the disk).
 pub const MAX_VTU_BYTES: u64 = 8 << 30;
@@ -421,12 +476,11 @@ impl RunWriter {
                 FolderMode::Overwrite => {
                     for e in present {
                         let p = dir.join(e);
-                        let r = if p.is_dir() {
-                            std::fs::remove_dir_all(&p)
+                        if p.is_dir() {
+                            remove_own_files(&p, e)?;
                         } else {
-                            std::fs::remove_file(&p)
-                        };
-                        r.map_err(|err| AppError::io(&p, err))?;
+                            std::fs::remove_file(&p).map_err(|err| AppError::io(&p, err))?;
+                        }
                     }
                 }
             }

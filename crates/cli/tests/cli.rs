@@ -2033,3 +2033,38 @@ fn an_interrupted_verification_writes_its_report_and_exits_130() {
     assert!(err.contains("interrupted"), "{err}");
     assert!(out.join("report.md").exists() && out.join("junit.xml").exists());
 }
+
+/// Issue #25, class 4: `--overwrite` removes only tubemem's own files: a file a user put inside
+/// the run's `vtu/`, `profiles/` or `checkpoints/` (or beside them) stays, while the earlier
+/// run's frames, profiles and checkpoints are replaced.
+#[test]
+fn overwrite_keeps_the_files_a_user_put_in_the_run_folder() {
+    let case = write_case("overwrite-user-files", SMALL_CASE);
+    let d = case.parent().unwrap().to_path_buf();
+    let out = d.join("out");
+    let (c, o) = (case.to_str().unwrap(), out.to_str().unwrap());
+    assert!(tubemem(&["run", c, "--out", o]).status.success());
+    let mine = [
+        out.join("vtu").join("my_view.pvsm"),
+        out.join("profiles").join("notes.csv"),
+        out.join("checkpoints").join("keep.txt"),
+        out.join("README.txt"),
+    ];
+    for f in &mine {
+        std::fs::write(f, "mine\n").unwrap();
+    }
+    // a stale frame of the earlier run, numbered past this run's frames
+    std::fs::write(out.join("vtu").join("step_99999.vtu"), "stale").unwrap();
+    let r = tubemem(&["run", c, "--out", o, "--overwrite"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    for f in &mine {
+        assert_eq!(
+            std::fs::read_to_string(f).unwrap(),
+            "mine\n",
+            "{}",
+            f.display()
+        );
+    }
+    assert!(!out.join("vtu").join("step_99999.vtu").exists());
+    assert!(out.join("vtu").join("step_00000.vtu").exists());
+}
