@@ -260,7 +260,13 @@ pub fn build_mesh_with_fit(case: &Case) -> Result<(Mesh, Option<crate::edge_fit:
         (Some(file), ..) => {
             let path = case.base_dir.join(file);
             tubemem_mesh::io::read_json(&path, g.radius)
-                .map(|m| (m, None))
+                .and_then(|m| {
+                    // the mesh's own faults first (plugs, unused nodes, orientation), then
+                    // whether it is the case's tube at all
+                    m.check()?;
+                    m.check_tube(0.5 * ll, g.caps == Caps::Hemisphere)?;
+                    Ok((m, None))
+                })
                 .map_err(|source| AppError::MeshFile {
                     file: file.clone(),
                     source,

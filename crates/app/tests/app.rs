@@ -1133,3 +1133,65 @@ fn a_tube_too_short_for_its_radius_names_its_length_ratio() {
     );
     Case::parse(&SMALL.replace("length = 8.0", "length = 0.001")).unwrap();
 }
+
+/// Issue #25, class 1: a user mesh that is not the case's tube is refused before anything is
+/// compared with GPS, naming the mismatch: two disconnected tubes, a whole tube declared an
+/// eighth, the axis along x, an elliptic cross-section and a radius 2 under `radius = 1`; the
+/// tube itself runs. (Tolerance: `tubemem_mesh::TUBE_TOLERANCE`, 1e-2 R.)
+#[test]
+fn a_user_mesh_that_is_not_the_cases_tube_is_refused() {
+    use tubemem_mesh::tube::capped_tube;
+    use tubemem_mesh::{Mesh, Symmetry};
+    let d = std::env::temp_dir().join(format!(
+        "tubemem-app-test-{}-not-the-tube",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&d).unwrap();
+    // the small case's tube, whole (L/R = 8, 16 around)
+    let tube = capped_tube(1.0, 8.0, 16, 24, Symmetry::None).unwrap();
+    let case_text = SMALL
+        .replace("around = 16\n", "file = \"mesh.json\"\n")
+        .replace("along = 24\n", "")
+        .replace("symmetry = \"eighth\"\n", "");
+    let attempt = |mesh: &Mesh| {
+        tubemem_mesh::io::write_json(&d.join("mesh.json"), mesh).unwrap();
+        let mut case = Case::parse(&case_text).unwrap();
+        case.base_dir = d.clone();
+        tubemem_app::run::build_mesh(&case)
+            .map(|_| ())
+            .map_err(|e| e.chain())
+    };
+    attempt(&tube).unwrap();
+    let map = |f: &dyn Fn([f64; 3]) -> [f64; 3]| {
+        let mut m = tube.clone();
+        m.nodes = m.nodes.iter().map(|&p| f(p)).collect();
+        m
+    };
+    let mut doubled = tube.clone();
+    let n = doubled.nodes.len();
+    doubled
+        .nodes
+        .extend(tube.nodes.iter().map(|p| [p[0] + 5.0, p[1], p[2]]));
+    doubled
+        .quads
+        .extend(tube.quads.iter().map(|q| q.map(|i| i + n)));
+    let mut eighth = tube.clone();
+    eighth.symmetry = Symmetry::Eighth;
+    for (mesh, needle) in [
+        (doubled, "2 separate pieces"),
+        (eighth, "declared symmetry \"eighth\""),
+        (map(&|p| [p[2], p[1], -p[0]]), "from the z axis"),
+        (map(&|p| [1.3 * p[0], p[1], p[2]]), "from the z axis"),
+        (
+            map(&|p| [2.0 * p[0], 2.0 * p[1], 2.0 * p[2]]),
+            "not the case's tube",
+        ),
+    ] {
+        let e = attempt(&mesh).unwrap_err();
+        assert!(
+            e.contains("not the case's tube") && e.contains(needle),
+            "{needle}: {e}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

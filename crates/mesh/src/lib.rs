@@ -82,7 +82,15 @@ pub enum MeshError {
     InvalidPlug { plug: usize, reason: String },
     #[error("{path}: {reason}")]
     Io { path: String, reason: String },
+    #[error("the mesh is not the case's tube: {reason}")]
+    NotTheTube { reason: String },
 }
+
+/// How far (in R) a user mesh's node may lie off the case's tube ([`Mesh::check_tube`]): 1e-2.
+/// A node of a surface mesh lies on the surface it discretizes (the generated tubes' to 1e-15);
+/// what a mesh of the wrong tube gets wrong is of order R (an axis along x, an ellipse, a
+/// radius 2 under `radius = 1`). One per cent leaves room for meshes written with few digits.
+pub const TUBE_TOLERANCE: f64 = 1e-2;
 
 /// Which symmetry planes bound the mesh (open edges are allowed only on these planes, and the
 /// matching displacement component is fixed there).
@@ -539,3 +547,91 @@ pub fn quad_area(x: &[[f64; 3]; 4]) -> f64 {
 
 #[cfg(test)]
 mod tests;
+
+impl Mesh {
+    /// Whether the mesh (scaled to R = 1) is the tube a case describes, a cylinder of
+    /// half-length `half` along z closed by hemispheres (`hemispheres`) or plugs: every node in
+    /// an element, one connected piece; every node on the side of each declared symmetry plane; every cylinder node
+    /// (|z| < `half`) at distance 1 from the z axis and the mesh reaching z = `half` + 1
+    /// (hemispheres) or `half` (plugs), all within [`TUBE_TOLERANCE`]. Else the first mismatch,
+    /// named with its node.
+    pub fn check_tube(&self, half: f64, hemispheres: bool) -> Result<(), MeshError> {
+        let bad = |reason: String| Err(MeshError::NotTheTube { reason });
+        // connectivity: union-find over the elements' corners
+        let mut parent: Vec<usize> = (0..self.nodes.len()).collect();
+        fn root(p: &mut [usize], mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        for q in &self.quads {
+            for w in q.windows(2) {
+                let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
+                parent[a] = b;
+            }
+        }
+        let used: std::collections::HashSet<usize> = self
+            .quads
+            .iter()
+            .flatten()
+            .chain(self.mid.iter().flatten())
+            .copied()
+            .collect();
+        if let Some(i) = (0..self.nodes.len()).find(|i| !used.contains(i)) {
+            return bad(format!(
+                "node {i} belongs to no element: every node must be a corner of a quad"
+            ));
+        }
+        let pieces: std::collections::HashSet<usize> =
+            used.iter().map(|&i| root(&mut parent, i)).collect();
+        if pieces.len() > 1 {
+            return bad(format!(
+                "it has {} separate pieces; a tube is one closed surface",
+                pieces.len()
+            ));
+        }
+        let axis = ["x", "y", "z"];
+        for &k in self.symmetry.planes() {
+            if let Some((i, p)) = self
+                .nodes
+                .iter()
+                .enumerate()
+                .find(|(_, p)| p[k] < -TUBE_TOLERANCE)
+            {
+                return bad(format!(
+                    "it is declared symmetry \"{}\", which models {} ≥ 0 only, but node {i} has {} = {:.6}",
+                    format!("{:?}", self.symmetry).to_lowercase(),
+                    axis[k],
+                    axis[k],
+                    p[k]
+                ));
+            }
+        }
+        for (i, p) in self.nodes.iter().enumerate() {
+            if p[2].abs() < half - TUBE_TOLERANCE {
+                let r = p[0].hypot(p[1]);
+                if (r - 1.0).abs() > TUBE_TOLERANCE {
+                    return bad(format!(
+                        "node {i} ({:.6}, {:.6}, {:.6}) on the cylinder (|z| < L/2 = {half}) is {r:.6} R from the z axis, not 1 (within {TUBE_TOLERANCE}): the tube's axis must be z and its cross-section the circle of `radius`",
+                        p[0], p[1], p[2]
+                    ));
+                }
+            }
+        }
+        let top = self.nodes.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
+        let want = if hemispheres { half + 1.0 } else { half };
+        if (top - want).abs() > TUBE_TOLERANCE {
+            return bad(format!(
+                "it reaches |z| = {top:.6} R, the case's tube {want} R (L/2 = {half}{})",
+                if hemispheres {
+                    " plus the hemispherical cap"
+                } else {
+                    ", plugged"
+                }
+            ));
+        }
+        Ok(())
+    }
+}
