@@ -566,9 +566,11 @@ impl Mesh {
             }
             i
         }
-        for q in &self.quads {
-            for w in q.windows(2) {
-                let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
+        for (e, q) in self.quads.iter().enumerate() {
+            // a 9-node element's mid-side and centre nodes belong to its corners' piece
+            let mid = self.mid.get(e).map_or(&[][..], |m| &m[..]);
+            for &n in q[1..].iter().chain(mid) {
+                let (a, b) = (root(&mut parent, q[0]), root(&mut parent, n));
                 parent[a] = b;
             }
         }
