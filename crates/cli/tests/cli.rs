@@ -1068,29 +1068,22 @@ fn output_folders_cannot_be_mixed() {
     assert_eq!(manifest["steps_written"], steps.rows.len());
 }
 
-/// SIGINT stops a run at its next Newton iteration: exit 130, every converged step kept, the
-/// summary and the manifest say "interrupted".
-#[test]
-fn an_interrupted_run_says_so_and_keeps_its_steps() {
-    let d = tmp("sigint");
-    let case = d.join("case.toml");
-    std::fs::write(&case, SMALL_CASE.replace("steps = 4", "steps = 2000")).unwrap();
-    let out = d.join("out");
+/// Run tubemem with `args`, send it SIGINT once one of `steps` (steps.csv files) has 3 rows
+/// (or after 60 s), and return its output.
+fn interrupted_when(args: &[&str], steps: &[PathBuf]) -> Output {
     let child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
+        .args(args)
+        .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
     let t0 = std::time::Instant::now();
-    while t0.elapsed().as_secs() < 30 {
-        let rows = std::fs::read_to_string(out.join("steps.csv"))
+    while t0.elapsed().as_secs() < 60 {
+        let rows = steps
+            .iter()
+            .filter_map(|p| std::fs::read_to_string(p).ok())
             .map(|t| t.lines().count())
+            .max()
             .unwrap_or(0);
         if rows >= 4 {
             break;
@@ -1101,7 +1094,26 @@ fn an_interrupted_run_says_so_and_keeps_its_steps() {
         .args(["-INT", &child.id().to_string()])
         .status()
         .unwrap();
-    let o = child.wait_with_output().unwrap();
+    child.wait_with_output().unwrap()
+}
+
+/// SIGINT stops a run at its next Newton iteration: exit 130, every converged step kept, the
+/// summary and the manifest say "interrupted".
+#[test]
+fn an_interrupted_run_says_so_and_keeps_its_steps() {
+    let d = tmp("sigint");
+    let case = d.join("case.toml");
+    std::fs::write(&case, SMALL_CASE.replace("steps = 4", "steps = 2000")).unwrap();
+    let out = d.join("out");
+    let o = interrupted_when(
+        &[
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[out.join("steps.csv")],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(130), "{err}");
     assert!(err.contains("interrupted"), "{err}");
@@ -1995,35 +2007,20 @@ fn an_interrupted_verification_writes_its_report_and_exits_130() {
     )
     .unwrap();
     let out = d.join("out");
-    let child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args([
+    let o = interrupted_when(
+        &[
             "verify",
             suite.to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
             "--jobs",
             "1",
-        ])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = std::time::Instant::now();
-    while t0.elapsed().as_secs() < 60 {
-        let rows = std::fs::read_to_string(out.join("first").join("run").join("steps.csv"))
-            .or_else(|_| std::fs::read_to_string(out.join("first").join("steps.csv")))
-            .map(|t| t.lines().count())
-            .unwrap_or(0);
-        if rows >= 4 {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
-    Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    let o = child.wait_with_output().unwrap();
+        ],
+        &[
+            out.join("first").join("run").join("steps.csv"),
+            out.join("first").join("steps.csv"),
+        ],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(130), "{err}");
     let r: Value =
