@@ -35,13 +35,42 @@ pub struct Fit {
 }
 
 /// The plates' four edges (from the x axis) at `a` from their symmetry line x = 0.
-pub(crate) fn plate_edges(a: f64) -> Vec<f64> {
+fn plate_edges(a: f64) -> Vec<f64> {
     vec![FRAC_PI_2 - a, FRAC_PI_2 + a, 1.5 * PI - a, 1.5 * PI + a]
 }
 
 /// The reference angle of the plates' contact edge from their symmetry line, π χ / (2 λs).
 pub fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
     PI * chi / (2.0 * lambda_s)
+}
+
+/// The plates' contact edges of the GPS section between plates at half-gap `rho` under the
+/// pressure `w` (from the stretches `guess`); none when it has no flat. The one computation of
+/// the one-off fit and of the tracking ([`crate::edge_track`]).
+pub(crate) fn plate_section_edges(
+    law: &dyn tubemem_material::MembraneLaw,
+    rho: f64,
+    w: f64,
+    guess: [f64; 2],
+) -> std::result::Result<Vec<f64>, tubemem_gps::GpsError> {
+    let s = section_at_pressure(law, rho, w, guess)?;
+    Ok(if s.chi > 0.0 {
+        plate_edges(edge_angle(s.chi, s.lambda_s))
+    } else {
+        vec![]
+    })
+}
+
+/// The contact edges of the GPS section in `walls` under the pressure `w` (as
+/// [`plate_section_edges`], for any walls symmetric about y = 0).
+pub(crate) fn wall_section_edges(
+    law: &dyn tubemem_material::MembraneLaw,
+    walls: &[tubemem_gps::confine::Wall],
+    w: f64,
+) -> std::result::Result<Vec<f64>, tubemem_gps::GpsError> {
+    let state =
+        tubemem_gps::confine::confine_at_pressure(law, tubemem_gps::Hypothesis::Gps, walls, w)?;
+    tubemem_gps::confine::contact_edges(walls, &state)
 }
 
 /// Where the case's mesh is fitted to the contact edges of its last contact stage, or `None`
@@ -79,10 +108,8 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
     };
     let edges = match plan[k].target {
         Target::Rho(rho) => {
-            let section =
-                section_at_pressure(law.as_ref(), rho, w, [located.lambda_s, located.lambda_z])
-                    .map_err(|e| AppError::gps(context("section between the plates"), e))?;
-            plate_edges(edge_angle(section.chi, section.lambda_s))
+            plate_section_edges(law.as_ref(), rho, w, [located.lambda_s, located.lambda_z])
+                .map_err(|e| AppError::gps(context("section between the plates"), e))?
         }
         _ => {
             let walls = case.stages[k]
@@ -91,14 +118,7 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
                 .map(|p| p.wall_at(1.0))
                 .collect::<std::result::Result<Vec<_>, _>>()
                 .map_err(|e| AppError::gps(context("walls"), e))?;
-            let state = tubemem_gps::confine::confine_at_pressure(
-                law.as_ref(),
-                tubemem_gps::Hypothesis::Gps,
-                &walls,
-                w,
-            )
-            .map_err(|e| AppError::gps(context("section in the walls"), e))?;
-            tubemem_gps::confine::contact_edges(&walls, &state)
+            wall_section_edges(law.as_ref(), &walls, w)
                 .map_err(|e| AppError::gps(context("section in the walls"), e))?
         }
     };

@@ -13,12 +13,12 @@
 //! closed form's starting guess), so a resumed run fits the same meshes bit for bit.
 
 use crate::case::PlaneSpec;
-use crate::edge_fit::{edge_angle, plate_edges};
+use crate::edge_fit::{plate_section_edges, wall_section_edges};
 use std::cell::RefCell;
 use std::rc::Rc;
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::FemError;
-use tubemem_gps::{inflate, section_at_pressure, Hypothesis};
+use tubemem_gps::{inflate, Hypothesis};
 use tubemem_material::MembraneLaw;
 use tubemem_mesh::hoop::HoopMap;
 use tubemem_mesh::tube::capped_tube_fitted_of;
@@ -104,13 +104,9 @@ impl Tracker<'_> {
                 if !touches {
                     return Ok(vec![]);
                 }
-                match section_at_pressure(self.law, rho, w, guess) {
-                    Ok(s) if s.chi > 0.0 => Ok(plate_edges(edge_angle(s.chi, s.lambda_s))),
-                    Ok(_) => Ok(vec![]),
-                    Err(e) => Err(format!(
-                        "the GPS section between the plates at ρ = {rho}, ϖ = {w}: {e}"
-                    )),
-                }
+                plate_section_edges(self.law, rho, w, guess).map_err(|e| {
+                    format!("the GPS section between the plates at ρ = {rho}, ϖ = {w}: {e}")
+                })
             }
             Pressing::Walls(planes) => {
                 let walls = planes
@@ -118,13 +114,9 @@ impl Tracker<'_> {
                     .map(|p| p.wall_at(value))
                     .collect::<Result<Vec<_>, _>>()
                     .map_err(|e| e.to_string())?;
-                let state =
-                    tubemem_gps::confine::confine_at_pressure(self.law, Hypothesis::Gps, &walls, w)
-                        .map_err(|e| {
-                            format!("the GPS section in the walls at t = {value}, ϖ = {w}: {e}")
-                        })?;
-                tubemem_gps::confine::contact_edges(&walls, &state)
-                    .map_err(|e| format!("the contact edges in the walls at t = {value}: {e}"))
+                wall_section_edges(self.law, &walls, w).map_err(|e| {
+                    format!("the GPS section in the walls at t = {value}, ϖ = {w}: {e}")
+                })
             }
         }
     }

@@ -127,6 +127,18 @@ pub trait Refit {
     fn restore(&mut self, snapshot: &[f64]);
 }
 
+/// The states a move of the mesh carries over: the trial, the last converged state and the one
+/// before it (the secant predictor's).
+fn carried<'a>(
+    trial: &'a mut State,
+    state: &'a mut State,
+    previous: &'a mut Option<State>,
+) -> Vec<&'a mut State> {
+    let mut v = vec![trial, state];
+    v.extend(previous.as_mut());
+    v
+}
+
 /// A reference mesh and the states on it, kept to go back to ([`run_stage_refitted`]).
 struct Fixed {
     nodes: Vec<[f64; 3]>,
@@ -318,10 +330,7 @@ pub fn run_stage_refitted<E>(
                 .map(|r| Fixed::take(model, r, state, &previous));
             if let Some(r) = refit.as_deref_mut() {
                 let at = trial.clone();
-                let mut carried: Vec<&mut State> = vec![&mut trial, &mut *state];
-                if let Some(p) = previous.as_mut() {
-                    carried.push(p);
-                }
+                let mut carried = carried(&mut trial, state, &mut previous);
                 follow(model, r, value, &at, &l, &mut carried).map_err(moved)?;
             }
             let mut report = match model.solve(&mut trial, &l) {
@@ -346,10 +355,7 @@ pub fn run_stage_refitted<E>(
                 let converged = Fixed::take(model, r, state, &previous);
                 let kept = trial.clone();
                 let at = trial.clone();
-                let mut carried: Vec<&mut State> = vec![&mut trial, &mut *state];
-                if let Some(p) = previous.as_mut() {
-                    carried.push(p);
-                }
+                let mut carried = carried(&mut trial, state, &mut previous);
                 if !follow(model, r, value, &at, &l, &mut carried).map_err(moved)? {
                     break;
                 }

@@ -229,22 +229,6 @@ impl Transfer {
             .map(|w| w.iter().fold(T::default(), |s, &(b, c)| s + f[b] * c))
             .collect()
     }
-
-    /// [`Transfer::apply`] on points.
-    pub fn apply_points(&self, f: &[[f64; 3]]) -> Vec<[f64; 3]> {
-        self.weights
-            .iter()
-            .map(|w| {
-                let mut p = [0.0; 3];
-                for &(b, c) in w {
-                    for k in 0..3 {
-                        p[k] += c * f[b][k];
-                    }
-                }
-                p
-            })
-            .collect()
-    }
 }
 
 /// The weights at angle `t` on `ring` (old (θ, node) sorted by θ, its first node on the

@@ -87,7 +87,8 @@ pub enum MeshError {
 }
 
 /// How far (in R) a user mesh's node may lie off the case's tube ([`Mesh::check_tube`]): 1e-2.
-/// A node of a surface mesh lies on the surface it discretizes (the generated tubes' to 1e-15);
+/// A node of a surface mesh lies on the surface it discretizes (the generator places its nodes on
+/// the exact circle);
 /// what a mesh of the wrong tube gets wrong is of order R (an axis along x, an ellipse, a
 /// radius 2 under `radius = 1`). One per cent leaves room for meshes written with few digits.
 pub const TUBE_TOLERANCE: f64 = 1e-2;
