@@ -696,22 +696,30 @@ impl StageSpec {
         if let Target::Rho(r) = t {
             if r.is_finite() && r <= 0.0 {
                 invalid!(
-                    "[[stage]] {}: `target_rho` = {r}: no equilibrium there — the plates would have to pass through the tube (ρ → 0 presses it flat, its two walls meeting at y = 0; give ρ > 0)",
-                    i + 1
+                    "[[stage]] {}: `target_rho` = {}: no equilibrium there — the plates would have to pass through the tube (ρ → 0 presses it flat, its two walls meeting at y = 0; give ρ > 0)",
+                    i + 1,
+                    tubemem_material::Num(r)
                 );
             }
         }
         let (name, v, ok) = match t {
             Target::Pressure(p) => ("target_pressure", p, p.is_finite() && p >= 0.0),
-            Target::Stretch(s) => ("target_stretch", s, s.is_finite() && s >= 1.0),
+            // at most the closed form's largest stretch: beyond it the invariants overflow, and
+            // an arc length scaled to 1e308 makes the first step NaN
+            Target::Stretch(s) => (
+                "target_stretch",
+                s,
+                s.is_finite() && (1.0..=tubemem_gps::MAX_STRETCH).contains(&s),
+            ),
             Target::VolumeRatio(r) => ("target_volume_ratio", r, r.is_finite() && r >= 1.0),
             Target::Rho(r) => ("target_rho", r, r.is_finite() && r > 0.0),
             Target::Confine(n) => ("plane", n as f64, n >= 1),
         };
         if !ok {
             invalid!(
-                "[[stage]] {}: `{name}` = {v} is out of range (pressure ≥ 0, stretch ≥ 1, volume ratio ≥ 1, rho > 0)",
-                i + 1
+                "[[stage]] {}: `{name}` = {} is out of range (pressure ≥ 0, stretch in [1, 1e6], volume ratio ≥ 1, rho > 0)",
+                i + 1,
+                tubemem_material::Num(v)
             );
         }
         if self.steps == 0 {
@@ -804,7 +812,8 @@ impl Case {
 
     /// Parse and validate case text (TOML).
     pub fn parse(text: &str) -> Result<Self, CaseError> {
-        let mut case: Case = toml::from_str(text).map_err(|e| CaseError::Syntax(e.to_string()))?;
+        let mut case: Case = toml::from_str(text)
+            .map_err(|e| CaseError::Syntax(tubemem_material::tidy_numbers(&e.to_string())))?;
         case.plan = case.validate()?;
         case.hash = crate::output::case_hash(text);
         Ok(case)

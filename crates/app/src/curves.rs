@@ -1,7 +1,6 @@
 //! Closed-form curves as CSV: the columns of `tubemem gps … --csv` and of the figures' data.
 
 use crate::{AppError, Result};
-use std::io::Write;
 use std::path::Path;
 use tubemem_gps::{FlatteningState, InflationState};
 
@@ -62,8 +61,5 @@ pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>
         out.push_str(&line.join(","));
         out.push('\n');
     }
-    let mut f = std::fs::File::create(path).map_err(|e| AppError::io(path, e))?;
-    f.write_all(out.as_bytes())
-        .map_err(|e| AppError::io(path, e))?;
-    Ok(())
+    tubemem_mesh::file::write_whole(path, out.as_bytes()).map_err(|e| AppError::io(path, e))
 }

@@ -464,12 +464,13 @@ pub fn save(fig: &Figure, stem: &Path, opts: &FigureOptions) -> Result<Vec<PathB
     let svg = render_svg(fig, &svg_path)?;
     let mut written = vec![];
     if opts.svg {
-        std::fs::write(&svg_path, &svg).map_err(|e| AppError::io(&svg_path, e))?;
+        tubemem_mesh::file::write_whole(&svg_path, svg.as_bytes())
+            .map_err(|e| AppError::io(&svg_path, e))?;
         written.push(svg_path);
     }
     if opts.png {
         let png = rasterize(&svg, opts.dpi, &png_path)?;
-        std::fs::write(&png_path, png).map_err(|e| AppError::io(&png_path, e))?;
+        tubemem_mesh::file::write_whole(&png_path, &png).map_err(|e| AppError::io(&png_path, e))?;
         written.push(png_path);
     }
     Ok(written)
@@ -709,7 +710,7 @@ fn write_points(dir: &Path, k: usize, o: &Overlay) -> Result<PathBuf> {
         text.push_str(&crate::curves::csv_line(&r));
         text.push('\n');
     }
-    std::fs::write(&p, text).map_err(|e| AppError::io(&p, e))?;
+    tubemem_mesh::file::write_whole(&p, text.as_bytes()).map_err(|e| AppError::io(&p, e))?;
     Ok(p)
 }
 

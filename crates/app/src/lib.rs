@@ -25,6 +25,7 @@ pub mod edge_fit;
 pub mod edge_track;
 pub mod export;
 pub mod figures;
+mod journal;
 pub mod main_job;
 pub mod output;
 pub mod output_file;
@@ -142,7 +143,9 @@ pub enum AppError {
         path: PathBuf,
         message: String,
     },
-    #[error("an observer stopped the run at stage {stage}, step {step}")]
+    /// An observer of the run (the run writer, the console, a Python callback) failed on a
+    /// converged step (stage 0, step 0: the reference state, before the first stage).
+    #[error("{}", if *stage == 0 { "the outputs of the reference state failed".to_string() } else { format!("stage {stage}, step {step} converged, but its outputs failed") })]
     Observer {
         stage: usize,
         step: usize,

@@ -22,7 +22,7 @@ use crate::report::{RunReport, StepRecord};
 use crate::run::{BoxError, Checkpoint, Observer, StepView};
 use crate::{AppError, Result};
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::post::{cell_contact_pressure, cell_values, regime_code, RingValues};
@@ -47,26 +47,14 @@ pub fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
     }
 }
 
-/// Append `rows` to the CSV at `path`, writing `header` first when the file is new (the files
-/// that only some runs have: fronts.csv, critical_points.csv).
-fn append_csv<R: AsRef<[f64]>>(path: &Path, header: &str, rows: &[R]) -> Result<()> {
-    let fresh = !path.exists();
-    let mut f = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .map_err(|e| AppError::io(path, e))?;
+/// `rows` as CSV lines.
+fn csv_rows<R: AsRef<[f64]>>(rows: &[R]) -> String {
     let mut text = String::new();
-    if fresh {
-        text.push_str(header);
-        text.push('\n');
-    }
     for r in rows {
         text.push_str(&crate::curves::csv_line(r.as_ref()));
         text.push('\n');
     }
-    f.write_all(text.as_bytes())
-        .map_err(|e| AppError::io(path, e))
+    text
 }
 
 /// The values of one critical_points.csv row ([`CRITICAL_HEADER`]; NaN where one does not apply).
@@ -221,7 +209,7 @@ pub enum FolderMode {
 }
 
 /// The entries a run writes; what `Overwrite` removes and `Fresh` refuses to find.
-pub const RUN_ENTRIES: [&str; 13] = [
+pub const RUN_ENTRIES: [&str; 12] = [
     "checkpoints",
     "fronts.csv",
     "iterations.csv",
@@ -233,11 +221,20 @@ pub const RUN_ENTRIES: [&str; 13] = [
     "tube.pvd",
     "vtu",
     "profiles",
-    ".summary.json.tmp",
-    ".run.json.tmp",
+    RESERVE,
 ];
 
 const LOCK: &str = ".tubemem.lock";
+
+/// The space a run holds back for its closing files: a file of [`RESERVE_BYTES`] written when
+/// the run takes its folder and removed when it ends, first thing on a failure, so that a run
+/// stopped by a full disk can still write its manifest and summary (issue #25, class 3).
+const RESERVE: &str = ".tubemem.reserve";
+
+/// 1 MiB: run.json is under 4 KiB and summary.json tens of KiB (the main job's is 11 KiB; a
+/// run of a thousand steps stays under 1 MiB, as the summary holds each stage's end, not each
+/// step).
+const RESERVE_BYTES: usize = 1 << 20;
 
 /// Whether `name` in the run's sub-folder `folder` (`vtu`, `profiles`, `checkpoints`) is a file
 /// the run writes there: the frames `step_NNNNN.vtu` and `critical_stage…_step….vtu`, the
@@ -267,8 +264,44 @@ fn own_file(folder: &str, name: &str) -> bool {
                     .is_some_and(digits)
         }
         "checkpoints" => matches!(name, "ckpt-a.bin" | "ckpt-b.bin" | ".ckpt.tmp"),
+        // the run folder itself
+        "" => RUN_ENTRIES.contains(&name) && !matches!(name, "vtu" | "profiles" | "checkpoints"),
         _ => false,
     }
+}
+
+/// Whether `name` in `folder` is the temporary file of one of the run's whole-file writes
+/// (`.NAME.PID.tmp`, [`tubemem_mesh::file`]), left by a kill between its write and its rename.
+fn own_partial(folder: &str, name: &str) -> bool {
+    tubemem_mesh::file::is_partial(name)
+        && name
+            .strip_prefix('.')
+            .and_then(|r| r.rsplit_once('.'))
+            .and_then(|(r, _)| r.rsplit_once('.'))
+            .is_some_and(|(stem, _)| own_file(folder, stem))
+}
+
+/// Remove the temporary files of the run's whole-file writes in the run folder `dir` and its
+/// sub-folders: a kill between a write and its rename leaves one (`--resume`, `--overwrite`).
+fn remove_partial_files(dir: &Path) -> Result<()> {
+    for folder in ["", "vtu", "profiles", "checkpoints"] {
+        let d = dir.join(folder);
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let p = entry.path();
+            if entry
+                .file_name()
+                .to_str()
+                .is_some_and(|n| own_partial(folder, n))
+                && p.is_file()
+            {
+                std::fs::remove_file(&p).map_err(|e| AppError::io(&p, e))?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `--overwrite` of the run's sub-folder `path` (`folder`): remove the files the run writes
@@ -282,7 +315,7 @@ fn remove_own_files(path: &Path, folder: &str) -> Result<()> {
         let name = entry.file_name();
         let p = entry.path();
         match name.to_str() {
-            Some(n) if own_file(folder, n) && p.is_file() => {
+            Some(n) if (own_file(folder, n) || own_partial(folder, n)) && p.is_file() => {
                 std::fs::remove_file(&p).map_err(|e| AppError::io(&p, e))?;
             }
             _ => left = true,
@@ -333,9 +366,10 @@ struct Manifest<'a> {
 /// Writes a run folder.
 pub struct RunWriter {
     dir: PathBuf,
-    steps: Option<BufWriter<File>>,
-    profiles: Option<BufWriter<File>>,
-    walls: Option<BufWriter<File>>,
+    /// the files of the step being written, undone together if one write fails
+    journal: crate::journal::Journal,
+    /// whether profiles.csv is written (a folder of an earlier version may lack it)
+    profiles: bool,
     pvd: Vec<(f64, String)>,
     frames: usize,
     rows: usize,
@@ -361,7 +395,7 @@ const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT2";
 /// Write a checkpoint: magic, header length (u64 LE), the header as JSON (exact floats), the
 /// node count and the multiplier count (u64 LE), the positions, the pressure and the
 /// multipliers as f64 LE, then the previous state's positions and pressure when there is one.
-fn write_checkpoint(path: &Path, tmp: &Path, ck: &Checkpoint) -> Result<()> {
+fn write_checkpoint(path: &Path, ck: &Checkpoint) -> Result<()> {
     let header = serde_json::to_vec(ck).map_err(|e| AppError::Output {
         what: path.display().to_string(),
         source: Box::new(e),
@@ -392,8 +426,7 @@ fn write_checkpoint(path: &Path, tmp: &Path, ck: &Checkpoint) -> Result<()> {
         }
         buf.extend_from_slice(&p.to_le_bytes());
     }
-    std::fs::write(tmp, &buf).map_err(|e| AppError::io(tmp, e))?;
-    std::fs::rename(tmp, path).map_err(|e| AppError::io(path, e))
+    tubemem_mesh::file::write_whole(path, &buf).map_err(|e| AppError::io(path, e))
 }
 
 /// Read a checkpoint written by [`write_checkpoint`]; `None` if it is not a whole one.
@@ -450,7 +483,7 @@ impl RunWriter {
             message,
         };
         crate::output_file::create_folder(dir)?;
-        let writer = Self::create_locked(dir, case_hash)?;
+        let mut writer = Self::create_locked(dir, case_hash)?;
         let present: Vec<&str> = RUN_ENTRIES
             .iter()
             .copied()
@@ -485,6 +518,8 @@ impl RunWriter {
                 }
             }
         }
+        remove_partial_files(dir)?;
+        writer.reserve()?;
         Ok(writer)
     }
 
@@ -499,7 +534,9 @@ impl RunWriter {
             message,
         };
         if !dir.join("checkpoints").is_dir() {
-            return Err(folder("it holds no checkpoint to resume from".into()));
+            return Err(folder(
+                "it holds no checkpoint to resume from (the run stopped before its first checkpoint): start it afresh with --overwrite".into(),
+            ));
         }
         let mut w = Self::create_locked(dir, case_hash)?;
         let ck = ["a", "b"]
@@ -524,8 +561,7 @@ impl RunWriter {
                 ck.rows
             )));
         }
-        std::fs::write(&path, format!("{}\n", kept.join("\n")))
-            .map_err(|e| AppError::io(&path, e))?;
+        atomic_write(&path, &format!("{}\n", kept.join("\n")))?;
         // frames past the checkpoint
         for k in ck.frames.. {
             let f = dir.join("vtu").join(format!("step_{k:05}.vtu"));
@@ -535,22 +571,10 @@ impl RunWriter {
             std::fs::remove_file(&f).map_err(|e| AppError::io(&f, e))?;
         }
         write_pvd(&dir.join("tube.pvd"), &ck.pvd).map_err(AppError::Mesh)?;
-        let steps = std::fs::OpenOptions::new()
-            .append(true)
-            .open(&path)
-            .map_err(|e| AppError::io(&path, e))?;
-        w.steps = Some(BufWriter::new(steps));
         // walls.csv: the rows of the kept steps (appended to from here on)
         trim_rows(&dir.join("walls.csv"), ck.rows)?;
         // profiles.csv: the rows of the kept steps
-        let path = dir.join("profiles").join("profiles.csv");
-        if trim_rows(&path, ck.rows)? {
-            let f = std::fs::OpenOptions::new()
-                .append(true)
-                .open(&path)
-                .map_err(|e| AppError::io(&path, e))?;
-            w.profiles = Some(BufWriter::new(f));
-        }
+        w.profiles = trim_rows(&dir.join("profiles").join("profiles.csv"), ck.rows)?;
         // fronts.csv, iterations.csv: the rows of the kept steps; critical_points.csv: the
         // checkpoint's points
         trim_rows(&dir.join("fronts.csv"), ck.rows)?;
@@ -562,12 +586,13 @@ impl RunWriter {
             .chain(&ck.critical_points)
             .map(critical_row)
             .collect();
-        if path.exists() {
+        if !points.is_empty() {
+            atomic_write(&path, &format!("{CRITICAL_HEADER}\n{}", csv_rows(&points)))?;
+        } else if path.exists() {
             std::fs::remove_file(&path).map_err(|e| AppError::io(&path, e))?;
         }
-        if !points.is_empty() {
-            append_csv(&path, CRITICAL_HEADER, &points)?;
-        }
+        remove_partial_files(dir)?;
+        w.reserve()?;
         w.pvd = ck.pvd.clone();
         w.frames = ck.frames;
         w.rows = ck.rows;
@@ -607,9 +632,8 @@ impl RunWriter {
         }
         Ok(Self {
             dir: dir.to_path_buf(),
-            steps: None,
-            profiles: None,
-            walls: None,
+            journal: crate::journal::Journal::default(),
+            profiles: true,
             pvd: vec![],
             frames: 0,
             rows: 0,
@@ -623,6 +647,26 @@ impl RunWriter {
         })
     }
 
+    /// Hold back [`RESERVE_BYTES`] of the disk for the closing files ([`RESERVE`]).
+    fn reserve(&mut self) -> Result<()> {
+        let path = self.dir.join(RESERVE);
+        tubemem_mesh::file::write_whole(&path, &vec![0u8; RESERVE_BYTES]).map_err(|e| {
+            AppError::Folder {
+                path: self.dir.clone(),
+                message: format!(
+                    "cannot hold back {} KiB for the run's closing files ({}): {e}",
+                    RESERVE_BYTES >> 10,
+                    path.display()
+                ),
+            }
+        })
+    }
+
+    /// Give the reserved space back ([`RESERVE`]).
+    fn release(&self) {
+        let _ = std::fs::remove_file(self.dir.join(RESERVE));
+    }
+
     /// Write a restart checkpoint every `n` converged steps (0: none; default 1).
     pub fn checkpoint_every(mut self, n: usize) -> Self {
         self.checkpoint_every = n;
@@ -633,6 +677,11 @@ impl RunWriter {
     pub fn frames_of(mut self, output: crate::case::OutputSpec) -> Self {
         self.vtu = output;
         self
+    }
+
+    /// The number of steps whose files are all written (the rows of steps.csv).
+    pub fn steps_written(&self) -> usize {
+        self.rows
     }
 
     /// The number of VTU frames written.
@@ -704,6 +753,7 @@ impl RunWriter {
             components: 1,
             values,
         };
+        self.journal.creating(&self.dir.join("vtu").join(&name));
         write_vtu(
             &self.dir.join("vtu").join(&name),
             &points,
@@ -762,11 +812,7 @@ impl RunWriter {
             what: "run.json".into(),
             source: Box::new(e),
         })?;
-        atomic_write(
-            &self.dir.join("run.json"),
-            &self.dir.join(".run.json.tmp"),
-            &text,
-        )
+        atomic_write(&self.dir.join("run.json"), &text)
     }
 
     fn write_summary(&self, report: &RunReport) -> Result<()> {
@@ -777,7 +823,6 @@ impl RunWriter {
     /// records: the mesh, the model, the memory guard, an interrupt between stages).
     fn write_summary_with(&self, report: &RunReport, error: Option<String>) -> Result<()> {
         let path = self.dir.join("summary.json");
-        let tmp = self.dir.join(".summary.json.tmp");
         let fail = |e: serde_json::Error| AppError::Output {
             what: path.display().to_string(),
             source: Box::new(e),
@@ -787,15 +832,14 @@ impl RunWriter {
             obj.insert("error".into(), serde_json::Value::String(e));
         }
         let text = serde_json::to_string_pretty(&value).map_err(fail)?;
-        atomic_write(&path, &tmp, &text)
+        atomic_write(&path, &text)
     }
 }
 
-/// Write `text` to `tmp`, then rename it over `path`: a reader sees the old file or the new one,
-/// never a partial one.
-fn atomic_write(path: &Path, tmp: &Path, text: &str) -> Result<()> {
-    std::fs::write(tmp, text).map_err(|e| AppError::io(tmp, e))?;
-    std::fs::rename(tmp, path).map_err(|e| AppError::io(path, e))
+/// Write `text` as the whole of `path` ([`tubemem_mesh::file::write_whole`]): a reader sees the
+/// old file or the new one, never a partial one.
+fn atomic_write(path: &Path, text: &str) -> Result<()> {
+    tubemem_mesh::file::write_whole(path, text.as_bytes()).map_err(|e| AppError::io(path, e))
 }
 
 /// The reflections that make the whole tube of a symmetry-reduced model: every combination of
@@ -917,18 +961,18 @@ fn trim_rows(path: &Path, rows: usize) -> Result<bool> {
         })
         .map(|(_, l)| l)
         .collect();
-    std::fs::write(path, format!("{}\n", kept.join("\n"))).map_err(|e| AppError::io(path, e))?;
+    atomic_write(path, &format!("{}\n", kept.join("\n")))?;
     Ok(true)
 }
 
-/// Write a profile (one row per ring) as CSV.
+/// Write a profile (one row per ring) as CSV, whole.
 pub fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
     let mut text = format!("{PROFILE_HEADER}\n");
     for r in rings {
         text.push_str(&join(&ring_row(r)));
         text.push('\n');
     }
-    std::fs::write(path, text).map_err(|e| AppError::io(path, e))
+    atomic_write(path, &text)
 }
 
 impl Observer for RunWriter {
@@ -946,20 +990,102 @@ impl Observer for RunWriter {
             let d = self.dir.join(sub);
             std::fs::create_dir_all(&d).map_err(|e| AppError::io(&d, e))?;
         }
-        let path = self.dir.join("steps.csv");
-        let mut steps = BufWriter::new(File::create(&path).map_err(|e| AppError::io(&path, e))?);
-        writeln!(steps, "{STEPS_HEADER}")?;
-        steps.flush()?;
-        self.steps = Some(steps);
-        let path = self.dir.join("profiles").join("profiles.csv");
-        let mut profiles = BufWriter::new(File::create(&path).map_err(|e| AppError::io(&path, e))?);
-        writeln!(profiles, "{PROFILES_HEADER}")?;
-        profiles.flush()?;
-        self.profiles = Some(profiles);
-        self.frame(0.0, model, state, None)
+        atomic_write(&self.dir.join("steps.csv"), &format!("{STEPS_HEADER}\n"))?;
+        atomic_write(
+            &self.dir.join("profiles").join("profiles.csv"),
+            &format!("{PROFILES_HEADER}\n"),
+        )?;
+        let r = self.frame(0.0, model, state, None);
+        self.settle(r)
     }
 
+    /// A converged step's files, all or none: a write that fails (a full disk) undoes the
+    /// step's other files ([`crate::journal`]), so the folder holds whole rows and frames of
+    /// the steps before it, and `rows` counts them.
     fn step(&mut self, view: &StepView) -> Result<(), BoxError> {
+        let (rows, frames, pvd, vtu_bytes) =
+            (self.rows, self.frames, self.pvd.len(), self.vtu_bytes);
+        let r = self.write_step(view);
+        if r.is_err() {
+            self.rows = rows;
+            self.frames = frames;
+            self.pvd.truncate(pvd);
+            self.vtu_bytes = vtu_bytes;
+        }
+        self.settle(r)
+    }
+
+    fn critical(
+        &mut self,
+        record: &crate::report::CriticalRecord,
+        model: &Model,
+        state: &State,
+        mode: Option<&[[f64; 3]]>,
+    ) -> Result<(), BoxError> {
+        let r = self.write_critical(record, model, state, mode);
+        self.settle(r)
+    }
+
+    fn stage_finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
+        if let Some(stage) = report.stages.last() {
+            let path = self
+                .dir
+                .join("profiles")
+                .join(format!("stage{}_final.csv", stage.plan.index));
+            write_profile(&path, &stage.profile)?;
+        }
+        self.write_summary(report)?;
+        self.write_manifest(report, "running", None)?;
+        Ok(())
+    }
+
+    fn finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
+        self.write_manifest(report, "finished", None)?;
+        self.release();
+        Ok(())
+    }
+
+    fn failed(&mut self, report: &RunReport, error: &AppError) {
+        // Best effort: the run's error is what the user must see. The reserved space is given
+        // back first, so that a run stopped by a full disk can still close its folder: the PVD
+        // index of the kept frames, the summary, and the manifest that says what happened.
+        if self.dir.is_dir() {
+            self.release();
+            let _ = write_pvd(&self.dir.join("tube.pvd"), &self.pvd);
+            // a failure that no stage holds is recorded at the top
+            let in_a_stage = report
+                .stages
+                .iter()
+                .any(|s| matches!(s.outcome, crate::report::StageOutcome::Failed(_)));
+            let _ = self.write_summary_with(report, (!in_a_stage).then(|| error.chain()));
+            let status = if matches!(error, AppError::Interrupted { .. }) {
+                "interrupted"
+            } else {
+                "failed"
+            };
+            let _ = self.write_manifest(report, status, Some(error.chain()));
+        }
+    }
+}
+
+impl RunWriter {
+    /// Keep the files of a step whose writes all succeeded, or undo them all.
+    fn settle(&mut self, r: Result<(), BoxError>) -> Result<(), BoxError> {
+        match r {
+            Ok(()) => {
+                self.journal.commit();
+                Ok(())
+            }
+            Err(e) => {
+                // the write's error is the one to report; an undo that fails too leaves rows
+                // past `steps_written`, which `--resume` cuts back to its checkpoint
+                let _ = self.journal.rollback();
+                Err(e)
+            }
+        }
+    }
+
+    fn write_step(&mut self, view: &StepView) -> Result<(), BoxError> {
         let iterations = view.model.take_iteration_log();
         if self.vtu.iterations && !iterations.is_empty() {
             // the iterations since the last converged step (a cut-back's failed attempts
@@ -983,13 +1109,15 @@ impl Observer for RunWriter {
                     ]
                 })
                 .collect();
-            append_csv(&path, ITERATIONS_HEADER, &rows)?;
+            self.journal
+                .append(&path, ITERATIONS_HEADER, &csv_rows(&rows))?;
         }
-        if let Some(steps) = &mut self.steps {
-            writeln!(steps, "{}", format_row(view.record))?;
-            steps.flush()?;
-            self.rows += 1;
-        }
+        self.journal.append(
+            &self.dir.join("steps.csv"),
+            STEPS_HEADER,
+            &format!("{}\n", format_row(view.record)),
+        )?;
+        self.rows += 1;
         if !view.record.walls.is_empty() && view.fraction >= 1.0 {
             // the mid-span ring of a confine stage's end, whole (symmetry copies), for plots
             // against the closed-form section (`tubemem gps confine --figure … --ring …`)
@@ -1006,25 +1134,12 @@ impl Observer for RunWriter {
                     text.push_str(&format!("{},{}\n", sg[0] * x[0], sg[1] * x[1]));
                 }
             }
-            std::fs::write(&path, text).map_err(|e| AppError::io(&path, e))?;
+            self.journal.create(&path, text.as_bytes())?;
         }
         if !view.record.walls.is_empty() {
-            if self.walls.is_none() {
-                let path = self.dir.join("walls.csv");
-                let fresh = !path.exists();
-                let f = std::fs::OpenOptions::new()
-                    .create(true)
-                    .append(true)
-                    .open(&path)
-                    .map_err(|e| AppError::io(&path, e))?;
-                let mut w = BufWriter::new(f);
-                if fresh {
-                    writeln!(w, "{WALLS_HEADER}")?;
-                }
-                self.walls = Some(w);
-            }
-            if let Some(out) = &mut self.walls {
+            {
                 let r = view.record;
+                let mut text = String::new();
                 let cf = |c: &Option<tubemem_gps::confine::ConfineState>, k: usize| {
                     c.as_ref()
                         .and_then(|c| c.walls.get(k))
@@ -1046,25 +1161,32 @@ impl Observer for RunWriter {
                         l[0],
                         l[1],
                     ];
-                    writeln!(out, "{}", crate::curves::csv_line(&vals))?;
+                    text.push_str(&crate::curves::csv_line(&vals));
+                    text.push('\n');
                 }
-                out.flush()?;
+                self.journal
+                    .append(&self.dir.join("walls.csv"), WALLS_HEADER, &text)?;
             }
         }
         if !view.record.fronts.is_empty() {
-            append_csv(
+            self.journal.append(
                 &self.dir.join("fronts.csv"),
                 FRONTS_HEADER,
-                &front_rows(self.rows, view.record),
+                &csv_rows(&front_rows(self.rows, view.record)),
             )?;
         }
-        if let Some(profiles) = &mut self.profiles {
+        if self.profiles && !view.record.profile.is_empty() {
             let r = view.record;
+            let mut text = String::new();
             for ring in &r.profile {
                 let head = [self.rows as f64, r.stage as f64, r.step as f64];
-                writeln!(profiles, "{},{}", join(&head), join(&ring_row(ring)))?;
+                text.push_str(&format!("{},{}\n", join(&head), join(&ring_row(ring))));
             }
-            profiles.flush()?;
+            self.journal.append(
+                &self.dir.join("profiles").join("profiles.csv"),
+                PROFILES_HEADER,
+                &text,
+            )?;
         }
         use crate::case::VtuFrames;
         let stage_end = view.fraction >= 1.0;
@@ -1103,21 +1225,21 @@ impl Observer for RunWriter {
         } else {
             "ckpt-b.bin"
         };
-        write_checkpoint(&dir.join(name), &dir.join(".ckpt.tmp"), &ck)?;
+        write_checkpoint(&dir.join(name), &ck)?;
         Ok(())
     }
 
-    fn critical(
+    fn write_critical(
         &mut self,
         record: &crate::report::CriticalRecord,
         model: &Model,
         state: &State,
         mode: Option<&[[f64; 3]]>,
     ) -> Result<(), BoxError> {
-        append_csv(
+        self.journal.append(
             &self.dir.join("critical_points.csv"),
             CRITICAL_HEADER,
-            &[critical_row(record)],
+            &csv_rows(&[critical_row(record)]),
         )?;
         // a bifurcation: the state with its critical mode, for ParaView
         if let (Some(mode), Some(name)) = (mode, &record.mode_vtu) {
@@ -1129,6 +1251,7 @@ impl Observer for RunWriter {
                 .collect();
             let m: Vec<f64> = mode.iter().flatten().copied().collect();
             let path = self.dir.join(name);
+            self.journal.creating(&path);
             write_vtu(
                 &path,
                 &state.x,
@@ -1171,6 +1294,7 @@ impl Observer for RunWriter {
                     )],
                 },
             );
+            self.journal.creating(&self.dir.join(name));
             let stem = self.dir.join(name.trim_end_matches(".png"));
             crate::figures::save(
                 &fig,
@@ -1183,42 +1307,5 @@ impl Observer for RunWriter {
             )?;
         }
         Ok(())
-    }
-
-    fn stage_finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
-        if let Some(stage) = report.stages.last() {
-            let path = self
-                .dir
-                .join("profiles")
-                .join(format!("stage{}_final.csv", stage.plan.index));
-            write_profile(&path, &stage.profile)?;
-        }
-        self.write_summary(report)?;
-        self.write_manifest(report, "running", None)?;
-        Ok(())
-    }
-
-    fn finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
-        self.write_manifest(report, "finished", None)?;
-        Ok(())
-    }
-
-    fn failed(&mut self, report: &RunReport, error: &AppError) {
-        // Best effort: the run's error is what the user must see; a summary that cannot be
-        // written here would have failed at the last stage end as well.
-        if self.dir.is_dir() {
-            // a failure that no stage holds is recorded at the top
-            let in_a_stage = report
-                .stages
-                .iter()
-                .any(|s| matches!(s.outcome, crate::report::StageOutcome::Failed(_)));
-            let _ = self.write_summary_with(report, (!in_a_stage).then(|| error.chain()));
-            let status = if matches!(error, AppError::Interrupted { .. }) {
-                "interrupted"
-            } else {
-                "failed"
-            };
-            let _ = self.write_manifest(report, status, Some(error.chain()));
-        }
     }
 }

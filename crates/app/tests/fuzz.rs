@@ -1,7 +1,9 @@
 //! The fuzz harness: structure-aware random case files and user meshes through the whole
 //! application (parse → validate → mesh → model → run → outputs). The property: no input makes
-//! tubemem panic, every failure is a typed error whose message is not empty and holds no
-//! `NaN`, and every number a finished run reports is finite.
+//! tubemem panic, no input takes more than 10 s (issue #25's per-input limit; runs are stopped
+//! at 2 s, below), every failure is a typed error whose message is not empty, holds no `NaN`
+//! and no number of more than 17 digits (1e308 reads as 1e308), and every number a finished run
+//! reports is finite.
 //!
 //! * In the test command: `cargo test -p tubemem-app --test fuzz` runs 48 generated inputs (a few
 //!   seconds, from a fixed seed) plus the crash inputs found before as regression seeds.
@@ -218,6 +220,7 @@ fn check(text: &str, mesh: &str) -> Result<(), TestCaseError> {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("mesh.json"), mesh).unwrap();
+    let started = Instant::now();
     let outcome = std::panic::catch_unwind(|| {
         let mut case = match Case::parse(text) {
             Ok(c) => c,
@@ -249,7 +252,12 @@ fn check(text: &str, mesh: &str) -> Result<(), TestCaseError> {
             None => Ok(serde_json::to_value(out.report.summary()).unwrap()),
         }
     });
+    let seconds = started.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
+    prop_assert!(
+        seconds < 10.0,
+        "{seconds:.1} s (over the 10 s limit) for:\n{text}"
+    );
     match outcome {
         Err(_) => Err(TestCaseError::fail(format!(
             "panic on input:\n{text}\n--- mesh:\n{mesh}"
@@ -260,6 +268,18 @@ fn check(text: &str, mesh: &str) -> Result<(), TestCaseError> {
             prop_assert!(
                 !msg.contains("NaN") || text.contains("nan"),
                 "NaN in the message `{}` for:\n{}",
+                msg,
+                text
+            );
+            let digits = msg
+                .split(|c: char| !c.is_ascii_digit())
+                .map(str::len)
+                .max()
+                .unwrap_or(0);
+            prop_assert!(
+                digits <= 17,
+                "a number of {} digits in the message `{}` for:\n{}",
+                digits,
                 msg,
                 text
             );

@@ -150,7 +150,8 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
             text.push_str(&row.join(","));
             text.push('\n');
         }
-        std::fs::write(csv, text).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        tubemem_mesh::file::write_whole(csv, text.as_bytes())
+            .map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
         crate::say!("wrote {} states to {}", path.len(), csv.display())?;
     }
     if let Some(fig) = &a.figure {

@@ -249,16 +249,20 @@ fn run_case(
             Ok(())
         }
         Some(e) => {
-            let steps = outcome.report.steps().count();
-            Err(app(e)).with_context(|| {
-                if steps == 0 {
+            // what is on disk: a step whose outputs failed converged but was not kept
+            let (converged, written) = (outcome.report.steps().count(), writer.steps_written());
+            Err(app(e)).with_context(|| match written {
+                0 if converged == 0 => {
                     format!("the run stopped before its first step ({})", out.display())
-                } else {
-                    format!(
-                        "the run stopped; its {steps} converged steps are in {}",
-                        out.display()
-                    )
                 }
+                _ if written < converged => format!(
+                    "the run stopped; {written} of its {converged} converged steps are in {} (steps.csv; the rest could not be written)",
+                    out.display()
+                ),
+                _ => format!(
+                    "the run stopped; its {written} converged steps are in {}",
+                    out.display()
+                ),
             })
         }
     }
@@ -305,7 +309,8 @@ fn run(cli: Cli) -> Result<()> {
                 bulk_ratio,
             )
             .with_context(|| format!("cannot export {}", case.display()))?;
-            std::fs::write(&out, deck).with_context(|| format!("writing {}", out.display()))?;
+            tubemem_mesh::file::write_whole(&out, deck.as_bytes())
+                .with_context(|| format!("writing {}", out.display()))?;
             tubemem_cli::say!("wrote {}", out.display())?;
             Ok(())
         }
@@ -352,12 +357,21 @@ fn main() -> ExitCode {
                 )
             }) =>
         {
-            let _ = writeln!(std::io::stderr(), "error: {e:#}");
+            let _ = writeln!(
+                std::io::stderr(),
+                "error: {}",
+                tubemem_material::tidy_numbers(&format!("{e:#}"))
+            );
             ExitCode::from(130)
         }
         Err(e) => {
-            // a closed standard error cannot be reported anywhere: the exit code says it
-            let _ = writeln!(std::io::stderr(), "error: {e:#}");
+            // a closed standard error cannot be reported anywhere: the exit code says it; the
+            // numbers of every cause as a user reads them (1e308, not 309 digits)
+            let _ = writeln!(
+                std::io::stderr(),
+                "error: {}",
+                tubemem_material::tidy_numbers(&format!("{e:#}"))
+            );
             ExitCode::FAILURE
         }
     }

@@ -2065,3 +2065,51 @@ fn overwrite_keeps_the_files_a_user_put_in_the_run_folder() {
     assert!(!out.join("vtu").join("step_99999.vtu").exists());
     assert!(out.join("vtu").join("step_00000.vtu").exists());
 }
+
+/// Issue #25, class 6: a value such as 1e308 is echoed as 1e308 in every message, from our own
+/// checks, from the TOML reader's and from a law's; and a target stretch past the closed form's
+/// 1e6 or a Kuhn number past 1e6 is refused before the run (they ran into NaN).
+#[test]
+fn huge_values_are_echoed_in_scientific_notation() {
+    let d = tmp("huge");
+    let small = include_str!("../../../cases/small_abb30_ls1.2.toml");
+    let squeeze =
+        format!("{small}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1e308\nsteps = 2\n");
+    for (k, (text, needle)) in [
+        (
+            small.replace("target_stretch = 1.2", "target_stretch = -1e308"),
+            "`target_stretch` = -1e308 is out of range",
+        ),
+        (
+            small.replace("target_stretch = 1.2", "target_stretch = 1e308"),
+            "`target_stretch` = 1e308 is out of range (pressure ≥ 0, stretch in [1, 1e6]",
+        ),
+        (
+            small.replace("around = 16", "around = 1e308"),
+            "floating point `1e308`, expected usize",
+        ),
+        (
+            small.replace("kuhn = 30", "kuhn = 1e308"),
+            "`kuhn` = 1e308: the Kuhn segment number must be > 1 and at most 1e6",
+        ),
+        (squeeze, "`target_rho` = 1e308"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let case = d.join(format!("c{k}.toml"));
+        std::fs::write(&case, text).unwrap();
+        let o = run_in(&case, &d.join(format!("o{k}")), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && err.contains(needle),
+            "{needle}: {err}"
+        );
+        let longest = err
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0);
+        assert!(longest <= 17, "a {longest}-digit number in: {err}");
+    }
+}

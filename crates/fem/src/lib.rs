@@ -180,7 +180,8 @@ impl FemError {
     }
 }
 
-/// The message of an error followed by its causes, ": "-separated.
+/// The message of an error followed by its causes, ": "-separated, its numbers as a user reads
+/// them ([`tubemem_material::tidy_numbers`]).
 pub fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
     let mut s = e.to_string();
     let mut cur = e.source();
@@ -189,5 +190,5 @@ pub fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
         s.push_str(&c.to_string());
         cur = c.source();
     }
-    s
+    tubemem_material::tidy_numbers(&s)
 }

@@ -7,14 +7,64 @@ use thiserror::Error;
 pub struct Num(pub f64);
 
 impl std::fmt::Display for Num {
+    /// A precision (`{:.6}`) is kept: digits after the point when plain, of the mantissa when
+    /// scientific.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let v = self.0;
-        if v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs()) {
-            write!(f, "{v:e}")
-        } else {
-            write!(f, "{v}")
+        let scientific = v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs());
+        match (scientific, f.precision()) {
+            (true, Some(p)) => write!(f, "{v:.p$e}"),
+            (true, None) => write!(f, "{v:e}"),
+            (false, Some(p)) => write!(f, "{v:.p$}"),
+            (false, None) => write!(f, "{v}"),
         }
     }
+}
+
+/// The messages of other crates (serde's "invalid type: floating point `1000…0`") with every
+/// number of more than 17 digits written as [`Num`] writes it: the one rule for a number a
+/// user reads, applied where a message is not ours to format.
+pub fn tidy_numbers(message: &str) -> String {
+    let b = message.as_bytes();
+    let mut out = String::with_capacity(message.len());
+    let mut i = 0;
+    while i < b.len() {
+        // a number: optional sign, digits, optional fraction, optional exponent
+        let start = i;
+        let mut j = i;
+        if matches!(b[j], b'-' | b'+') && j + 1 < b.len() && b[j + 1].is_ascii_digit() {
+            j += 1;
+        }
+        if j < b.len()
+            && b[j].is_ascii_digit()
+            && (start == 0 || !(b[start - 1].is_ascii_alphanumeric() || b[start - 1] == b'.'))
+        {
+            while j < b.len() && b[j].is_ascii_digit() {
+                j += 1;
+            }
+            if j + 1 < b.len() && b[j] == b'.' && b[j + 1].is_ascii_digit() {
+                j += 1;
+                while j < b.len() && b[j].is_ascii_digit() {
+                    j += 1;
+                }
+            }
+            let digits = b[start..j].iter().filter(|c| c.is_ascii_digit()).count();
+            if digits > 17 {
+                if let Ok(v) = message[start..j].parse::<f64>() {
+                    out.push_str(&Num(v).to_string());
+                    i = j;
+                    continue;
+                }
+            }
+            out.push_str(&message[start..j]);
+            i = j;
+            continue;
+        }
+        let c = message[i..].chars().next().unwrap_or(' ');
+        out.push(c);
+        i += c.len_utf8();
+    }
+    out
 }
 
 /// Why a material law or a stretch state was rejected.

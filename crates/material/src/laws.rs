@@ -22,6 +22,12 @@ fn check_positive(name: &'static str, value: f64) -> Result<(), MaterialError> {
 /// W̄'(I1) = K [ 1/(6𝒩) − 1/(I1 − 3𝒩) ],   W̄''(I1) = K/(I1 − 3𝒩)²
 /// ```
 /// W̄'(3) = ½, so μ is the small-strain shear modulus; the chains lock at I1 → 3𝒩.
+/// The largest Kuhn segment number the law takes, 1e6 (networks have tens to hundreds; the
+/// paper's is 30). The energy's logarithm ln((I1 − 3𝒩)/(3 − 3𝒩)) is that of a ratio within
+/// (I1 − 3)/(3𝒩) of 1, so its relative error is about 1.1e-16 · 3𝒩/(I1 − 3): 3e-4 at 𝒩 = 1e6
+/// and I1 − 3 = 1e-6, and all of it beyond 𝒩 ≈ 1e10 there; at 𝒩 = 1e308, 3𝒩 overflows.
+pub const MAX_KUHN: f64 = 1e6;
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AnssariBenamBucchi {
     shear_modulus: f64,
@@ -30,14 +36,14 @@ pub struct AnssariBenamBucchi {
 
 impl AnssariBenamBucchi {
     /// `shear_modulus` μ > 0 (any unit: the dimensionless functions do not use it) and Kuhn
-    /// segment number 𝒩 > 1.
+    /// segment number 1 < 𝒩 ≤ [`MAX_KUHN`].
     pub fn new(shear_modulus: f64, kuhn: f64) -> Result<Self, MaterialError> {
         check_positive("shear_modulus", shear_modulus)?;
-        if !(kuhn.is_finite() && kuhn > 1.0) {
+        if !(kuhn.is_finite() && kuhn > 1.0 && kuhn <= MAX_KUHN) {
             return Err(MaterialError::InvalidParameter {
                 name: "kuhn",
                 value: kuhn,
-                requirement: "the Kuhn segment number must be finite and > 1",
+                requirement: "the Kuhn segment number must be > 1 and at most 1e6",
             });
         }
         Ok(Self {
@@ -71,7 +77,7 @@ impl AnssariBenamBucchi {
 
 impl MembraneLaw for AnssariBenamBucchi {
     fn name(&self) -> String {
-        format!("Anssari-Benam–Bucchi (𝒩 = {})", self.kuhn)
+        format!("Anssari-Benam–Bucchi (𝒩 = {})", crate::Num(self.kuhn))
     }
     fn shear_modulus(&self) -> f64 {
         self.shear_modulus

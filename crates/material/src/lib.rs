@@ -40,7 +40,7 @@ mod error;
 pub mod laws;
 pub mod relaxed;
 
-pub use error::{MaterialError, Num};
+pub use error::{tidy_numbers, MaterialError, Num};
 use serde::{Deserialize, Serialize};
 
 /// W(a, b) and its partial derivatives, a = tr C, b = det C (dimensionless, per μ).

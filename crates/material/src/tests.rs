@@ -385,3 +385,26 @@ fn hand_dual_matches_num_dual() {
         }
     }
 }
+
+/// Issue #25, class 6: numbers in messages read as a user writes them. `Num` keeps a precision;
+/// `tidy_numbers` rewrites a number of more than 17 digits (what Rust's `{}` makes of 1e308 or
+/// 1e-300) in another crate's message, and leaves every other number and word alone.
+#[test]
+fn numbers_in_messages_read_as_written() {
+    use crate::{tidy_numbers, Num};
+    assert_eq!(format!("{:.6}", Num(1.5)), "1.500000");
+    assert_eq!(format!("{:.3}", Num(4.069e303)), "4.069e303");
+    assert_eq!(format!("{}", Num(1e308)), "1e308");
+    assert_eq!(format!("{}", Num(-2.5e-9)), "-2.5e-9");
+    let big = format!("invalid type: floating point `{}`, expected usize", 1e308);
+    assert_eq!(
+        tidy_numbers(&big),
+        "invalid type: floating point `1e308`, expected usize"
+    );
+    let small = format!("`offset` = {} and {}", 1e-300, -1e300);
+    assert_eq!(tidy_numbers(&small), "`offset` = 1e-300 and -1e300");
+    let plain = "step 12 (load parameter 0.123456): 3 cut-backs, pid 4711, fnv1a64:00ff12, x2.5";
+    assert_eq!(tidy_numbers(plain), plain);
+    // 18 digits are more than a double holds: the shortest form of the same double
+    assert_eq!(tidy_numbers("λ = 1.30000000000000004 ✓"), "λ = 1.3 ✓");
+}

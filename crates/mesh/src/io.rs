@@ -133,7 +133,7 @@ pub fn write_json(path: &Path, mesh: &Mesh) -> Result<(), MeshError> {
         path: path.display().to_string(),
         reason: e.to_string(),
     })?;
-    std::fs::write(path, text).map_err(|e| MeshError::Io {
+    crate::file::write_whole(path, text.as_bytes()).map_err(|e| MeshError::Io {
         path: path.display().to_string(),
         reason: e.to_string(),
     })

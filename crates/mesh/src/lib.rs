@@ -23,6 +23,7 @@
 // a non-finite coordinate is reported instead of slipping through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod file;
 pub mod hoop;
 pub mod io;
 pub mod shape;

@@ -215,7 +215,7 @@ pub fn write_vtu<C: AsRef<[usize]>>(
         data_array(&mut s, f, quads.len(), encoding).map_err(|e| io_err(path, e))?;
     }
     s.push_str("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
-    std::fs::write(path, s).map_err(|e| io_err(path, e))
+    crate::file::write_whole(path, s.as_bytes()).map_err(|e| io_err(path, e))
 }
 
 /// Write a `.pvd` collection of (time, file name relative to the `.pvd`) entries.
@@ -230,7 +230,7 @@ pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> Result<(), MeshError
         );
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
-    std::fs::write(path, s).map_err(|e| io_err(path, e))
+    crate::file::write_whole(path, s.as_bytes()).map_err(|e| io_err(path, e))
 }
 
 #[cfg(test)]

@@ -52,8 +52,10 @@ fn material_err(e: MaterialError) -> PyErr {
         // a stretch beyond the locking limit, asked for directly, is bad input too
         MaterialError::InvalidParameter { .. }
         | MaterialError::InvalidState { .. }
-        | MaterialError::Locking { .. } => PyValueError::new_err(e.to_string()),
-        _ => TubememError::new_err(e.to_string()),
+        | MaterialError::Locking { .. } => {
+            PyValueError::new_err(tubemem_material::tidy_numbers(&e.to_string()))
+        }
+        _ => TubememError::new_err(tubemem_material::tidy_numbers(&e.to_string())),
     }
 }
 
@@ -72,7 +74,8 @@ fn from_py<T: serde::de::DeserializeOwned>(obj: &Bound<'_, PyAny>, what: &str) -
             ))
         })?
         .extract()?;
-    serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
+    serde_json::from_str(&text)
+        .map_err(|e| PyValueError::new_err(tubemem_material::tidy_numbers(&format!("{what}: {e}"))))
 }
 
 /// A serde value to a Python object, through `json.loads`.

@@ -355,7 +355,7 @@ pub fn run_check(c: &Check, out: &Path, opts: &VerifyOptions) -> CheckResult {
     }
     if let Some(png) = &r.png {
         let p = dir.join("plot.png");
-        if std::fs::write(&p, png).is_ok() {
+        if tubemem_mesh::file::write_whole(&p, png).is_ok() {
             r.plot = Some(format!("{}/plot.png", c.spec.name));
         }
     }
@@ -1352,9 +1352,10 @@ fn gold(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -> Kin
     if opts.update_gold {
         std::fs::create_dir_all(&c.gold_dir)
             .map_err(|e| format!("{}: {e}", c.gold_dir.display()))?;
-        std::fs::write(&gsteps, &steps).map_err(|e| format!("{}: {e}", gsteps.display()))?;
+        tubemem_mesh::file::write_whole(&gsteps, steps.as_bytes())
+            .map_err(|e| format!("{}: {e}", gsteps.display()))?;
         let text = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
-        std::fs::write(&gsummary, text + "\n")
+        tubemem_mesh::file::write_whole(&gsummary, (text + "\n").as_bytes())
             .map_err(|e| format!("{}: {e}", gsummary.display()))?;
         r.message = format!(
             "gold files rewritten in {} (--update-gold)",

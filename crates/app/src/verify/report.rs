@@ -308,7 +308,8 @@ pub fn write_all(out: &Path, r: &Results) -> crate::Result<Vec<PathBuf>> {
         ("junit.xml", junit(r)),
     ] {
         let p = out.join(name);
-        std::fs::write(&p, text).map_err(|e| crate::AppError::io(&p, e))?;
+        tubemem_mesh::file::write_whole(&p, text.as_bytes())
+            .map_err(|e| crate::AppError::io(&p, e))?;
         written.push(p);
     }
     Ok(written)

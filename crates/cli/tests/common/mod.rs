@@ -1,0 +1,53 @@
+//! What the end-to-end tests of the binary share: running it, and their scratch folders.
+#![allow(dead_code)] // each test file uses a part
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Run the `tubemem` binary with `args`.
+pub fn tubemem(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .output()
+        .expect("the tubemem binary runs")
+}
+
+/// A fresh scratch folder of this test process, named `name`.
+pub fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tubemem-cli-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// `tubemem run CASE --out OUT EXTRA…`.
+pub fn run_in(case: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    tubemem(&args)
+}
+
+/// `files` of run folder `b` byte-identical to `a`'s, and with `frames` every VTU frame too.
+pub fn assert_same_run(a: &Path, b: &Path, files: &[&str], frames: bool) {
+    for f in files {
+        assert!(
+            std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
+            "{f} differs after the restart"
+        );
+    }
+    if frames {
+        for f in std::fs::read_dir(a.join("vtu")).unwrap() {
+            let name = f.unwrap().file_name();
+            assert!(
+                std::fs::read(a.join("vtu").join(&name)).unwrap()
+                    == std::fs::read(b.join("vtu").join(&name)).unwrap(),
+                "{name:?} differs"
+            );
+        }
+    }
+}
