@@ -41,12 +41,9 @@ pub fn csv_line(values: &[f64]) -> String {
         .join(",")
 }
 
-/// Write rows of numbers as CSV (shortest round-trip representation). A non-finite value is
-/// refused: it would be a silent wrong answer.
-pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
-    }
+/// Rows of numbers as CSV text (shortest round-trip representation), for the file `path`. A
+/// non-finite value is refused: it would be a silent wrong answer.
+pub fn csv_text(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<String> {
     let mut out = String::with_capacity(1 << 16);
     out.push_str(header);
     out.push('\n');
@@ -61,5 +58,14 @@ pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>
         out.push_str(&line.join(","));
         out.push('\n');
     }
+    Ok(out)
+}
+
+/// Write rows of numbers as CSV ([`csv_text`]), whole.
+pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
+    }
+    let out = csv_text(path, header, rows)?;
     tubemem_mesh::file::write_whole(path, out.as_bytes()).map_err(|e| AppError::io(path, e))
 }

@@ -16,7 +16,7 @@
 //! another law than the curves' is refused.
 
 use crate::curves::{
-    flattening_values, inflation_values, write_csv, FLATTENING_HEADER, INFLATION_HEADER,
+    csv_text, flattening_values, inflation_values, FLATTENING_HEADER, INFLATION_HEADER,
 };
 use crate::report::RunReport;
 use crate::{AppError, Result};
@@ -453,6 +453,20 @@ pub fn rasterize(svg: &str, dpi: f64, path: &Path) -> Result<Vec<u8>> {
 
 /// Write `fig` as `<stem>.svg` and/or `<stem>.png`; returns the files written.
 pub fn save(fig: &Figure, stem: &Path, opts: &FigureOptions) -> Result<Vec<PathBuf>> {
+    let mut written = vec![];
+    for (path, bytes) in render_files(fig, stem, opts)? {
+        tubemem_mesh::file::write_whole(&path, &bytes).map_err(|e| AppError::io(&path, e))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// The files [`save`] writes, rendered: (path, content).
+pub fn render_files(
+    fig: &Figure,
+    stem: &Path,
+    opts: &FigureOptions,
+) -> Result<Vec<(PathBuf, Vec<u8>)>> {
     opts.check()?;
     // (not `with_extension`: a stem like `…_ls1.3` has a dot of its own)
     let with = |ext: &str| {
@@ -462,18 +476,15 @@ pub fn save(fig: &Figure, stem: &Path, opts: &FigureOptions) -> Result<Vec<PathB
     };
     let (svg_path, png_path) = (with(".svg"), with(".png"));
     let svg = render_svg(fig, &svg_path)?;
-    let mut written = vec![];
-    if opts.svg {
-        tubemem_mesh::file::write_whole(&svg_path, svg.as_bytes())
-            .map_err(|e| AppError::io(&svg_path, e))?;
-        written.push(svg_path);
-    }
+    let mut files = vec![];
     if opts.png {
         let png = rasterize(&svg, opts.dpi, &png_path)?;
-        tubemem_mesh::file::write_whole(&png_path, &png).map_err(|e| AppError::io(&png_path, e))?;
-        written.push(png_path);
+        files.push((png_path, png));
     }
-    Ok(written)
+    if opts.svg {
+        files.insert(0, (svg_path, svg.into_bytes()));
+    }
+    Ok(files)
 }
 
 /// One FE point of a squeeze step.
@@ -666,7 +677,7 @@ fn slug(s: &str) -> String {
 
 /// The overlays' points as CSV, one file each: every FE point drawn, with the GPS force at the
 /// same ρ from the run's λs* and the difference shown in the error panels.
-fn write_points(dir: &Path, k: usize, o: &Overlay) -> Result<PathBuf> {
+fn points_file(dir: &Path, k: usize, o: &Overlay) -> (PathBuf, Vec<u8>) {
     let p = dir.join(format!("fe_points_{}_{}.csv", k + 1, slug(&o.label)));
     let mut rows: Vec<Vec<f64>> = o
         .inflation
@@ -710,8 +721,7 @@ fn write_points(dir: &Path, k: usize, o: &Overlay) -> Result<PathBuf> {
         text.push_str(&crate::curves::csv_line(&r));
         text.push('\n');
     }
-    tubemem_mesh::file::write_whole(&p, text.as_bytes()).map_err(|e| AppError::io(&p, e))?;
-    Ok(p)
+    (p, text.into_bytes())
 }
 
 /// Compute the curves of `law` (or, when `None`, of the overlays' law, else the paper's) and
@@ -739,11 +749,11 @@ pub fn write_all(
             });
         }
     }
-    crate::output_file::create_folder(dir)?;
     let built = spec.build()?;
     let law = built.as_ref();
     let name = law_label(&spec);
-    let mut written = vec![];
+    // every file rendered first; the folder is checked and written only once all are
+    let mut files: Vec<(PathBuf, Vec<u8>)> = vec![];
     let hyps = [(Hypothesis::Gps, GPS_COLOR), (Hypothesis::Ps, PS_COLOR)];
     let starts = [(1.3, Stroke::Dashed), (6.0, Stroke::Dotted)];
 
@@ -752,8 +762,8 @@ pub fn write_all(
         let c = inflation_curve(law, h, 1.0, 7.5, 651)
             .map_err(|e| AppError::gps("the inflation curve", e))?;
         let p = dir.join(format!("inflation_{}.csv", h.label().to_lowercase()));
-        write_csv(&p, INFLATION_HEADER, c.iter().map(inflation_values))?;
-        written.push(p);
+        let text = csv_text(&p, INFLATION_HEADER, c.iter().map(inflation_values))?;
+        files.push((p, text.into_bytes()));
         inflation.push(c);
     }
     // flattening[start][hyp]
@@ -767,8 +777,8 @@ pub fn write_all(
                 "flattening_ls{ls0:.1}_{}.csv",
                 h.label().to_lowercase()
             ));
-            write_csv(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
-            written.push(p);
+            let text = csv_text(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
+            files.push((p, text.into_bytes()));
             per.push(c);
         }
         flattening.push(per);
@@ -776,7 +786,7 @@ pub fn write_all(
     let limits =
         limit_points(law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))?;
     for (k, o) in overlays.iter().enumerate() {
-        written.push(write_points(dir, k, o)?);
+        files.push(points_file(dir, k, o));
     }
 
     // Fig. 5
@@ -866,7 +876,7 @@ pub fn write_all(
         })
         .filter(|m| !m.points.is_empty())
         .collect();
-    written.extend(save(
+    files.extend(render_files(
         &Figure {
             markers,
             ..Figure::new(
@@ -879,7 +889,7 @@ pub fn write_all(
         &dir.join("fig5_pressure_stretch"),
         opts,
     )?);
-    written.extend(save(
+    files.extend(render_files(
         &Figure {
             markers: zoom_markers,
             y_from_zero: false,
@@ -962,7 +972,7 @@ pub fn write_all(
             series: vec![],
             markers: errors,
         });
-        written.extend(save(
+        files.extend(render_files(
             &Figure {
                 markers,
                 panel,
@@ -1006,7 +1016,7 @@ pub fn write_all(
         stroke: Stroke::Solid,
         width: 3,
     });
-    written.extend(save(
+    files.extend(render_files(
         &Figure::new(
             format!("Axial stretch vs hoop stretch ({name})"),
             "hoop stretch λs",
@@ -1016,8 +1026,13 @@ pub fn write_all(
         &dir.join("fig_lambda_z"),
         opts,
     )?);
-    Ok(written)
+    crate::output_file::create_folder(dir)?;
+    crate::output_file::write_owned(dir, FIGURES_MANIFEST, "tubemem figures", &files)
 }
+
+/// The list of the files `tubemem figures` wrote into its folder, so that a later call replaces
+/// those and refuses any other file of the same name.
+const FIGURES_MANIFEST: &str = ".tubemem-figures";
 
 /// A critical mode along the tube: the means over each ring of nodes at the reference radius
 /// (the cylinder and the caps' equators) of the mode's radial and axial components, against

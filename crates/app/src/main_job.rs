@@ -67,7 +67,7 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
     let case = Case::parse(DEFAULT_CASE)?;
     let run_dir = out.join("squeeze");
     // the main job's own folder: each run of it replaces the last
-    let mut writer = RunWriter::create(&run_dir, FolderMode::Overwrite, case.hash())?;
+    let mut writer = RunWriter::create(&run_dir, FolderMode::Overwrite, case.hash(), &[])?;
     let mut all: Vec<&mut dyn Observer> = vec![&mut writer];
     all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
     let report = run(

@@ -281,6 +281,44 @@ fn own_partial(folder: &str, name: &str) -> bool {
             .is_some_and(|(stem, _)| own_file(folder, stem))
 }
 
+/// Refuse a run folder `dir` in which one of the run's `inputs` (the case file, a user mesh
+/// file) has the name of a file the run writes, replaces or removes (`DIR/summary.json` as the
+/// case file): tubemem never writes over its inputs (issue #25, class 4).
+fn refuse_inputs(dir: &Path, inputs: &[&Path]) -> Result<()> {
+    let Ok(root) = dir.canonicalize() else {
+        // a folder that does not exist yet holds no input
+        return Ok(());
+    };
+    for input in inputs {
+        let Ok(path) = input.canonicalize() else {
+            continue;
+        };
+        let (Some(parent), Some(name)) = (path.parent(), path.file_name().and_then(|n| n.to_str()))
+        else {
+            continue;
+        };
+        let folder = if parent == root {
+            Some("")
+        } else {
+            ["vtu", "profiles", "checkpoints"]
+                .into_iter()
+                .find(|f| parent == root.join(f))
+        };
+        if let Some(folder) = folder {
+            if own_file(folder, name) || own_partial(folder, name) || name == LOCK {
+                return Err(AppError::Folder {
+                    path: dir.to_path_buf(),
+                    message: format!(
+                        "the input {} has the name of a file the run writes there: tubemem never writes over its inputs; move it, or choose another --out",
+                        input.display()
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Remove the temporary files of the run's whole-file writes in the run folder `dir` and its
 /// sub-folders: a kill between a write and its rename leaves one (`--resume`, `--overwrite`).
 fn remove_partial_files(dir: &Path) -> Result<()> {
@@ -477,11 +515,12 @@ impl RunWriter {
     /// Take the folder `dir` for a run of the case whose text hashes to `case_hash`
     /// ([`case_hash`]): create it, lock it, and refuse (`Fresh`) or clear (`Overwrite`) an
     /// earlier run found in it.
-    pub fn create(dir: &Path, mode: FolderMode, case_hash: &str) -> Result<Self> {
+    pub fn create(dir: &Path, mode: FolderMode, case_hash: &str, inputs: &[&Path]) -> Result<Self> {
         let folder = |message: String| AppError::Folder {
             path: dir.to_path_buf(),
             message,
         };
+        refuse_inputs(dir, inputs)?;
         crate::output_file::create_folder(dir)?;
         let mut writer = Self::create_locked(dir, case_hash)?;
         let present: Vec<&str> = RUN_ENTRIES
@@ -528,11 +567,12 @@ impl RunWriter {
     /// steps.csv and the VTU series back to that checkpoint (a kill may have come between a
     /// step's files and its checkpoint). Returns the writer and the checkpoint to give to
     /// [`crate::run::RunOptions::resume`].
-    pub fn resume(dir: &Path, case_hash: &str) -> Result<(Self, Checkpoint)> {
+    pub fn resume(dir: &Path, case_hash: &str, inputs: &[&Path]) -> Result<(Self, Checkpoint)> {
         let folder = |message: String| AppError::Folder {
             path: dir.to_path_buf(),
             message,
         };
+        refuse_inputs(dir, inputs)?;
         if !dir.join("checkpoints").is_dir() {
             return Err(folder(
                 "it holds no checkpoint to resume from (the run stopped before its first checkpoint): start it afresh with --overwrite".into(),

@@ -115,3 +115,62 @@ pub fn create_folder(dir: &Path) -> Result<()> {
     }
     std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))
 }
+
+/// Write `files` into the folder `dir` of a command (`who`, e.g. "tubemem figures") that
+/// records in `dir/manifest` the names it has written there: an existing file is replaced only
+/// if the manifest lists it (or, in a folder written before manifests existed, if it begins
+/// with the same 64 bytes as its new content: the same CSV header, SVG preamble or PNG
+/// header); any other is refused, with every such file named, before anything is written.
+/// The manifest is written first, so a file is never on disk unlisted. Returns the paths.
+pub fn write_owned(
+    dir: &Path,
+    manifest: &str,
+    who: &str,
+    files: &[(std::path::PathBuf, Vec<u8>)],
+) -> Result<Vec<std::path::PathBuf>> {
+    let list = dir.join(manifest);
+    let listed: Vec<String> = std::fs::read_to_string(&list)
+        .map(|t| t.lines().map(str::to_string).collect())
+        .unwrap_or_default();
+    let name = |p: &Path| {
+        p.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let mut foreign = vec![];
+    for (path, bytes) in files {
+        if path.is_dir() {
+            foreign.push(format!("{} (a folder)", path.display()));
+        } else if path.exists() && !listed.contains(&name(path)) {
+            let n = bytes.len().min(64);
+            let same_start = std::fs::read(path).is_ok_and(|old| old.get(..n) == bytes.get(..n));
+            if !(listed.is_empty() && same_start) {
+                foreign.push(path.display().to_string());
+            }
+        }
+    }
+    if !foreign.is_empty() {
+        return Err(AppError::Folder {
+            path: dir.to_path_buf(),
+            message: format!(
+                "{} would replace files it did not write: {}; give another --out, or move them",
+                who,
+                foreign.join(", ")
+            ),
+        });
+    }
+    let mut names = listed;
+    for (path, _) in files {
+        if !names.contains(&name(path)) {
+            names.push(name(path));
+        }
+    }
+    tubemem_mesh::file::write_whole(&list, format!("{}\n", names.join("\n")).as_bytes())
+        .map_err(|e| AppError::io(&list, e))?;
+    let mut written = vec![];
+    for (path, bytes) in files {
+        tubemem_mesh::file::write_whole(path, bytes).map_err(|e| AppError::io(path, e))?;
+        written.push(path.clone());
+    }
+    Ok(written)
+}

@@ -38,7 +38,7 @@ fn tmp(name: &str) -> PathBuf {
 fn the_files_are_the_report() {
     let case = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
     let out = tmp("files");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let report = run(&case, "small", &mut [&mut writer])
         .into_result()
         .unwrap();
@@ -118,7 +118,7 @@ fn profiles_at_stage_ends_only() {
     ))
     .unwrap();
     let out = tmp("profiles-stage-end");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let report = run(&case, "small", &mut [&mut writer])
         .into_result()
         .unwrap();
@@ -146,7 +146,7 @@ fn profiles_at_stage_ends_only() {
 fn a_precondition_failure_is_recorded() {
     let case = Case::parse(&format!("{SMALL}{}", SQUEEZE.replace("1.0", "5.0"))).unwrap();
     let out = tmp("precondition");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let outcome = run(&case, "small", &mut [&mut writer]);
     let err = outcome.error.expect("the squeeze cannot start");
     let text = err.chain();
@@ -340,7 +340,7 @@ fn a_confine_runs_walls_csv_is_the_report() {
     let channel = "\n[[stage]]\nkind = \"confine\"\nsteps = 4\n[[stage.plane]]\nnormal = [1, 0]\noffset = 1.25\ntarget = 1.1\n[[stage.plane]]\nnormal = [-1, 0]\noffset = 1.25\ntarget = 1.1\n[[stage.plane]]\nnormal = [0, 1]\noffset = 1.25\ntarget = 1.1\n[[stage.plane]]\nnormal = [0, -1]\noffset = 1.25\ntarget = 1.1\n";
     let case = Case::parse(&format!("{SMALL}{channel}")).unwrap();
     let out = tmp("walls");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let report = run(&case, "channel", &mut [&mut writer])
         .into_result()
         .unwrap();
@@ -412,7 +412,7 @@ fn an_arc_length_stage_reports_its_critical_points_in_every_output() {
     let case = Case::parse(&text).unwrap();
     assert!(case.plan()[0].arc_length);
     let out = tmp("arc");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let report = run(&case, "small", &mut [&mut writer])
         .into_result()
         .unwrap();
@@ -474,7 +474,7 @@ fn a_pressure_beyond_the_maximum_is_refused_with_the_limit_point() {
         .replace("target_stretch = 1.2", "target_pressure = 0.9");
     let case = Case::parse(&text).unwrap();
     let out = tmp("beyond");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let outcome = run(&case, "small", &mut [&mut writer]);
     let err = outcome.error.expect("no equilibrium at ϖ = 0.9");
     let tubemem_app::AppError::BeyondLimit { w_max, target, .. } = &err else {
@@ -524,7 +524,7 @@ fn a_target_past_the_maximum_marks_gps_not_applicable() {
     let text = "[geometry]\nradius = 1.0\nlength = 20.0\n\n[material]\nmodel = \"mooney-rivlin\"\nshear_modulus = 1.0\nalpha = 0.1\n\n[mesh]\naround = 16\nalong = 40\nsymmetry = \"eighth\"\n\n[[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = 2.0\nsteps = 8\n\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.2\nsteps = 4\n";
     let case = Case::parse(text).unwrap();
     let out = tmp("past-max");
-    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash()).unwrap();
+    let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let report = run(&case, "mr", &mut [&mut writer]).into_result().unwrap();
     assert!(
         report
@@ -579,7 +579,7 @@ fn iterations_csv_accounts_for_every_newton_iteration() {
     let case = Case::parse(&format!("{SMALL}{SQUEEZE}\n[output]\niterations = true\n")).unwrap();
     let out = tmp("iterations");
     for mode in [FolderMode::Fresh, FolderMode::Overwrite] {
-        let mut writer = RunWriter::create(&out, mode, case.hash())
+        let mut writer = RunWriter::create(&out, mode, case.hash(), &[])
             .unwrap()
             .frames_of(case.output);
         let report = run(&case, "small", &mut [&mut writer])
@@ -635,7 +635,7 @@ fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
         let continued = Case::parse(&format!("{SMALL}{}", arc(stage))).unwrap();
         assert!(continued.plan()[1].arc_length);
         let out = tmp("closed-gas-arc");
-        let mut writer = RunWriter::create(&out, FolderMode::Fresh, continued.hash()).unwrap();
+        let mut writer = RunWriter::create(&out, FolderMode::Fresh, continued.hash(), &[]).unwrap();
         let rs = run(&stepped, "stepped", &mut []).into_result().unwrap();
         let rc = run(&continued, "arc", &mut [&mut writer])
             .into_result()

@@ -166,10 +166,10 @@ fn run_case(
     log: Option<&std::path::Path>,
 ) -> Result<()> {
     let case = Case::read(case_path).map_err(|e| app(e.into()))?;
+    let inputs = tubemem_app::output_file::case_inputs(case_path, &case);
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     // the log is checked before the run folder is touched
     if let Some(path) = log {
-        let inputs = tubemem_app::output_file::case_inputs(case_path, &case);
-        let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
         tubemem_app::output_file::check("--log", path, &inputs, tubemem_app::output_file::is_log)
             .map_err(app)?;
         // the run folder may not exist yet: compare absolute paths, canonical where they exist
@@ -199,7 +199,7 @@ fn run_case(
         }
     }
     let (mut writer, checkpoint) = if resume {
-        let (w, ck) = RunWriter::resume(out, case.hash()).map_err(app)?;
+        let (w, ck) = RunWriter::resume(out, case.hash(), &inputs).map_err(app)?;
         tubemem_cli::say!(
             "resuming {} from stage {}, step {} ({} steps already in steps.csv)",
             out.display(),
@@ -215,7 +215,7 @@ fn run_case(
             FolderMode::Fresh
         };
         (
-            RunWriter::create(out, mode, case.hash()).map_err(app)?,
+            RunWriter::create(out, mode, case.hash(), &inputs).map_err(app)?,
             None,
         )
     };

@@ -2110,6 +2110,72 @@ fn huge_values_are_echoed_in_scientific_notation() {
             .map(str::len)
             .max()
             .unwrap_or(0);
-        assert!(longest <= 17, "a {longest}-digit number in: {err}");
+        // a double written plain in [1e-4, 1e15) has at most 20 digits in a run
+        assert!(longest <= 20, "a {longest}-digit number in: {err}");
     }
+}
+
+/// Issue #25, class 4: a case file or mesh file with the name of a file the run writes in its
+/// folder (`DIR/summary.json` run with `--out DIR --overwrite`, a mesh `DIR/steps.csv`) is
+/// refused before anything is written, fresh, overwritten or resumed; the input stays whole.
+#[test]
+fn a_run_folder_never_writes_over_its_inputs() {
+    let d = tmp("inputs-in-folder");
+    let small = include_str!("../../../cases/small_abb30_ls1.2.toml");
+    let case = d.join("summary.json");
+    std::fs::write(&case, small).unwrap();
+    for extra in [&[][..], &["--overwrite"], &["--resume"]] {
+        let o = run_in(&case, &d, extra);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && err.contains("has the name of a file the run writes there"),
+            "{extra:?}: {err}"
+        );
+        assert_eq!(std::fs::read_to_string(&case).unwrap(), small);
+    }
+    // a user mesh called steps.csv beside a case, run into their folder
+    let m = tmp("mesh-in-folder");
+    let (case, mesh) = (m.join("case.toml"), m.join("steps.csv"));
+    std::fs::write(&mesh, "{}").unwrap();
+    std::fs::write(
+        &case,
+        small
+            .replace("around = 16\n", "file = \"steps.csv\"\n")
+            .replace("along = 24\n", "")
+            .replace("symmetry = \"eighth\"\n", ""),
+    )
+    .unwrap();
+    let o = run_in(&case, &m, &["--overwrite"]);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("has the name of a file the run writes"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&mesh).unwrap(), "{}");
+}
+
+/// Issue #25, class 4: `figures --out DIR` replaces only the files it wrote there before
+/// (listed in `DIR/.tubemem-figures`): a file of the same name that it did not write is named
+/// and refused before anything is written, and stays as it was.
+#[test]
+fn figures_never_replace_files_they_did_not_write() {
+    let d = tmp("figures-foreign");
+    let out = d.join("figs");
+    std::fs::create_dir_all(&out).unwrap();
+    let mine = out.join("fig5_pressure_stretch.svg");
+    std::fs::write(&mine, "my own drawing").unwrap();
+    let args = ["figures", "--out", out.to_str().unwrap(), "--format", "svg"];
+    let o = tubemem(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("would replace files it did not write"), "{err}");
+    assert!(err.contains("fig5_pressure_stretch.svg"), "{err}");
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my own drawing");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "something was written");
+    // moved away, the figures are written, and written again over their own files
+    std::fs::remove_file(&mine).unwrap();
+    for _ in 0..2 {
+        let o = tubemem(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert!(std::fs::read_to_string(&mine).unwrap().starts_with("<svg"));
 }

@@ -478,7 +478,10 @@ fn run_parsed<'py>(
         bar = Some(tqdm.getattr("tqdm")?.call((), Some(&kwargs))?);
         progress = None;
     }
-    let mut writer = RunWriter::create(out, mode, case.hash())
+    // the case file (when the label is its path) and its mesh: never written over
+    let inputs = tubemem_app::output_file::case_inputs(std::path::Path::new(label), case);
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let mut writer = RunWriter::create(out, mode, case.hash(), &inputs)
         .map_err(|e| PyValueError::new_err(e.chain()))?
         .checkpoint_every(case.solver.checkpoint_every)
         .frames_of(case.output);

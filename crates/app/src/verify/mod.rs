@@ -398,7 +398,7 @@ pub fn run_member(
 ) -> Result<RunReport, String> {
     let mut case = Case::parse(text).map_err(|e| crate::error_chain(&e))?;
     case.base_dir = base_dir.to_path_buf();
-    let mut writer = RunWriter::create(dir, FolderMode::Overwrite, case.hash())
+    let mut writer = RunWriter::create(dir, FolderMode::Overwrite, case.hash(), &[])
         .map_err(|e| e.chain())?
         .checkpoint_every(case.solver.checkpoint_every)
         .frames_of(case.output);
