@@ -886,10 +886,9 @@ impl Model {
                     },
                 });
             }
-            state.multipliers = lambda;
             aug.updates += 1;
             aug.change = size.change;
-            let again = once(self, state)?;
+            let again = self.solve_updated(state, lambda, &mut once)?;
             aug.iterations += again.iterations;
             report.iterations += again.iterations;
             report.history.extend(again.history);
@@ -898,6 +897,52 @@ impl Model {
         }
         report.augmentation = aug;
         Ok(report)
+    }
+
+    /// Solve `state` again after its multipliers' Uzawa update to `lambda` (from
+    /// [`Model::augment`]). Where Newton fails from the updated multipliers (a point at the
+    /// contact edge whose gap and multiplier are both about zero can make the first direction
+    /// one that no step length follows: the line search fails at iteration 0), the update is
+    /// halved, up to [`MAX_UPDATE_HALVINGS`] times, from the state in equilibrium before it:
+    /// the multipliers move part of the way, the local penalties stay. A solve that converges
+    /// at once is unchanged.
+    fn solve_updated(
+        &mut self,
+        state: &mut State,
+        lambda: Vec<f64>,
+        once: &mut impl FnMut(
+            &mut Self,
+            &mut State,
+        ) -> Result<newton::NewtonReport, NewtonError<FemError>>,
+    ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
+        let before = state.clone();
+        state.multipliers = lambda.clone();
+        let mut halvings = 0;
+        loop {
+            match once(self, state) {
+                Ok(r) => return Ok(r),
+                Err(e)
+                    if halvings < MAX_UPDATE_HALVINGS
+                        && !matches!(e.cause(), Some(FemError::Interrupted)) =>
+                {
+                    halvings += 1;
+                    let w = 0.5f64.powi(halvings);
+                    *state = before.clone();
+                    // the history is [λ, κ, last gap] per point: λ part of the way, κ as it
+                    // was, the gap of the update
+                    let h = crate::contact::HISTORY;
+                    for (m, full) in state
+                        .multipliers
+                        .chunks_exact_mut(h)
+                        .zip(lambda.chunks_exact(h))
+                    {
+                        m[0] += w * (full[0] - m[0]);
+                        m[2] = full[2];
+                    }
+                }
+                Err(e) => return Err(e),
+            }
+        }
     }
 
     /// Newton iterations at the prescribed total volume `volume` with the direction `phi0`
@@ -1326,6 +1371,11 @@ pub struct Held {
 /// sign), 3e-14 to 2e-10 at 4 per R and 1e-17 to 1e-14 (round-off) at 8 per R. The bound lies
 /// below the physical modes and above the translation on the meshes where it stops the path.
 pub const NEUTRAL: f64 = 1e-8;
+
+/// How many times [`Model::solve_updated`] halves a multiplier update whose solve failed: 3
+/// (to 1/8 of the update; the channel's first contact steps at 32 and 64 around converge at
+/// the first halving).
+pub const MAX_UPDATE_HALVINGS: i32 = 3;
 
 /// The stiffness's mode of smallest |eigenvalue|, described ([`Model::mode_report`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
