@@ -74,8 +74,12 @@ pub(crate) fn wall_section_edges(
 }
 
 /// Where the case's mesh is fitted to the contact edges of its last contact stage, or `None`
-/// without `fit_contact_edge` or `contact_edge_angle`.
-pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
+/// without `fit_contact_edge` or `contact_edge_angle`. `interrupt` stops the locating solve
+/// ([`crate::run::RunOptions::interrupt`]; the run is then [`AppError::Interrupted`]).
+pub fn contact_edges(
+    case: &Case,
+    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> Result<Option<Fit>> {
     if !case.mesh.fit_contact_edge && case.mesh.contact_edge_angle.is_none() {
         return Ok(None);
     }
@@ -98,7 +102,7 @@ pub fn contact_edges(case: &Case) -> Result<Option<Fit>> {
         .into());
     };
     let law = case.material.build()?;
-    let located = locate(case, k)?;
+    let located = locate(case, k, interrupt)?;
     let w = located.w;
     let context = |what: &str| {
         format!(
@@ -139,7 +143,11 @@ pub const LOCATOR_AROUND: usize = 16;
 /// The mid-span state at the end of stage `k` (0-based) of `case` solved on the coarse
 /// uniform mesh of [`LOCATOR_AROUND`] elements around (fewer if the case has fewer), the same
 /// case otherwise, in memory.
-fn locate(case: &Case, k: usize) -> Result<tubemem_fem::post::MidSpan> {
+fn locate(
+    case: &Case,
+    k: usize,
+    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> Result<tubemem_fem::post::MidSpan> {
     let mut coarse = case.clone();
     let around = case.mesh.around.unwrap_or(LOCATOR_AROUND);
     let n = LOCATOR_AROUND.min(around);
@@ -158,13 +166,19 @@ fn locate(case: &Case, k: usize) -> Result<tubemem_fem::post::MidSpan> {
     coarse.mesh.contact_edge_angle = None;
     coarse.stages.truncate(k + 1);
     coarse.truncate_plan(k + 1);
-    let outcome = crate::run::run(&coarse, "contact-edge locator", &mut []);
+    let options = crate::run::RunOptions {
+        interrupt: interrupt.cloned(),
+        ..Default::default()
+    };
+    let outcome = crate::run::run_with(&coarse, "contact-edge locator", &options, &mut []);
     let located = outcome.report.stages.get(k).and_then(|s| match &s.outcome {
         crate::report::StageOutcome::Finished(f) => Some(f.final_state.midspan),
         _ => None,
     });
     match (outcome.error, located) {
         (None, Some(w)) => Ok(w),
+        // stopped by the run's own interrupt: the run is interrupted, not its locator failed
+        (Some(e @ AppError::Interrupted { .. }), _) => Err(e),
         (Some(e), _) => Err(AppError::Locator {
             around: n,
             source: Box::new(e),

@@ -91,13 +91,31 @@ pub trait Observer {
 /// the last converged `state` towards `target` and return the first pressure maximum located on
 /// the way (ϖmax and the mid-span λs there), or `None` when the path reaches the target or the
 /// probe fails (the Newton failure is then the whole story). The model's state is not changed.
-fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Option<(f64, f64)> {
+///
+/// The probe looks where the closed form puts the maximum: it aims at no more than twice the
+/// GPS inflation maximum of `law` (a finite tube's maximum lies within a few per cent of it),
+/// and a law whose GPS inflation has no maximum is not probed. It takes at most
+/// [`PROBE_STEPS`] steps. (Aimed at a target of 1e308 it had walked for over ten minutes.)
+fn pressure_maximum_below(
+    model: &mut Model,
+    state: &State,
+    target: f64,
+    law: &dyn MembraneLaw,
+) -> Option<(f64, f64)> {
     use tubemem_fem::continuation::{follow, ArcEvent, ArcSettings, MembranePath, Target};
+    let w_max = tubemem_gps::limits::limit_points(law, Hypothesis::Gps)
+        .ok()?
+        .max?
+        .w;
     let monitor = |s: &State| s.p;
     let goal = Target {
         name: "pressure",
         monitor: &monitor,
-        value: target,
+        value: target.min(2.0 * w_max),
+    };
+    let settings = ArcSettings {
+        max_steps: PROBE_STEPS,
+        ..ArcSettings::default()
     };
     let mut path = MembranePath::new(model, ArcLoading::Pressure(None));
     let mut found = None;
@@ -105,7 +123,7 @@ fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Opti
         &mut path,
         state.clone(),
         &goal,
-        &ArcSettings::default(),
+        &settings,
         |path, e| match e {
             ArcEvent::Critical(c) if c.kind == CriticalKind::LimitMax => {
                 found = midspan(path.model, &c.state)
@@ -118,6 +136,11 @@ fn pressure_maximum_below(model: &mut Model, state: &State, target: f64) -> Opti
     );
     found.filter(|(w, _)| *w < target)
 }
+
+/// The most steps [`pressure_maximum_below`] takes: 200 (the shipped bulge's arc-length stage,
+/// `cases/inflate_abb30_ls6.0_bulge.toml`, locates its maximum at step 6 and its minimum at
+/// step 24).
+pub const PROBE_STEPS: usize = 200;
 
 /// `branch = "follow-stable"`: the branch-switching step leaves the bifurcation point along the
 /// critical mode by this fraction of the arc length of the step that crossed it (an RMS nodal
@@ -248,12 +271,16 @@ fn checkpoint_edges(ck: &Checkpoint) -> Option<Vec<f64>> {
 
 /// Build the mesh a case asks for.
 pub fn build_mesh(case: &Case) -> Result<Mesh> {
-    build_mesh_with_fit(case).map(|(m, _)| m)
+    build_mesh_with_fit(case, None).map(|(m, _)| m)
 }
 
 /// [`build_mesh`], with where its node line was fitted to the contact edge (`[mesh]
-/// fit_contact_edge`, [`crate::edge_fit`]).
-pub fn build_mesh_with_fit(case: &Case) -> Result<(Mesh, Option<crate::edge_fit::Fit>)> {
+/// fit_contact_edge`, [`crate::edge_fit`]); `interrupt` stops its locating solve as it stops
+/// the run ([`RunOptions::interrupt`]).
+pub fn build_mesh_with_fit(
+    case: &Case,
+    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> Result<(Mesh, Option<crate::edge_fit::Fit>)> {
     let g = &case.geometry;
     let ll = g.length / g.radius;
     match (&case.mesh.file, case.mesh.around, case.mesh.along) {
@@ -275,7 +302,7 @@ pub fn build_mesh_with_fit(case: &Case) -> Result<(Mesh, Option<crate::edge_fit:
         (None, Some(around), Some(along)) => {
             let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
             let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
-            let fit = crate::edge_fit::contact_edges(case)?;
+            let fit = crate::edge_fit::contact_edges(case, interrupt)?;
             let map = match &fit {
                 Some(f) => Some(HoopMap::fitted(around, &f.edges).map_err(AppError::Mesh)?),
                 None => None,
@@ -943,7 +970,7 @@ fn run_inner(
     if let Some(n) = equations_estimate(case) {
         check_memory(n, options.force)?;
     }
-    let (mesh, contact_edge_fit) = build_mesh_with_fit(case)?;
+    let (mesh, contact_edge_fit) = build_mesh_with_fit(case, options.interrupt.as_ref())?;
     if case.mesh.file.is_some() {
         check_memory(3 * mesh.nodes.len(), options.force)?;
     }
@@ -1446,7 +1473,12 @@ fn run_inner(
                     match (plan.target, plan.arc_length) {
                         // a pressure target the path cannot reach: say where its maximum is
                         (Target::Pressure(target), false) if state.p < target => {
-                            match pressure_maximum_below(&mut model, &state, target) {
+                            match pressure_maximum_below(
+                                &mut model,
+                                &state,
+                                target,
+                                closed_form_law.as_ref(),
+                            ) {
                                 Some((w_max, lambda_s)) => AppError::BeyondLimit {
                                     stage: i,
                                     stages,

@@ -382,6 +382,13 @@ fn reported_crash_inputs_are_errors_now() {
             "[geometry]\nradius = 6\nlength = 1\n[material]\nmodel = \"neo-hookean\"\nshear_modulus = 1.0\n[mesh]\naround = 8\nalong = 2\nsymmetry = \"none\"\n[[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = 2\nsteps = 1\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1e-300\nsteps = 1\npenalty = 1e308\n".to_string(),
             String::new(),
         ),
+        // found by the 30-minute run of 2026-12-02: a pressure target of 1e308 beyond the law's
+        // maximum, with the mesh fitted by a locating solve; the probe for the maximum walked
+        // towards 1e308 for over ten minutes and the locator ignored the interrupt
+        (
+            "[geometry]\nradius = 2.3874449059406295\nlength = 1.0486937012836541\n[material]\nmodel = \"abb\"\nshear_modulus = 1.0\nkuhn = 77\n[mesh]\naround = 8\nalong = 16\nsymmetry = \"quarter\"\nfit_contact_edge = true\n[[stage]]\nkind = \"inflate\"\ncontrol = \"pressure\"\ntarget_pressure = 1e308\nsteps = 2\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.7142699393509986\nsteps = 4\n".to_string(),
+            String::new(),
+        ),
         // a case file that is /dev/zero is covered by `Case::read`'s size limit; a mesh file too
         (user.replace("mesh.json", "/dev/zero"), String::new()),
     ];
