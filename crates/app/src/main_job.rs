@@ -152,7 +152,7 @@ impl MainJob {
         let _ = writeln!(
             t,
             "(FE−GPS(ϖ): the force's relative error against the GPS section under the FE's own pressure, eq. 76 without the gas law;\n \
-             the hoop node lines follow the contact edges at every step, so every step verifies at the element's order, the first (its flat a fraction of an element wide) least.\n \
+             the hoop node lines follow the contact edges at every step, so every step verifies at the element's order.\n \
              The FE differs from GPS mostly by the end effect, which acts through the gas: the ends keep gas the plates do not squeeze; see the README)"
         );
         t
