@@ -900,9 +900,9 @@ impl Model {
     }
 
     /// Solve `state` again after its multipliers' Uzawa update to `lambda` (from
-    /// [`Model::augment`]). Where Newton fails from the updated multipliers (a point at the
-    /// contact edge whose gap and multiplier are both about zero can make the first direction
-    /// one that no step length follows: the line search fails at iteration 0), the update is
+    /// [`Model::augment`]). Where Newton finds no descent at its first iteration from the
+    /// updated multipliers (a point at the contact edge whose gap and multiplier are both about
+    /// zero can make the first direction one that no step length follows), the update is
     /// halved, up to [`MAX_UPDATE_HALVINGS`] times, from the state in equilibrium before it:
     /// the multipliers move part of the way, the local penalties stay. A solve that converges
     /// at once is unchanged.
@@ -921,9 +921,10 @@ impl Model {
         loop {
             match once(self, state) {
                 Ok(r) => return Ok(r),
-                Err(e)
-                    if halvings < MAX_UPDATE_HALVINGS
-                        && !matches!(e.cause(), Some(FemError::Interrupted)) =>
+                // the kink: no descent at the first iteration (cheap to detect); a solve that
+                // fails later is not retried (each retry would cost up to a whole solve)
+                Err(NewtonError::NoDescent { iteration: 0, .. })
+                    if halvings < MAX_UPDATE_HALVINGS =>
                 {
                     halvings += 1;
                     let w = 0.5f64.powi(halvings);
