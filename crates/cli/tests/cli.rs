@@ -6,13 +6,8 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn tubemem(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .output()
-        .expect("the tubemem binary runs")
-}
+mod common;
+use common::{assert_same_run, reference_run, run_in, tmp, tubemem};
 
 fn json(args: &[&str]) -> Value {
     let out = tubemem(args);
@@ -28,12 +23,6 @@ fn num(v: &Value, key: &str) -> f64 {
     v[key]
         .as_f64()
         .unwrap_or_else(|| panic!("key `{key}` missing or not a number in {v}"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tubemem-cli-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// The failure contract: non-zero exit, an `error:` line naming the problem, no panic.
@@ -977,17 +966,6 @@ fn output_errors_and_resource_caps_are_clear_errors() {
     );
 }
 
-fn run_in(case: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    tubemem(&args)
-}
-
 /// Malformed user meshes are refused with the plug or node at fault: an empty plug ring
 /// (`"plugs": [[]]`) and a node that no quad uses.
 #[test]
@@ -1226,26 +1204,6 @@ fn killed_in_its_squeeze(name: &str, text: &str) -> (PathBuf, PathBuf, PathBuf) 
         steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
     });
     (case, reference, killed)
-}
-
-/// `files` of run folder `b` byte-identical to `a`'s, and with `frames` every VTU frame too.
-fn assert_same_run(a: &Path, b: &Path, files: &[&str], frames: bool) {
-    for f in files {
-        assert!(
-            std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap(),
-            "{f} differs after the restart"
-        );
-    }
-    if frames {
-        for f in std::fs::read_dir(a.join("vtu")).unwrap() {
-            let name = f.unwrap().file_name();
-            assert!(
-                std::fs::read(a.join("vtu").join(&name)).unwrap()
-                    == std::fs::read(b.join("vtu").join(&name)).unwrap(),
-                "{name:?} differs"
-            );
-        }
-    }
 }
 
 /// Start `tubemem run CASE --out OUT` and kill it (SIGKILL) once its steps.csv satisfies `done`
@@ -2195,17 +2153,12 @@ fn figures_never_replace_files_they_did_not_write() {
 /// `--resume` ends byte-identical to the uninterrupted run.
 #[test]
 fn a_run_killed_at_any_moment_resumes_bit_identical() {
-    let d = tmp("killed-anywhen");
-    let case = d.join("case.toml");
-    std::fs::write(
-        &case,
+    let (_, case, reference) = reference_run(
+        "killed-anywhen",
         include_str!("../../../cases/squeeze_abb30_ls1.3.toml"),
-    )
-    .unwrap();
-    let reference = d.join("ref");
-    assert!(run_in(&case, &reference, &[]).status.success());
+    );
     for rows in [1, 4, 7, 10] {
-        let killed = d.join(format!("killed{rows}"));
+        let killed = case.parent().unwrap().join(format!("killed{rows}"));
         run_and_kill(&case, &killed, |s| s.lines().count() > rows);
         let manifest = std::fs::read_to_string(killed.join("run.json")).unwrap();
         assert!(manifest.contains("\"running\""), "{rows}: {manifest}");

@@ -5,7 +5,7 @@
 //! Set `TUBEMEM_NO_TMPFS=1` to skip it on a machine whose kernel refuses user namespaces.
 
 mod common;
-use common::{assert_same_run, run_in, tmp};
+use common::{assert_same_run, reference_run, run_in};
 use std::path::Path;
 use std::process::Command;
 
@@ -90,15 +90,10 @@ fn a_full_disk_leaves_a_consistent_folder_that_resumes_bit_identical() {
         eprintln!("skipped: TUBEMEM_NO_TMPFS is set");
         return;
     }
-    let d = tmp("full-disk");
-    let case = d.join("case.toml");
-    std::fs::write(
-        &case,
+    let (d, case, reference) = reference_run(
+        "full-disk",
         include_str!("../../../cases/squeeze_abb30_ls1.3.toml"),
-    )
-    .unwrap();
-    let reference = d.join("ref");
-    assert!(run_in(&case, &reference, &[]).status.success());
+    );
     // the run holds back 1 MiB while it runs (below), then writes `whole` bytes in all
     let whole = allocated(&reference);
     let mut resumed = 0;

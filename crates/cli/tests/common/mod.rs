@@ -51,3 +51,15 @@ pub fn assert_same_run(a: &Path, b: &Path, files: &[&str], frames: bool) {
         }
     }
 }
+
+/// A scratch folder `name` with `text` as its `case.toml`, run once to the end into `ref`:
+/// (folder, case file, reference run folder).
+pub fn reference_run(name: &str, text: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let d = tmp(name);
+    let case = d.join("case.toml");
+    std::fs::write(&case, text).unwrap();
+    let reference = d.join("ref");
+    let o = run_in(&case, &reference, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (d, case, reference)
+}
