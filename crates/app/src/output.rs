@@ -1040,7 +1040,7 @@ impl Observer for RunWriter {
     }
 
     /// A converged step's files, all or none: a write that fails (a full disk) undoes the
-    /// step's other files ([`crate::journal`]), so the folder holds whole rows and frames of
+    /// step's other files (the journal), so the folder holds whole rows and frames of
     /// the steps before it, and `rows` counts them.
     fn step(&mut self, view: &StepView) -> Result<(), BoxError> {
         let (rows, frames, pvd, vtu_bytes) =

@@ -137,9 +137,9 @@ fn pressure_maximum_below(
     found.filter(|(w, _)| *w < target)
 }
 
-/// The most steps [`pressure_maximum_below`] takes: 200 (the shipped bulge's arc-length stage,
-/// `cases/inflate_abb30_ls6.0_bulge.toml`, locates its maximum at step 6 and its minimum at
-/// step 24).
+/// The most steps the probe for a pressure maximum after a failed pressure stage takes: 200
+/// (the shipped bulge's arc-length stage, `cases/inflate_abb30_ls6.0_bulge.toml`, locates its
+/// maximum at step 6 and its minimum at step 24).
 pub const PROBE_STEPS: usize = 200;
 
 /// `branch = "follow-stable"`: the branch-switching step leaves the bifurcation point along the

@@ -1373,7 +1373,7 @@ pub struct Held {
 /// below the physical modes and above the translation on the meshes where it stops the path.
 pub const NEUTRAL: f64 = 1e-8;
 
-/// How many times [`Model::solve_updated`] halves a multiplier update whose solve failed: 3
+/// How many times the augmented solve halves a multiplier update whose solve failed: 3
 /// (to 1/8 of the update; the channel's first contact steps at 32 and 64 around converge at
 /// the first halving).
 pub const MAX_UPDATE_HALVINGS: i32 = 3;
