@@ -67,5 +67,5 @@ pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>
         std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;
     }
     let out = csv_text(path, header, rows)?;
-    tubemem_mesh::file::write_whole(path, out.as_bytes()).map_err(|e| AppError::io(path, e))
+    crate::output_file::write_whole(path, out.as_bytes())
 }

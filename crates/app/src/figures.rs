@@ -455,7 +455,7 @@ pub fn rasterize(svg: &str, dpi: f64, path: &Path) -> Result<Vec<u8>> {
 pub fn save(fig: &Figure, stem: &Path, opts: &FigureOptions) -> Result<Vec<PathBuf>> {
     let mut written = vec![];
     for (path, bytes) in render_files(fig, stem, opts)? {
-        tubemem_mesh::file::write_whole(&path, &bytes).map_err(|e| AppError::io(&path, e))?;
+        crate::output_file::write_whole(&path, &bytes)?;
         written.push(path);
     }
     Ok(written)
@@ -476,14 +476,16 @@ pub fn render_files(
     };
     let (svg_path, png_path) = (with(".svg"), with(".png"));
     let svg = render_svg(fig, &svg_path)?;
+    let png = if opts.png {
+        Some(rasterize(&svg, opts.dpi, &png_path)?)
+    } else {
+        None
+    };
     let mut files = vec![];
-    if opts.png {
-        let png = rasterize(&svg, opts.dpi, &png_path)?;
-        files.push((png_path, png));
-    }
     if opts.svg {
-        files.insert(0, (svg_path, svg.into_bytes()));
+        files.push((svg_path, svg.into_bytes()));
     }
+    files.extend(png.map(|png| (png_path, png)));
     Ok(files)
 }
 

@@ -53,7 +53,7 @@ impl Journal {
         if !path.exists() {
             self.note(path);
         }
-        tubemem_mesh::file::write_whole(path, bytes).map_err(|e| AppError::io(path, e))
+        crate::output_file::write_whole(path, bytes)
     }
 
     /// Remember a file that a writer outside the journal is about to create (a VTU frame), so

@@ -231,9 +231,8 @@ const LOCK: &str = ".tubemem.lock";
 /// stopped by a full disk can still write its manifest and summary (issue #25, class 3).
 const RESERVE: &str = ".tubemem.reserve";
 
-/// 1 MiB: run.json is under 4 KiB and summary.json tens of KiB (the main job's is 11 KiB; a
-/// run of a thousand steps stays under 1 MiB, as the summary holds each stage's end, not each
-/// step).
+/// 1 MiB: the main job's run.json is 314 bytes and its summary.json 5.2 KiB, the shipped
+/// bulge's (27 steps) 3.9 KiB (2026-12-02): the summary holds each stage's end, not each step.
 const RESERVE_BYTES: usize = 1 << 20;
 
 /// Whether `name` in the run's sub-folder `folder` (`vtu`, `profiles`, `checkpoints`) is a file
@@ -273,12 +272,7 @@ fn own_file(folder: &str, name: &str) -> bool {
 /// Whether `name` in `folder` is the temporary file of one of the run's whole-file writes
 /// (`.NAME.PID.tmp`, [`tubemem_mesh::file`]), left by a kill between its write and its rename.
 fn own_partial(folder: &str, name: &str) -> bool {
-    tubemem_mesh::file::is_partial(name)
-        && name
-            .strip_prefix('.')
-            .and_then(|r| r.rsplit_once('.'))
-            .and_then(|(r, _)| r.rsplit_once('.'))
-            .is_some_and(|(stem, _)| own_file(folder, stem))
+    tubemem_mesh::file::partial_of(name).is_some_and(|stem| own_file(folder, stem))
 }
 
 /// Refuse a run folder `dir` in which one of the run's `inputs` (the case file, a user mesh
@@ -464,7 +458,7 @@ fn write_checkpoint(path: &Path, ck: &Checkpoint) -> Result<()> {
         }
         buf.extend_from_slice(&p.to_le_bytes());
     }
-    tubemem_mesh::file::write_whole(path, &buf).map_err(|e| AppError::io(path, e))
+    crate::output_file::write_whole(path, &buf)
 }
 
 /// Read a checkpoint written by [`write_checkpoint`]; `None` if it is not a whole one.
@@ -876,10 +870,9 @@ impl RunWriter {
     }
 }
 
-/// Write `text` as the whole of `path` ([`tubemem_mesh::file::write_whole`]): a reader sees the
-/// old file or the new one, never a partial one.
+/// Write `text` as the whole of `path` ([`crate::output_file::write_whole`]).
 fn atomic_write(path: &Path, text: &str) -> Result<()> {
-    tubemem_mesh::file::write_whole(path, text.as_bytes()).map_err(|e| AppError::io(path, e))
+    crate::output_file::write_whole(path, text.as_bytes())
 }
 
 /// The reflections that make the whole tube of a symmetry-reduced model: every combination of
@@ -1035,24 +1028,14 @@ impl Observer for RunWriter {
             &self.dir.join("profiles").join("profiles.csv"),
             &format!("{PROFILES_HEADER}\n"),
         )?;
-        let r = self.frame(0.0, model, state, None);
-        self.settle(r)
+        self.all_or_none(|w| w.frame(0.0, model, state, None))
     }
 
     /// A converged step's files, all or none: a write that fails (a full disk) undoes the
     /// step's other files (the journal), so the folder holds whole rows and frames of
     /// the steps before it, and `rows` counts them.
     fn step(&mut self, view: &StepView) -> Result<(), BoxError> {
-        let (rows, frames, pvd, vtu_bytes) =
-            (self.rows, self.frames, self.pvd.len(), self.vtu_bytes);
-        let r = self.write_step(view);
-        if r.is_err() {
-            self.rows = rows;
-            self.frames = frames;
-            self.pvd.truncate(pvd);
-            self.vtu_bytes = vtu_bytes;
-        }
-        self.settle(r)
+        self.all_or_none(|w| w.write_step(view))
     }
 
     fn critical(
@@ -1062,8 +1045,7 @@ impl Observer for RunWriter {
         state: &State,
         mode: Option<&[[f64; 3]]>,
     ) -> Result<(), BoxError> {
-        let r = self.write_critical(record, model, state, mode);
-        self.settle(r)
+        self.all_or_none(|w| w.write_critical(record, model, state, mode))
     }
 
     fn stage_finished(&mut self, report: &RunReport) -> Result<(), BoxError> {
@@ -1109,9 +1091,15 @@ impl Observer for RunWriter {
 }
 
 impl RunWriter {
-    /// Keep the files of a step whose writes all succeeded, or undo them all.
-    fn settle(&mut self, r: Result<(), BoxError>) -> Result<(), BoxError> {
-        match r {
+    /// Run `write` (one step's files) and keep all it wrote, or, when it fails, undo its
+    /// files and the writer's counts of rows and frames with them.
+    fn all_or_none(
+        &mut self,
+        write: impl FnOnce(&mut Self) -> Result<(), BoxError>,
+    ) -> Result<(), BoxError> {
+        let (rows, frames, pvd, vtu_bytes) =
+            (self.rows, self.frames, self.pvd.len(), self.vtu_bytes);
+        match write(self) {
             Ok(()) => {
                 self.journal.commit();
                 Ok(())
@@ -1120,6 +1108,10 @@ impl RunWriter {
                 // the write's error is the one to report; an undo that fails too leaves rows
                 // past `steps_written`, which `--resume` cuts back to its checkpoint
                 let _ = self.journal.rollback();
+                self.rows = rows;
+                self.frames = frames;
+                self.pvd.truncate(pvd);
+                self.vtu_bytes = vtu_bytes;
                 Err(e)
             }
         }
@@ -1177,36 +1169,34 @@ impl RunWriter {
             self.journal.create(&path, text.as_bytes())?;
         }
         if !view.record.walls.is_empty() {
-            {
-                let r = view.record;
-                let mut text = String::new();
-                let cf = |c: &Option<tubemem_gps::confine::ConfineState>, k: usize| {
-                    c.as_ref()
-                        .and_then(|c| c.walls.get(k))
-                        .map_or([f64::NAN; 2], |w| [w.contact_length, w.force])
-                };
-                for (k, w) in r.walls.iter().enumerate() {
-                    let g = cf(&r.closed_form.gps_confine, k);
-                    let l = cf(&r.closed_form.local_confine, k);
-                    let vals = [
-                        self.rows as f64,
-                        r.stage as f64,
-                        r.step as f64,
-                        (k + 1) as f64,
-                        w.contact_length,
-                        w.force,
-                        w.penetration,
-                        g[0],
-                        g[1],
-                        l[0],
-                        l[1],
-                    ];
-                    text.push_str(&crate::curves::csv_line(&vals));
-                    text.push('\n');
-                }
-                self.journal
-                    .append(&self.dir.join("walls.csv"), WALLS_HEADER, &text)?;
+            let r = view.record;
+            let mut text = String::new();
+            let cf = |c: &Option<tubemem_gps::confine::ConfineState>, k: usize| {
+                c.as_ref()
+                    .and_then(|c| c.walls.get(k))
+                    .map_or([f64::NAN; 2], |w| [w.contact_length, w.force])
+            };
+            for (k, w) in r.walls.iter().enumerate() {
+                let g = cf(&r.closed_form.gps_confine, k);
+                let l = cf(&r.closed_form.local_confine, k);
+                let vals = [
+                    self.rows as f64,
+                    r.stage as f64,
+                    r.step as f64,
+                    (k + 1) as f64,
+                    w.contact_length,
+                    w.force,
+                    w.penetration,
+                    g[0],
+                    g[1],
+                    l[0],
+                    l[1],
+                ];
+                text.push_str(&crate::curves::csv_line(&vals));
+                text.push('\n');
             }
+            self.journal
+                .append(&self.dir.join("walls.csv"), WALLS_HEADER, &text)?;
         }
         if !view.record.fronts.is_empty() {
             self.journal.append(

@@ -93,6 +93,12 @@ pub fn is_deck(text: &str) -> bool {
     l.next() == Some("*HEADING") && l.next().is_some_and(|s| s.starts_with("tubemem export of"))
 }
 
+/// Write `bytes` as the whole of `path` ([`tubemem_mesh::file::write_whole`]: the old file or
+/// the new one, never a partial one); the error names the path.
+pub fn write_whole(path: &Path, bytes: &[u8]) -> Result<()> {
+    tubemem_mesh::file::write_whole(path, bytes).map_err(|e| AppError::io(path, e))
+}
+
 /// Create the output folder `dir` (and its parents), or refuse a path that is a file (or
 /// whose parent is one) as "not a folder" instead of the system's "File exists".
 pub fn create_folder(dir: &Path) -> Result<()> {
@@ -165,11 +171,10 @@ pub fn write_owned(
             names.push(name(path));
         }
     }
-    tubemem_mesh::file::write_whole(&list, format!("{}\n", names.join("\n")).as_bytes())
-        .map_err(|e| AppError::io(&list, e))?;
+    write_whole(&list, format!("{}\n", names.join("\n")).as_bytes())?;
     let mut written = vec![];
     for (path, bytes) in files {
-        tubemem_mesh::file::write_whole(path, bytes).map_err(|e| AppError::io(path, e))?;
+        write_whole(path, bytes)?;
         written.push(path.clone());
     }
     Ok(written)

@@ -3,8 +3,8 @@
 //! process). The content goes to a temporary sibling `.NAME.PID.tmp` (created exclusively, so a
 //! file of that name that tubemem did not write is never touched), which is then renamed over
 //! `NAME`; a failed write removes its temporary file, so a full disk leaves no partial file
-//! behind. A kill between the two leaves only the temporary file, which [`is_partial`] names as
-//! such.
+//! behind. A kill between the two leaves only the temporary file, which [`partial_of`] names
+//! as such.
 //!
 //! No `fsync`: the guarantee is against a failed write or a killed process, not against the
 //! machine losing power (a renamed file may then be empty on some file systems).
@@ -21,14 +21,15 @@ fn temporary(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-/// Whether `name` is the name of a temporary file of [`write_whole`]: `.NAME.PID.tmp`.
-pub fn is_partial(name: &str) -> bool {
+/// The `NAME` of a temporary file of [`write_whole`], `.NAME.PID.tmp`; `None` for any other.
+pub fn partial_of(name: &str) -> Option<&str> {
     name.strip_prefix('.')
         .and_then(|r| r.strip_suffix(".tmp"))
         .and_then(|r| r.rsplit_once('.'))
-        .is_some_and(|(stem, pid)| {
+        .filter(|(stem, pid)| {
             !stem.is_empty() && !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit())
         })
+        .map(|(stem, _)| stem)
 }
 
 /// Write `bytes` as the whole content of `path`: to a temporary sibling, then renamed over
@@ -75,10 +76,14 @@ mod tests {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
         assert_eq!(names, ["a.csv"]);
-        assert!(is_partial(
-            &temporary(&p).file_name().unwrap().to_string_lossy()
-        ));
-        assert!(!is_partial("a.csv") && !is_partial(".a.tmp") && !is_partial(".a.x1.tmp"));
+        let tmp = temporary(&p);
+        assert_eq!(
+            partial_of(&tmp.file_name().unwrap().to_string_lossy()),
+            Some("a.csv")
+        );
+        for other in ["a.csv", ".a.tmp", ".a.x1.tmp"] {
+            assert_eq!(partial_of(other), None, "{other}");
+        }
         std::fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -308,8 +308,7 @@ pub fn write_all(out: &Path, r: &Results) -> crate::Result<Vec<PathBuf>> {
         ("junit.xml", junit(r)),
     ] {
         let p = out.join(name);
-        tubemem_mesh::file::write_whole(&p, text.as_bytes())
-            .map_err(|e| crate::AppError::io(&p, e))?;
+        crate::output_file::write_whole(&p, text.as_bytes())?;
         written.push(p);
     }
     Ok(written)
