@@ -274,18 +274,47 @@ impl Contact {
         xe: &[Vec3; N],
         lambda: &[f64],
         r: &mut SVector<f64, D>,
+        k: Option<&mut SMatrix<f64, D, D>>,
+    ) -> f64 {
+        self.kernel_on_branch(re, xe, None, lambda, r, k)
+    }
+
+    /// [`Contact::kernel`] on the branch of the element's positions `branch` (where a Newton
+    /// step ends): a point is pushed where the plane pushes it at `branch`, with the traction
+    /// λ − κ_g g linearized at `xe` (negative where the point is apart at `xe`: the pushed
+    /// branch continued), and free where the plane does not push it at `branch` (no force,
+    /// no stiffness, even where it pushes at `xe`). The traction t = ⟨λ − κ_g g⟩ is piecewise
+    /// linear in x; a Newton step on the branch it ends on is the semi-smooth Newton step
+    /// ([`crate::model`]'s `relinearize`). `branch` = `xe` (or none) is [`Contact::kernel`].
+    /// The energy returned is the branch's quadratic (t² − λ²)/(2κ_g), for pushed points.
+    pub fn kernel_on_branch<const N: usize, const D: usize>(
+        &self,
+        re: &RefElement<N>,
+        xe: &[Vec3; N],
+        branch: Option<&[Vec3; N]>,
+        lambda: &[f64],
+        r: &mut SVector<f64, D>,
         mut k: Option<&mut SMatrix<f64, D, D>>,
     ) -> f64 {
         let mut energy = 0.0;
         for (g, gp) in self.samples(re).iter().enumerate() {
             let n = &gp.n;
             let p = gp.position(xe);
+            let at_branch = branch.map(|b| gp.position(b));
             for (kp, plane) in self.planes.iter().enumerate() {
                 let gap = plane.gap_at(&p);
                 let at = self.point(lambda, g, kp);
                 let (l, kappa) = (at.lambda, at.penalty);
-                let t = self.traction_at(gap, at);
-                if t <= 0.0 {
+                // pushed: the plane's traction t at the status positions is positive; t the
+                // pushed branch's value at xe (on its own branch, ⟨λ − κ_g g⟩)
+                let (pushed, t) = match &at_branch {
+                    None => {
+                        let t = self.traction_at(gap, at);
+                        (t > 0.0, t)
+                    }
+                    Some(b) => (self.traction_at(plane.gap_at(b), at) > 0.0, l - kappa * gap),
+                };
+                if !pushed {
                     // free: E = −λ²/(2κ), a constant of x
                     if l != 0.0 {
                         energy -= gp.w * l * l / (2.0 * kappa);
@@ -312,6 +341,27 @@ impl Contact {
             }
         }
         energy
+    }
+
+    /// The number of points and planes of one element whose contact status (pushed: t > 0, or
+    /// free) differs between the positions `xe` and `other`, with the history `lambda`.
+    pub fn status_changes<const N: usize>(
+        &self,
+        re: &RefElement<N>,
+        xe: &[Vec3; N],
+        other: &[Vec3; N],
+        lambda: &[f64],
+    ) -> usize {
+        let mut changes = 0;
+        for (g, gp) in self.samples(re).iter().enumerate() {
+            let (p, q) = (gp.position(xe), gp.position(other));
+            for (kp, plane) in self.planes.iter().enumerate() {
+                let at = self.point(lambda, g, kp);
+                let pushed = self.traction_at(plane.gap_at(&p), at) > 0.0;
+                changes += usize::from(pushed != (self.traction_at(plane.gap_at(&q), at) > 0.0));
+            }
+        }
+        changes
     }
 
     /// The Uzawa update of one element's contact history at the positions `xe`, written to

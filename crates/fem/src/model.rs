@@ -161,6 +161,9 @@ struct Terms<'a> {
     contact: Option<&'a Contact>,
     /// the contact multipliers of every element ([`State::multipliers`]; empty: none)
     multipliers: &'a [f64],
+    /// positions whose contact status selects the contact's branch
+    /// ([`Contact::kernel_on_branch`]; none: the positions assembled)
+    branch: Option<&'a [[f64; 3]]>,
 }
 
 impl Terms<'_> {
@@ -183,7 +186,8 @@ impl Terms<'_> {
             })?;
         if let Some(c) = self.contact {
             let lambda = c.element_history(self.multipliers, e, c.samples(el).len());
-            energy += c.kernel(el, xe, lambda, r, k);
+            let branch = self.branch.map(|b| el.gather(b));
+            energy += c.kernel_on_branch(el, xe, branch.as_ref(), lambda, r, k);
         }
         Ok(energy)
     }
@@ -582,10 +586,24 @@ impl Model {
         contact: Option<&Contact>,
         multipliers: &[f64],
     ) -> Result<Assembled, FemError> {
+        self.assemble_terms(x, tangent, contact, multipliers, None)
+    }
+
+    /// [`Model::assemble_with_multipliers`] with the contact on the branch of the positions
+    /// `branch` (see [`Contact::kernel_on_branch`]).
+    fn assemble_terms(
+        &self,
+        x: &[[f64; 3]],
+        tangent: bool,
+        contact: Option<&Contact>,
+        multipliers: &[f64],
+        branch: Option<&[[f64; 3]]>,
+    ) -> Result<Assembled, FemError> {
         let terms = Terms {
             law: self.law.as_ref(),
             contact,
             multipliers,
+            branch,
         };
         match &self.elements {
             Elements::Quad4(els) => self.assemble_with::<4, 12>(els, x, tangent, terms),
@@ -815,6 +833,25 @@ impl Model {
                 .reduce(UpdateSize::default, UpdateSize::max);
             (out, size)
         })
+    }
+
+    /// The contact points and planes whose status (pushed or free) differs between the
+    /// positions `x` and `other`, with the multipliers `multipliers`.
+    fn contact_status_changes(
+        &self,
+        x: &[[f64; 3]],
+        other: &[[f64; 3]],
+        contact: &Contact,
+        multipliers: &[f64],
+    ) -> usize {
+        with_elements!(&self.elements, els => els
+            .par_iter()
+            .enumerate()
+            .map(|(e, el)| {
+                let lambda = contact.element_history(multipliers, e, contact.samples(el).len());
+                contact.status_changes(el, &el.gather(x), &el.gather(other), lambda)
+            })
+            .sum())
     }
 
     /// Run `once` (one Newton solve of `state`) and, when the contact at the state
@@ -1485,6 +1522,11 @@ struct MembraneProblem<'a> {
     /// seconds spent assembling line-search trials that were not taken since the last
     /// linearization
     rejected_seconds: std::cell::Cell<f64>,
+    /// positions whose contact status the next linearization's contact takes
+    /// ([`Contact::kernel_on_branch`]; set only by `relinearize`)
+    branch: Option<Vec<[f64; 3]>>,
+    /// the residual R = f_int − ϖg of the last linearization on its own branch
+    residual: Vec<f64>,
 }
 
 impl MembraneProblem<'_> {
@@ -1502,6 +1544,8 @@ impl MembraneProblem<'_> {
             held: None,
             trial: std::cell::RefCell::new(None),
             rejected_seconds: std::cell::Cell::new(0.0),
+            branch: None,
+            residual: Vec::new(),
         }
     }
 
@@ -1517,6 +1561,18 @@ impl MembraneProblem<'_> {
     /// it was made at exactly these positions and planes (bitwise), a fresh one otherwise.
     fn assemble_at(&self, state: &State) -> Result<(Assembled, f64), FemError> {
         let x = &state.x;
+        if let Some(branch) = &self.branch {
+            let t = std::time::Instant::now();
+            let contact = self.contact(state);
+            let a = self.model.assemble_terms(
+                x,
+                true,
+                contact.as_deref(),
+                &state.multipliers,
+                Some(branch),
+            )?;
+            return Ok((a, t.elapsed().as_secs_f64()));
+        }
         if let Some((xt, a, secs)) = self.trial.borrow_mut().take() {
             let same = xt.x.len() == x.len()
                 && xt.planes.to_bits() == state.planes.to_bits()
@@ -1709,6 +1765,9 @@ impl newton::Problem for MembraneProblem<'_> {
             }
         }
         let slope = dot(&r, &dx);
+        if self.branch.is_none() {
+            self.residual = r;
+        }
         self.model.log_iteration(IterationRecord {
             assembly: assembly_seconds,
             line_search: self.rejected_seconds.replace(0.0),
@@ -1730,6 +1789,41 @@ impl newton::Problem for MembraneProblem<'_> {
                 shift,
             },
         })
+    }
+
+    /// Where the full step from `state` ends at `trial` with contact points on the other side
+    /// of their kink (pushed at one end, free at the other), the semi-smooth Newton step: the
+    /// linearization with each point's contact on the branch it has at `trial`
+    /// ([`Contact::kernel_on_branch`]), its residual and potential (for the line search) the
+    /// state's own. None where no point changes.
+    fn relinearize(
+        &mut self,
+        state: &mut State,
+        lin: &Linearization<Self::Step>,
+        trial: &State,
+    ) -> Result<Option<Linearization<Self::Step>>, FemError> {
+        let Some(contact) = self.contact(state) else {
+            return Ok(None);
+        };
+        let changes =
+            self.model
+                .contact_status_changes(&state.x, &trial.x, &contact, &state.multipliers);
+        drop(contact);
+        if changes == 0 {
+            return Ok(None);
+        }
+        let own = std::mem::take(&mut self.residual);
+        self.branch = Some(trial.x.clone());
+        let branched = self.linearize(state);
+        self.branch = None;
+        let mut branched = branched?;
+        branched.slope = dot(&own, &branched.step.0);
+        self.residual = own;
+        branched.residual = lin.residual;
+        branched.merit = lin.merit;
+        branched.potential = lin.potential;
+        branched.converged = lin.converged;
+        Ok(Some(branched))
     }
 
     fn evaluate(&self, state: &State) -> Result<Evaluation, FemError> {

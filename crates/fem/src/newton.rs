@@ -98,7 +98,26 @@ pub trait Problem {
     fn step_size(&self, step: &Self::Step) -> f64;
     /// Whether every entry of the step is finite.
     fn step_is_finite(&self, step: &Self::Step) -> bool;
+    /// For a residual that is only piecewise smooth (e.g. contact, whose traction has a kink
+    /// where a point touches): where the step of `lin` from `state` ends at `trial` on other
+    /// pieces than `state`'s, the linearization at `state` on `trial`'s pieces (a semi-smooth
+    /// Newton step), with `lin`'s residual, merit and potential. None (the default): the
+    /// residual is smooth, or `trial` is on the same pieces.
+    fn relinearize(
+        &mut self,
+        state: &mut Self::State,
+        lin: &Linearization<Self::Step>,
+        trial: &Self::State,
+    ) -> Result<Option<Linearization<Self::Step>>, Self::Error> {
+        let _ = (state, lin, trial);
+        Ok(None)
+    }
 }
+
+/// The semi-smooth re-linearizations ([`Problem::relinearize`]) one Newton iteration may take
+/// when its full step is rejected: 2 (a second where the first step also ends across a kink,
+/// e.g. a point the first one took into contact that the new step frees).
+pub const MAX_RELINEARIZATIONS: usize = 2;
 
 /// A converged solve.
 #[derive(Clone, Debug, PartialEq)]
@@ -275,37 +294,58 @@ pub fn solve<P: Problem>(
         if it == settings.max_iterations {
             break;
         }
-        let size = problem.step_size(&lin.step);
-        let mut t = if size > settings.max_step {
-            settings.max_step / size
-        } else {
-            1.0
-        };
-        if !problem.step_is_finite(&lin.step) {
-            return Err(NewtonError::NonFinite {
-                iteration: it,
-                history,
-            });
-        }
-        let base = state.clone();
-        let armijo = |t: f64| lin.potential + settings.armijo * t * lin.slope;
+        let mut lin = lin;
+        let mut base = state.clone();
+        let mut relinearized = 0;
         let mut accepted = false;
-        for _ in 0..settings.backtracks {
-            problem.update(&base, &lin.step, t, state);
-            match problem.evaluate(state) {
-                Ok(trial) => {
-                    if lin.bordered
-                        || trial.residual < lin.residual
-                        || trial.potential < armijo(t)
-                        || t < settings.min_fraction
-                    {
-                        accepted = true;
-                        break;
+        'direction: loop {
+            let size = problem.step_size(&lin.step);
+            let mut t = if size > settings.max_step {
+                settings.max_step / size
+            } else {
+                1.0
+            };
+            if !problem.step_is_finite(&lin.step) {
+                return Err(NewtonError::NonFinite {
+                    iteration: it,
+                    history,
+                });
+            }
+            let armijo = |t: f64| lin.potential + settings.armijo * t * lin.slope;
+            for trial_index in 0..settings.backtracks {
+                problem.update(&base, &lin.step, t, state);
+                match problem.evaluate(state) {
+                    Ok(trial) => {
+                        if lin.bordered
+                            || trial.residual < lin.residual
+                            || trial.potential < armijo(t)
+                            || t < settings.min_fraction
+                        {
+                            accepted = true;
+                            break 'direction;
+                        }
+                    }
+                    Err(e) => rejected = Some(Box::new(e)),
+                }
+                // the first (longest) trial rejected: where it ends across a kink of the
+                // residual, step again on the pieces it ends on
+                if trial_index == 0 && relinearized < MAX_RELINEARIZATIONS {
+                    let branched =
+                        problem
+                            .relinearize(&mut base, &lin, state)
+                            .map_err(|source| NewtonError::Problem {
+                                iteration: it,
+                                source,
+                            })?;
+                    if let Some(branched) = branched {
+                        relinearized += 1;
+                        lin = branched;
+                        continue 'direction;
                     }
                 }
-                Err(e) => rejected = Some(Box::new(e)),
+                t *= 0.5;
             }
-            t *= 0.5;
+            break;
         }
         if !accepted {
             *state = base;
@@ -405,5 +445,110 @@ mod tests {
             NewtonError::NoConvergence { history, .. } => assert_eq!(history.len(), 3),
             e => panic!("{e:?}"),
         }
+    }
+
+    /// A soft spring a pulled by f against a stiff penalty κ beyond the gap c:
+    /// Π(x) = a x²/2 − f x + κ⟨x − c⟩²/2, exact x* = (f + κc)/(a + κ) (pushed, since f > ac).
+    /// From x = 0 (free), Newton's step f/a goes far past the kink, and every halving of it
+    /// still ends deep in the penalty: the plain driver finds no descent. With the step
+    /// re-linearized on the piece it ends on, the step lands on x* (the residual is linear
+    /// there) and the driver converges at the next linearization.
+    struct Touch {
+        a: f64,
+        f: f64,
+        c: f64,
+        kappa: f64,
+        semi_smooth: bool,
+    }
+    impl Touch {
+        fn residual(&self, x: f64) -> f64 {
+            self.a * x - self.f + self.kappa * (x - self.c).max(0.0)
+        }
+        fn potential(&self, x: f64) -> f64 {
+            let pen = (x - self.c).max(0.0);
+            0.5 * self.a * x * x - self.f * x + 0.5 * self.kappa * pen * pen
+        }
+        /// the linearization at x on the piece of `piece` (pushed where piece > c)
+        fn on_piece(&self, x: f64, piece: f64) -> Linearization<f64> {
+            let pushed = piece > self.c;
+            let r = self.a * x - self.f
+                + if pushed {
+                    self.kappa * (x - self.c)
+                } else {
+                    0.0
+                };
+            let k = self.a + if pushed { self.kappa } else { 0.0 };
+            let step = -r / k;
+            let own = self.residual(x);
+            Linearization {
+                residual: own.abs(),
+                merit: own.abs(),
+                converged: own.abs() <= 1e-12,
+                step,
+                potential: self.potential(x),
+                slope: own * step,
+                bordered: false,
+                inertia: Inertia::default(),
+            }
+        }
+    }
+    impl Problem for Touch {
+        type State = f64;
+        type Step = f64;
+        type Error = String;
+        fn linearize(&mut self, x: &mut f64) -> Result<Linearization<f64>, String> {
+            Ok(self.on_piece(*x, *x))
+        }
+        fn evaluate(&self, x: &f64) -> Result<Evaluation, String> {
+            Ok(Evaluation {
+                residual: self.residual(*x).abs(),
+                potential: self.potential(*x),
+            })
+        }
+        fn update(&self, base: &f64, step: &f64, t: f64, x: &mut f64) {
+            *x = base + t * step;
+        }
+        fn step_size(&self, step: &f64) -> f64 {
+            step.abs()
+        }
+        fn step_is_finite(&self, step: &f64) -> bool {
+            step.is_finite()
+        }
+        fn relinearize(
+            &mut self,
+            x: &mut f64,
+            _lin: &Linearization<f64>,
+            trial: &f64,
+        ) -> Result<Option<Linearization<f64>>, String> {
+            let changed = (*x > self.c) != (*trial > self.c);
+            Ok((self.semi_smooth && changed).then(|| self.on_piece(*x, *trial)))
+        }
+    }
+
+    #[test]
+    fn a_step_across_a_kink_is_taken_on_the_piece_it_ends_on() {
+        let settings = NewtonSettings {
+            max_step: 10.0,
+            ..Default::default()
+        };
+        let touch = |semi_smooth| Touch {
+            a: 1.0,
+            f: 1.0,
+            c: 1e-4,
+            kappa: 1e8,
+            semi_smooth,
+        };
+        let exact = (1.0 + 1e8 * 1e-4) / (1.0 + 1e8);
+        let mut x = 0.0;
+        let err = solve(&mut touch(false), &mut x, &settings).unwrap_err();
+        assert!(
+            matches!(err, NewtonError::NoDescent { iteration: 0, .. }),
+            "{err:?}"
+        );
+        assert_eq!(x, 0.0, "a failed solve leaves the state where it was");
+        let mut x = 0.0;
+        let rep = solve(&mut touch(true), &mut x, &settings).unwrap();
+        assert_eq!(rep.iterations, 1, "{rep:?}");
+        assert!((x - exact).abs() <= 1e-15, "{x} against {exact}");
     }
 }

@@ -223,6 +223,55 @@ fn augmented_contact_tangent_matches_finite_differences() {
     );
 }
 
+/// The contact kernel on a branch ([`Contact::kernel_on_branch`]) with the status positions
+/// held: its residual and tangent against central differences of its energy and residual, with
+/// random multipliers and status positions, so that some points are pushed on a branch they
+/// are apart on (a pulling traction) and some are free where they penetrate; on the branch of
+/// the positions themselves it is the kernel, bit for bit.
+#[test]
+fn contact_on_a_branch_matches_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(16);
+    let h = 1e-7;
+    let (mut pulled, mut freed) = (0, 0);
+    for _ in 0..20 {
+        let (re, x, contact) = element_on_tilted_plane(&mut rng);
+        let contact = contact.with_enforcement(Enforcement::augmented());
+        let history: Vec<f64> = (0..4)
+            .flat_map(|_| {
+                let kappa = 300.0 * rng.random_range(1.0..20.0);
+                [rng.random_range(0.0..1.0), kappa, f64::NAN]
+            })
+            .collect();
+        // status positions: the element moved by up to ±0.6 along the normal (its gaps are of that
+        // size), node by node
+        let normal = Vec3::from(contact.planes[0].normal);
+        let branch = x.map(|p| p + normal * rng.random_range(-0.6..0.6));
+        for g in 0..4 {
+            let at = contact.point(&history, g, 0);
+            let gap = contact.planes[0].gap(re.position(g, &x).into());
+            let pushed_at_branch = contact
+                .traction_at(contact.planes[0].gap(re.position(g, &branch).into()), at)
+                > 0.0;
+            let pushed_here = contact.traction_at(gap, at) > 0.0;
+            pulled += usize::from(pushed_at_branch && !pushed_here);
+            freed += usize::from(!pushed_at_branch && pushed_here);
+        }
+        let eval = |x: &[Vec3; 4]| {
+            let (mut r, mut k) = (SVector::<f64, 12>::zeros(), SMatrix::<f64, 12, 12>::zeros());
+            let e = contact.kernel_on_branch(&re, x, Some(&branch), &history, &mut r, Some(&mut k));
+            (e, r, k)
+        };
+        check_element_fd(&x, h, "contact on a branch", eval);
+        // on its own branch: the kernel
+        let (mut r1, mut k1) = (SVector::<f64, 12>::zeros(), SMatrix::<f64, 12, 12>::zeros());
+        let (mut r2, mut k2) = (SVector::<f64, 12>::zeros(), SMatrix::<f64, 12, 12>::zeros());
+        let e1 = contact.kernel(&re, &x, &history, &mut r1, Some(&mut k1));
+        let e2 = contact.kernel_on_branch(&re, &x, Some(&x), &history, &mut r2, Some(&mut k2));
+        assert_eq!((e1, r1, k1), (e2, r2, k2));
+    }
+    assert!(pulled > 0 && freed > 0, "pulled {pulled}, freed {freed}");
+}
+
 /// Patch test: a flat (tilted, distorted) element under a uniform in-plane stretch reproduces the
 /// law's resultants exactly (the bilinear field contains every affine map).
 #[test]
