@@ -389,3 +389,52 @@ fn the_case_study_says_whether_gps_describes_the_tube() {
     );
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// Issue #24 item 2: `verify --case … --quick --filter reference` had panicked (exit 101, an
+/// index out of bounds: the study read its checks by position). Each filter runs the checks it
+/// selects, and where it leaves out what the closed-form comparison needs, the verdict says so.
+#[test]
+fn a_filtered_study_runs_what_it_selects_and_says_what_it_left_out() {
+    let d = tmp("study-filter");
+    for (filter, ran, left) in [
+        ("reference", vec!["reference"], "both"),
+        ("invariance", vec!["invariance"], "both"),
+        ("end", vec!["end-effect"], "convergence"),
+    ] {
+        let out_dir = d.join(filter);
+        let o = tubemem(
+            &[
+                "verify",
+                "--case",
+                SMALL,
+                "--quick",
+                "--filter",
+                filter,
+                "--out",
+                out_dir.to_str().unwrap(),
+            ],
+            &[("TUBEMEM_PYTHON", "/nonexistent/python")],
+        );
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            matches!(o.status.code(), Some(0 | 1)),
+            "--filter {filter}: {:?}\n{out}\n{}",
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            out.contains(&format!("--filter \"{filter}\" left {left} out")),
+            "--filter {filter}: {out}"
+        );
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
+                .unwrap();
+        let names: Vec<&str> = r["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(names, ran, "--filter {filter}");
+    }
+}

@@ -146,8 +146,11 @@ pub fn run_study(
     let mut results = run_checks(&[mk(end), mk(inv), mk(reference)], out, opts, progress)
         .map_err(|e| e.chain())?;
     let q = "w";
-    let end_r = &results[0];
-    let fit = end_r.details.get("fit");
+    // by name: `--filter` may have left any of them out
+    let named = |results: &[CheckResult], name: &str| -> Option<usize> {
+        results.iter().position(|r| r.name == name)
+    };
+    let fit = named(&results, "end-effect").and_then(|i| results[i].details.get("fit"));
     let end_at_l = fit.and_then(|f| {
         let a = f["a"].as_f64()?;
         let k = f["k"].as_f64()?;
@@ -168,9 +171,12 @@ pub fn run_study(
     // allows for the end effect and the mesh together
     conv.compare_reference = Some(false);
     results.extend(run_checks(&[mk(conv)], out, opts, progress).map_err(|e| e.chain())?);
-    let conv_r = &results[3];
-    let end_r = &results[0];
-    let table = conv_r.details.get("quantities").and_then(|t| t.as_array());
+    let conv_r = named(&results, "convergence").map(|i| &results[i]);
+    let end_r = named(&results, "end-effect").map(|i| &results[i]);
+    let (have_end, have_conv) = (end_r.is_some(), conv_r.is_some());
+    let table = conv_r
+        .and_then(|r| r.details.get("quantities"))
+        .and_then(|t| t.as_array());
     let w_row = table.and_then(|t| t.iter().find(|r| r["quantity"] == q));
     let values = w_row.and_then(|r| r["values"].as_array());
     // the user's mesh is member −start
@@ -182,7 +188,7 @@ pub fn run_study(
         (Some(u), Some(e)) => Some(u / e - 1.0),
         _ => None,
     };
-    let needed = end_r.details["length_for_epsilon"].as_f64();
+    let needed = end_r.and_then(|r| r.details.get("length_for_epsilon")?.as_f64());
     let mut cf = spec("closed-form", CheckKind::ClosedForm, &path);
     let (tol, source) = match (discretization, end_at_l, gci) {
         (Some(d), Some(e), Some(g)) => (
@@ -205,7 +211,9 @@ pub fn run_study(
     results.extend(cf_results);
     let cf_r = results.iter().find(|r| r.name == "closed-form");
     let measured = cf_r.and_then(|r| r.measures.first()).map(|m| m.measured);
-    let core = results[1].measures.first().map(|m| m.measured);
+    let core = named(&results, "invariance")
+        .and_then(|i| results[i].measures.first())
+        .map(|m| m.measured);
     let all_ok = results
         .iter()
         .all(|r| matches!(r.status, Status::Pass | Status::Skipped));
@@ -215,6 +223,21 @@ pub fn run_study(
         .filter(|r| matches!(r.status, Status::Fail | Status::Error))
         .map(|r| r.name.as_str())
         .collect();
+    // what `--filter` left out of the comparison with GPS
+    let left_out = opts
+        .filter
+        .as_deref()
+        .filter(|_| !(have_end && have_conv))
+        .map(|f| {
+            format!(
+                "the comparison with GPS was not made: it needs the end-effect and convergence checks, and --filter {f:?} left {} out; ",
+                match (have_end, have_conv) {
+                    (false, false) => "both",
+                    (false, true) => "end-effect",
+                    _ => "convergence",
+                }
+            )
+        });
     match (measured, discretization, end_at_l) {
         (Some(m), Some(d), Some(e)) if all_ok => {
             verdict = format!(
@@ -230,8 +253,13 @@ pub fn run_study(
                 )),
                 failed.join(", ")
             );
+            verdict.push_str(left_out.as_deref().unwrap_or(""));
         }
-        _ => verdict.push_str("the comparison with GPS could not be made (see the checks); "),
+        _ => verdict.push_str(
+            left_out
+                .as_deref()
+                .unwrap_or("the comparison with GPS could not be made (see the checks); "),
+        ),
     }
     // past the GPS pressure maximum the uniform state is unstable: say so
     let last_ls = results
