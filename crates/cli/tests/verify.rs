@@ -329,17 +329,8 @@ fn the_case_study_says_whether_gps_describes_the_tube() {
         out.starts_with("GPS describes the mid-span of this tube"),
         "{out}"
     );
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("good/results.json")).unwrap())
-            .unwrap();
-    let names: Vec<&str> = r["checks"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c["name"].as_str().unwrap())
-        .collect();
     assert_eq!(
-        names,
+        check_names(&d.join("good")),
         [
             "end-effect",
             "invariance",
@@ -426,15 +417,18 @@ fn a_filtered_study_runs_what_it_selects_and_says_what_it_left_out() {
             out.contains(&format!("--filter \"{filter}\" left {left} out")),
             "--filter {filter}: {out}"
         );
-        let r: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
-                .unwrap();
-        let names: Vec<&str> = r["checks"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|c| c["name"].as_str().unwrap())
-            .collect();
-        assert_eq!(names, ran, "--filter {filter}");
+        assert_eq!(check_names(&out_dir), ran, "--filter {filter}");
     }
+}
+
+/// The names of the checks in `dir/results.json`, in order.
+fn check_names(dir: &std::path::Path) -> Vec<String> {
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+    r["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap().to_string())
+        .collect()
 }

@@ -549,6 +549,9 @@ mod tests {
         let mut x = 0.0;
         let rep = solve(&mut touch(true), &mut x, &settings).unwrap();
         assert_eq!(rep.iterations, 1, "{rep:?}");
+        // one step on the linear piece is exact up to rounding: x* ≈ 1e-4 to a few ulps
+        // (1.4e-20 each); 1e-15 is far above that and far below the error of the free
+        // piece's step (x = f/a = 1)
         assert!((x - exact).abs() <= 1e-15, "{x} against {exact}");
     }
 }

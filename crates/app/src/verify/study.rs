@@ -55,6 +55,11 @@ pub struct Study {
     pub verdict: String,
 }
 
+/// The study's check `name` among `results`, by name: `--filter` may have left any out.
+fn named<'a>(results: &'a [CheckResult], name: &str) -> Option<&'a CheckResult> {
+    results.iter().find(|r| r.name == name)
+}
+
 /// Build and run the study of `case_path` into `out`.
 pub fn run_study(
     case_path: &Path,
@@ -146,11 +151,7 @@ pub fn run_study(
     let mut results = run_checks(&[mk(end), mk(inv), mk(reference)], out, opts, progress)
         .map_err(|e| e.chain())?;
     let q = "w";
-    // by name: `--filter` may have left any of them out
-    let named = |results: &[CheckResult], name: &str| -> Option<usize> {
-        results.iter().position(|r| r.name == name)
-    };
-    let fit = named(&results, "end-effect").and_then(|i| results[i].details.get("fit"));
+    let fit = named(&results, "end-effect").and_then(|r| r.details.get("fit"));
     let end_at_l = fit.and_then(|f| {
         let a = f["a"].as_f64()?;
         let k = f["k"].as_f64()?;
@@ -171,8 +172,8 @@ pub fn run_study(
     // allows for the end effect and the mesh together
     conv.compare_reference = Some(false);
     results.extend(run_checks(&[mk(conv)], out, opts, progress).map_err(|e| e.chain())?);
-    let conv_r = named(&results, "convergence").map(|i| &results[i]);
-    let end_r = named(&results, "end-effect").map(|i| &results[i]);
+    let conv_r = named(&results, "convergence");
+    let end_r = named(&results, "end-effect");
     let (have_end, have_conv) = (end_r.is_some(), conv_r.is_some());
     let table = conv_r
         .and_then(|r| r.details.get("quantities"))
@@ -209,10 +210,10 @@ pub fn run_study(
         vec![]
     };
     results.extend(cf_results);
-    let cf_r = results.iter().find(|r| r.name == "closed-form");
+    let cf_r = named(&results, "closed-form");
     let measured = cf_r.and_then(|r| r.measures.first()).map(|m| m.measured);
     let core = named(&results, "invariance")
-        .and_then(|i| results[i].measures.first())
+        .and_then(|r| r.measures.first())
         .map(|m| m.measured);
     let all_ok = results
         .iter()
