@@ -125,10 +125,14 @@ def sweep(
     out: Union[str, PathLike],
     params: Optional[list[Mapping[str, Any]]] = None,
     client: Any = None,
+    workers: Optional[int] = None,
+    progress: Union[None, str, Callable[[dict[str, Any]], Any]] = None,
     processes: Optional[int] = None,
 ) -> Any:
-    """Run many cases (locally in processes, or on a Dask client); a pandas DataFrame with one
-    row per case and converged step; failed members keep their `error` and lose no others."""
+    """Run many cases (locally on `workers` threads of this process, or on a Dask client); a
+    pandas DataFrame with one row per case and converged step; failed members keep their
+    `error` and lose no others. `processes` is the former name of `workers`. `progress`:
+    "tqdm", or a callable given {"case", "done", "total", "error"} per finished member."""
 
 def _sweep_one(index: int, text: str, out: Union[str, PathLike]) -> dict[str, Any]: ...
 
@@ -140,5 +144,7 @@ def verify(
     jobs: int = 0,
     filter: Optional[str] = None,
     update_gold: bool = False,
+    python: Optional[Union[str, PathLike]] = None,
+    python_ref: Optional[Union[str, PathLike]] = None,
 ) -> dict[str, Any]:
     """Verification suites (or the study of one case): results.json's content as a dict."""

@@ -107,3 +107,31 @@ def test_compare_the_located_pressure_maximum_with_the_axisymmetric_tube(tmp_pat
     # and 320 cylinder elements alike (to 1e-11); bracketed within about 10 % so that a broken
     # reference (no end effect, or the wrong law) fails
     assert 1.0e-3 < w[8] < 1.25e-3, w
+
+
+def test_verify_finds_the_installed_references_outside_the_checkout(tmp_path, tubemem_exe):
+    """Issue #24 item 3: a study run outside the checkout skipped the references silently (it
+    looked only for a python_ref folder above the case or the working folder). With the
+    references installed in the interpreter (this venv has `pip install -e python_ref`),
+    `--python` is enough; with a bare interpreter, the skip message names every way to point at
+    them (--python, --python-ref and both variables)."""
+    import os
+
+    case = tmp_path / "case.toml"
+    case.write_text(CASE)
+    env = {k: v for k, v in os.environ.items() if k not in ("TUBEMEM_PYTHON", "TUBEMEM_PYTHON_REF")}
+    run = lambda *extra: subprocess.run(  # noqa: E731
+        [tubemem_exe, "verify", "--case", str(case), "--filter", "reference", "--out", str(tmp_path / f"out{len(extra)}"), *extra],
+        capture_output=True, text=True, cwd=tmp_path, env=env, timeout=900,
+    )
+    done = run("--python", sys.executable)
+    assert done.returncode == 0, done.stderr
+    assert "SKIPPED" not in done.stderr and "PASS    reference" in done.stderr, done.stderr
+    # a python with nothing installed: skipped, naming the fixes
+    bare = tmp_path / "bare"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(bare)], check=True)
+    skipped = run("--python", str(bare / "bin" / "python"), "--jobs", "1")
+    msg = skipped.stderr
+    assert "SKIPPED reference" in msg, msg
+    for how in ["pip install ./python_ref", "--python", "--python-ref", "TUBEMEM_PYTHON_REF", "TUBEMEM_PYTHON"]:
+        assert how in msg, (how, msg)

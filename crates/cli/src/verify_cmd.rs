@@ -30,10 +30,16 @@ pub struct VerifyArgs {
     /// Rewrite the gold files of `gold` checks from this run (on request only).
     #[arg(long)]
     pub update_gold: bool,
-    /// The Python interpreter with the scikit-fem references (default: $TUBEMEM_PYTHON, else
-    /// the .venv next to python_ref/, else python3).
+    /// The Python interpreter that runs the scikit-fem references (the `reference` checks):
+    /// default $TUBEMEM_PYTHON, else the .venv next to the python_ref folder found, else
+    /// python3. Outside the checkout, install the references in it (pip install ./python_ref).
     #[arg(long)]
     pub python: Option<PathBuf>,
+    /// The python_ref folder to import the references from, when they are not installed in the
+    /// interpreter: default $TUBEMEM_PYTHON_REF, else the python_ref of a checkout above the
+    /// case (or suite) or the working folder.
+    #[arg(long)]
+    pub python_ref: Option<PathBuf>,
 }
 
 /// Exit code 2: the verification could not be set up.
@@ -55,7 +61,7 @@ pub fn run(a: VerifyArgs) -> u8 {
         filter: a.filter.clone(),
         update_gold: a.update_gold,
         python: a.python.clone(),
-        python_ref: None,
+        python_ref: a.python_ref.clone(),
     };
     let progress = |e: Event| {
         let mut err = std::io::stderr().lock();

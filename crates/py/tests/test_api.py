@@ -373,7 +373,7 @@ def _sweep_cases():
 
 def test_sweep_runs_in_local_processes_and_keeps_finished_runs(tmp_path):
     cases, params = _sweep_cases()
-    df = tubemem.sweep(cases, str(tmp_path), params=params, processes=2)
+    df = tubemem.sweep(cases, str(tmp_path), params=params, workers=2)
     assert set(df["case"]) == {0, 1, 2, 3}
     ok = df[df["error"].isna()]
     assert set(ok["case"]) == {0, 1, 2}
@@ -387,6 +387,45 @@ def test_sweep_runs_in_local_processes_and_keeps_finished_runs(tmp_path):
         assert last["L/R"] == [4.0, 6.0, 8.0][i] == summary["geometry"]["length"]
     failed = df[df["case"] == 3]
     assert len(failed) == 1 and "locking" in failed["error"].iloc[0]
+
+
+def test_sweep_runs_from_a_plain_script_without_a_main_guard(tmp_path):
+    # issue #24 item 1: called at module level, the sweep had spawned worker processes that
+    # re-imported the script and died with BrokenProcessPool; it now runs on threads of this
+    # process, and its progress callback sees every member once
+    import subprocess
+    import sys
+    import textwrap
+
+    script = tmp_path / "plain.py"
+    script.write_text(textwrap.dedent(f"""
+        import tomllib, tubemem
+        tables = tomllib.loads({SMALL_CASE!r})
+        cases = [tubemem.Case(**dict(tables, geometry={{"radius": 1.0, "length": L}})) for L in (4.0, 6.0)]
+        seen = []
+        df = tubemem.sweep(cases, {str(tmp_path / "out")!r}, workers=2, progress=seen.append)
+        assert sorted(d["case"] for d in seen) == [0, 1], seen
+        assert [d["done"] for d in seen] == [1, 2] and all(d["total"] == 2 for d in seen)
+        assert df["error"].isna().all(), df["error"]
+        print("rows", len(df))
+    """))
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "BrokenProcessPool" not in done.stderr
+    assert done.stdout.startswith("rows ")
+
+
+def test_sweep_arguments_are_checked_before_anything_runs(tmp_path):
+    cases, params = _sweep_cases()
+    with pytest.raises(ValueError, match=r"params has 1 entries for 4 cases"):
+        tubemem.sweep(cases, str(tmp_path / "a"), params=params[:1])
+    with pytest.raises(ValueError, match=r"workers=1 and processes=2"):
+        tubemem.sweep(cases, str(tmp_path / "b"), workers=1, processes=2)
+    with pytest.raises(ValueError, match=r"progress"):
+        tubemem.sweep(cases, str(tmp_path / "c"), progress="bar")
+    with pytest.raises(ValueError, match=r"cases\[1\]"):
+        tubemem.sweep([cases[0], {"geometry": {"radius": -1.0}}], str(tmp_path / "d"))
+    assert not any((tmp_path / d).exists() for d in "abcd")
 
 
 def test_sweep_on_a_dask_local_cluster_equals_the_local_one(tmp_path):

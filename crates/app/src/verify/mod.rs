@@ -674,8 +674,10 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     Ok(None)
 }
 
-/// Where the `python_ref` folder is: given, or searched upwards from `from` and the working
-/// folder.
+/// Where the `python_ref` folder is, when there is one to put on the module path: given
+/// (`--python-ref`, `TUBEMEM_PYTHON_REF`), or the checkout's, searched upwards from `from` and
+/// the working folder. None: the references are the `tubemem_ref` package installed in the
+/// interpreter (`pip install ./python_ref`).
 fn find_python_ref(opts: &VerifyOptions, from: &Path) -> Option<PathBuf> {
     if let Some(p) = &opts.python_ref {
         return Some(p.clone());
@@ -687,7 +689,11 @@ fn find_python_ref(opts: &VerifyOptions, from: &Path) -> Option<PathBuf> {
     for start in [Some(from.to_path_buf()), cwd].into_iter().flatten() {
         let start = start.canonicalize().unwrap_or(start);
         for d in start.ancestors() {
-            if d.join("python_ref").join("compare.py").is_file() {
+            if d.join("python_ref")
+                .join("tubemem_ref")
+                .join("compare.py")
+                .is_file()
+            {
                 return Some(d.join("python_ref"));
             }
         }
@@ -695,7 +701,9 @@ fn find_python_ref(opts: &VerifyOptions, from: &Path) -> Option<PathBuf> {
     None
 }
 
-fn python_for(opts: &VerifyOptions, python_ref: &Path) -> PathBuf {
+/// The interpreter that runs the references: `--python`, `TUBEMEM_PYTHON`, the `.venv` next to
+/// the `python_ref` folder found, else `python3`.
+fn python_for(opts: &VerifyOptions, python_ref: Option<&Path>) -> PathBuf {
     if let Some(p) = &opts.python {
         return p.clone();
     }
@@ -703,7 +711,7 @@ fn python_for(opts: &VerifyOptions, python_ref: &Path) -> PathBuf {
         return PathBuf::from(p);
     }
     let venv = python_ref
-        .parent()
+        .and_then(Path::parent)
         .map(|d| d.join(".venv").join("bin").join("python"));
     match venv {
         Some(v) if v.is_file() => v,
@@ -711,23 +719,31 @@ fn python_for(opts: &VerifyOptions, python_ref: &Path) -> PathBuf {
     }
 }
 
+/// How to point `tubemem verify` at the references, for the messages of a skipped check.
+pub const REFERENCES_HOWTO: &str = "install them in the interpreter (pip install ./python_ref) and pass it with --python or TUBEMEM_PYTHON, or name the python_ref folder with --python-ref or TUBEMEM_PYTHON_REF; the README's test command creates .venv with them";
+
 fn reference(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
-    let Some(pref) = find_python_ref(opts, &c.base_dir) else {
-        return Ok(Some(
-            "the Python references (python_ref/compare.py) were not found: set TUBEMEM_PYTHON_REF or run from the tubemem checkout".into(),
-        ));
-    };
-    let python = python_for(opts, &pref);
-    // are the references importable?
+    let pref = find_python_ref(opts, &c.base_dir);
+    let python = python_for(opts, pref.as_deref());
+    // the module path: the folder found first (a checkout's own references win over an
+    // installed copy), then whatever the interpreter has installed
+    let path_arg = pref
+        .as_ref()
+        .map_or(String::new(), |p| p.display().to_string());
+    let prelude = "import sys\nif sys.argv[1]: sys.path.insert(0, sys.argv[1])\n";
     let probe = std::process::Command::new(&python)
         .arg("-c")
-        .arg("import sys; sys.path.insert(0, sys.argv[1]); import tubemem_ref, skfem, scipy")
-        .arg(&pref)
+        .arg(format!("{prelude}import tubemem_ref.compare, skfem, scipy"))
+        .arg(&path_arg)
         .output();
+    let whence = match &pref {
+        Some(p) => format!("with {} on its path", p.display()),
+        None => "(no python_ref folder found: the installed package was tried)".into(),
+    };
     match probe {
         Err(e) => {
             return Ok(Some(format!(
-                "no Python interpreter at {} ({e}): the scikit-fem references cannot run (set TUBEMEM_PYTHON)",
+                "no Python interpreter at {} ({e}): the scikit-fem references cannot run; {REFERENCES_HOWTO}",
                 python.display()
             )))
         }
@@ -735,7 +751,7 @@ fn reference(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -
             let err = String::from_utf8_lossy(&o.stderr);
             let last = err.lines().last().unwrap_or("").to_string();
             return Ok(Some(format!(
-                "the scikit-fem references are not installed for {} ({last}); the README's test command creates .venv with them",
+                "the scikit-fem references do not import in {} {whence} ({last}); {REFERENCES_HOWTO}",
                 python.display()
             )));
         }
@@ -744,11 +760,11 @@ fn reference(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -
     let run_dir = dir.join("run");
     let report = member(c, &c.case_text, &run_dir, r)?;
     let cmp = dir.join("compare");
-    let script = "import json, math, sys\nsys.path.insert(0, sys.argv[1])\nimport compare\nrows = compare.compare(sys.argv[2], sys.argv[3], plot=True)\nclean = [[None if isinstance(v, float) and not math.isfinite(v) else v for v in row] for row in rows]\nprint('TUBEMEM_JSON ' + json.dumps(clean))\n";
+    let script = format!("{prelude}import json, math\nimport tubemem_ref.compare as compare\nrows = compare.compare(sys.argv[2], sys.argv[3], plot=True)\nclean = [[None if isinstance(v, float) and not math.isfinite(v) else v for v in row] for row in rows]\nprint('TUBEMEM_JSON ' + json.dumps(clean))\n");
     let o = std::process::Command::new(&python)
         .arg("-c")
         .arg(script)
-        .arg(&pref)
+        .arg(&path_arg)
         .arg(&run_dir)
         .arg(&cmp)
         .output()
@@ -757,14 +773,14 @@ fn reference(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -
     if !o.status.success() {
         let err = String::from_utf8_lossy(&o.stderr);
         return Err(format!(
-            "python_ref/compare.py failed: {}",
+            "the references (tubemem_ref.compare) failed: {}",
             err.lines().last().unwrap_or("(no message)")
         ));
     }
     let line = stdout
         .lines()
         .find_map(|l| l.strip_prefix("TUBEMEM_JSON "))
-        .ok_or("python_ref/compare.py printed no result")?;
+        .ok_or("the references (tubemem_ref.compare) printed no result")?;
     let rows: Vec<Vec<serde_json::Value>> =
         serde_json::from_str(line).map_err(|e| format!("compare.py's result: {e}"))?;
     let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
