@@ -142,9 +142,18 @@ pub struct EdgeTracking {
 /// 5.9, a factor of 5).
 pub const BULGE: f64 = 0.1;
 
+/// A crossing of the mid level is a bulge front only where λs(Z) flattens on both sides of it:
+/// some segment on each side, before the profile ends, slopes by at most this share of the
+/// crossing's slope. A front is a transition between two coexisting states, whose slope decays
+/// away from it on both sides (a tanh-like profile: 7 % of its peak two widths away). The fall
+/// of λs toward a cap junction is not: the cap layer decays away from the cap, so its slope
+/// grows all the way to the junction, and that side never flattens (issue #24: a uniform
+/// Mooney–Rivlin tube at λs* = 1.4 falls 14 % over its last 0.5 R, and was reported as a bulge).
+pub const FRONT_FLATTENING: f64 = 0.2;
+
 /// The fronts of a bulge: where λs(Z) crosses the level halfway between its smallest and
-/// largest values along the profile (linear interpolation between rings), in increasing Z;
-/// empty without a bulge ([`BULGE`]).
+/// largest values along the profile (linear interpolation between rings), in increasing Z, and
+/// flattens on both sides ([`FRONT_FLATTENING`]); empty without a bulge ([`BULGE`]).
 pub fn bulge_fronts(rings: &[RingValues]) -> Vec<f64> {
     let ls: Vec<f64> = rings.iter().map(|r| r.values.lambda_s).collect();
     let (Some(lo), Some(hi)) = (
@@ -157,12 +166,31 @@ pub fn bulge_fronts(rings: &[RingValues]) -> Vec<f64> {
         return vec![];
     }
     let level = 0.5 * (lo + hi);
+    // |dλs/dZ| of segment k (rings k, k + 1)
+    let slope: Vec<f64> = rings
+        .windows(2)
+        .map(|w| {
+            let dz = w[1].z_ref - w[0].z_ref;
+            if dz == 0.0 {
+                0.0
+            } else {
+                ((w[1].values.lambda_s - w[0].values.lambda_s) / dz).abs()
+            }
+        })
+        .collect();
+    let flattens = |c: usize, mut side: Box<dyn Iterator<Item = usize>>| {
+        side.any(|k| slope[k] <= FRONT_FLATTENING * slope[c])
+    };
     rings
         .windows(2)
-        .filter_map(|w| {
+        .enumerate()
+        .filter_map(|(c, w)| {
             let (a, b) = (w[0].values.lambda_s - level, w[1].values.lambda_s - level);
-            (a * b < 0.0 || (b == 0.0 && a != 0.0))
-                .then(|| w[0].z_ref + (w[1].z_ref - w[0].z_ref) * a / (a - b))
+            let crosses = a * b < 0.0 || (b == 0.0 && a != 0.0);
+            (crosses
+                && flattens(c, Box::new((0..c).rev()))
+                && flattens(c, Box::new(c + 1..slope.len())))
+            .then(|| w[0].z_ref + (w[1].z_ref - w[0].z_ref) * a / (a - b))
         })
         .collect()
 }

@@ -1195,3 +1195,71 @@ fn a_user_mesh_that_is_not_the_cases_tube_is_refused() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+fn ring(z: f64, lambda_s: f64) -> tubemem_fem::post::RingValues {
+    tubemem_fem::post::RingValues {
+        z_ref: z,
+        z,
+        radius: lambda_s,
+        values: tubemem_fem::post::MidSpan {
+            w: 0.0,
+            lambda_s,
+            lambda_z: 1.0,
+            n_s: 0.0,
+            n_z: 0.0,
+            n_sz: 0.0,
+            volume: 0.0,
+        },
+        contact_width: 0.0,
+        contact_force: 0.0,
+    }
+}
+
+/// Issue #24 item 7: the fall of λs toward a cap junction is not a bulge. Synthetic profiles
+/// on Z ∈ [0, 7.5] (an eighth model, the junction at 7.5): a uniform tube with a cap layer
+/// decaying at 1 per R from the junction, 16 % deep (the user's Mooney–Rivlin tube falls
+/// 1.40 → 1.20), has no front; a bulge (λs 1.2 → 3.0, a tanh front of width 0.5 R at Z = 3)
+/// with the same cap layer below its lower state has one front, at Z = 3 to the ring spacing.
+#[test]
+fn the_cap_layer_is_not_a_bulge_front() {
+    use tubemem_app::report::bulge_fronts;
+    let zs: Vec<f64> = (0..=60).map(|k| 0.125 * k as f64).collect();
+    let cap = |z: f64| (-(7.5 - z)).exp();
+    let uniform: Vec<_> = zs.iter().map(|&z| ring(z, 1.4 - 0.2 * cap(z))).collect();
+    assert_eq!(bulge_fronts(&uniform), Vec::<f64>::new());
+    let bulged: Vec<_> = zs
+        .iter()
+        .map(|&z| {
+            ring(
+                z,
+                1.2 + 0.9 * (1.0 - ((z - 3.0) / 0.5).tanh()) - 0.15 * cap(z),
+            )
+        })
+        .collect();
+    let fronts = bulge_fronts(&bulged);
+    assert_eq!(fronts.len(), 1, "{fronts:?}");
+    assert!((fronts[0] - 3.0).abs() < 0.125, "{fronts:?}");
+}
+
+/// The user's tube of issue #24 (verify/examples/mr_lr15_ls1.4.toml, coarsened to 16 around):
+/// uniform but for its cap layers, it had a "front" at Z ≈ 7.0–7.1 R (the layer's mid level) at
+/// five of its ten steps; now none, and no fronts.csv.
+#[test]
+fn a_uniform_tube_reports_no_bulge_fronts() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let text = std::fs::read_to_string(root.join("verify/examples/mr_lr15_ls1.4.toml"))
+        .unwrap()
+        .replace("around = 32", "around = 16")
+        .replace("along = 120", "along = 60");
+    let case = Case::parse(&text).unwrap();
+    let out = tmp("no-fronts");
+    let mut w = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
+    let report = tubemem_app::run::run_with(&case, "mr", &Default::default(), &mut [&mut w]).report;
+    let steps: Vec<_> = report.steps().collect();
+    assert!(steps.len() >= 10, "{}", steps.len());
+    assert!(steps.iter().all(|s| s.fronts.is_empty()));
+    // fronts.csv is written with the first front
+    assert!(!out.join("fronts.csv").exists());
+    assert!(out.join("steps.csv").exists());
+    let _ = std::fs::remove_dir_all(&out);
+}
