@@ -873,7 +873,21 @@ impl Case {
             (Some(_), ..) => invalid!(
                 "[mesh] `file` gives the whole mesh: drop `around`, `along`, `cap_rows`, `symmetry` and `element` (the file sets its own symmetry and element)"
             ),
-            (None, Some(_), Some(_)) => {}
+            (None, Some(around), Some(along)) => {
+                // the generator's own admissibility, before anything runs or is written
+                let cap_rows = m.cap_rows.unwrap_or(around / 8);
+                if let Err(tubemem_mesh::MeshError::InvalidParameter {
+                    name,
+                    value,
+                    requirement,
+                }) = tubemem_mesh::tube::check_counts(around, along, cap_rows)
+                {
+                    invalid!(
+                        "[mesh] `{name}` = {}: {requirement}",
+                        tubemem_material::Num(value)
+                    );
+                }
+            }
             (None, ..) => invalid!("[mesh] needs `around` and `along` (a generated tube) or `file` (a user mesh)"),
         }
         if (m.fit_contact_edge || m.contact_edge_angle.is_some()) && m.file.is_some() {
@@ -926,6 +940,45 @@ impl Case {
             }
         }
         self.material.build().map_err(CaseError::Material)?;
+        // a squeeze must close the plates on the tube: where the plan fixes the half-height at
+        // its start (a stretch-controlled inflation ends with the mid-span ring at λs* R, a
+        // squeeze with the plates at ρR), `target_rho` must be below it
+        let mut height: Option<(f64, String)> = None;
+        for (k, p) in plan.iter().enumerate() {
+            match p.target {
+                Target::Stretch(s) => {
+                    height = Some((
+                        s,
+                        format!(
+                            "the mid-span half-height λs* = {} that [[stage]] {} inflates to",
+                            tubemem_material::Num(s),
+                            k + 1
+                        ),
+                    ))
+                }
+                Target::Rho(r) => {
+                    if let Some((h, what)) = &height {
+                        if r >= *h {
+                            invalid!(
+                                "[[stage]] {}: `target_rho` = {}: the plates must close on the tube, below {what} (ρ < {})",
+                                k + 1,
+                                tubemem_material::Num(r),
+                                tubemem_material::Num(*h)
+                            );
+                        }
+                    }
+                    height = Some((
+                        r,
+                        format!(
+                            "the plates' half-gap ρ = {} of the squeeze [[stage]] {}",
+                            tubemem_material::Num(r),
+                            k + 1
+                        ),
+                    ));
+                }
+                _ => height = None,
+            }
+        }
         if !(self.solver.rtol > 0.0 && self.solver.rtol < 1e-2) {
             invalid!(
                 "[solver] `rtol` = {}: must be in (0, 1e-2)",

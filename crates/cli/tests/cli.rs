@@ -2207,3 +2207,39 @@ fn a_run_killed_at_any_moment_resumes_bit_identical() {
         assert!(left.is_empty(), "{rows}: {left:?} left after the resume");
     }
 }
+
+/// Issue #24 item 8: the whole plan is validated before the output folder is created. A mesh
+/// the generator refuses (`around = 30`) and plates that cannot reach the tube (`target_rho`
+/// above the λs* the inflation ends at) failed only at run time, after the inflation had run
+/// and a failed run had been written; the next attempt was then refused until --overwrite.
+/// Each is now a case error naming the key, and no folder is left behind.
+#[test]
+fn an_invalid_plan_is_refused_before_the_folder_is_created() {
+    for (name, text, needle) in [
+        (
+            "around30",
+            SMALL_CASE.replace("around = 16", "around = 30"),
+            "[mesh] `around` = 30: elements around must be a multiple of 8",
+        ),
+        (
+            "along-odd",
+            SMALL_CASE.replace("along = 24", "along = 23"),
+            "[mesh] `along`",
+        ),
+        (
+            "rho-above",
+            format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.25\nsteps = 2\n"),
+            "[[stage]] 2: `target_rho` = 1.25: the plates must close on the tube, below the mid-span half-height λs* = 1.2 that [[stage]] 1 inflates to",
+        ),
+    ] {
+        assert!(text != SMALL_CASE, "{name}: the edit did not apply");
+        let case = write_case(&format!("plan-{name}"), &text);
+        let out = case.parent().unwrap().join("out");
+        let r = tubemem(&["run", case.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{name}: {err}");
+        assert!(err.contains("in case file"), "{name}: {err}");
+        assert!(err.contains(needle), "{name}: {err}");
+        assert!(!out.exists(), "{name}: the folder was created");
+    }
+}

@@ -276,21 +276,9 @@ pub fn capped_tube_with_cap_rows_of(
     )
 }
 
-/// [`capped_tube_with_cap_rows_of`] with the cylinder's hoop spacing fitted by `fit` (see
-/// [`crate::hoop`]): its corner node lines moved by the map, the mid-side lines of a 9-node
-/// element at the mid-angle of its corners, blended back to uniform spacing towards the caps
-/// ([`crate::hoop::blend`]). `None`: uniform.
-#[allow(clippy::too_many_arguments)]
-pub fn capped_tube_fitted_of(
-    kind: ElementKind,
-    radius: f64,
-    length: f64,
-    around: usize,
-    along: usize,
-    cap_rows: usize,
-    symmetry: Symmetry,
-    fit: Option<&crate::hoop::HoopMap>,
-) -> Result<Mesh, MeshError> {
+/// The element counts a generated tube admits (checked before anything is built, also by the
+/// case validation): `around` a multiple of 8 (≥ 8), `along` even (≥ 2), `cap_rows` ≥ 1.
+pub fn check_counts(around: usize, along: usize, cap_rows: usize) -> Result<(), MeshError> {
     if cap_rows == 0 {
         return Err(MeshError::InvalidParameter {
             name: "cap_rows",
@@ -299,8 +287,6 @@ pub fn capped_tube_fitted_of(
                 "a cap needs at least one row of elements between its equator and its top face",
         });
     }
-    check_positive("radius", radius)?;
-    check_positive("length", length)?;
     if around < 8 || !around.is_multiple_of(8) {
         return Err(MeshError::InvalidParameter {
             name: "around",
@@ -316,6 +302,27 @@ pub fn capped_tube_fitted_of(
                 "elements along must be even (≥ 2), so that the mid-span z = 0 is a mesh line",
         });
     }
+    Ok(())
+}
+
+/// [`capped_tube_with_cap_rows_of`] with the cylinder's hoop spacing fitted by `fit` (see
+/// [`crate::hoop`]): its corner node lines moved by the map, the mid-side lines of a 9-node
+/// element at the mid-angle of its corners, blended back to uniform spacing towards the caps
+/// ([`crate::hoop::blend`]). `None`: uniform.
+#[allow(clippy::too_many_arguments)]
+pub fn capped_tube_fitted_of(
+    kind: ElementKind,
+    radius: f64,
+    length: f64,
+    around: usize,
+    along: usize,
+    cap_rows: usize,
+    symmetry: Symmetry,
+    fit: Option<&crate::hoop::HoopMap>,
+) -> Result<Mesh, MeshError> {
+    check_positive("radius", radius)?;
+    check_positive("length", length)?;
+    check_counts(around, along, cap_rows)?;
     // the node lattice: `order` lattice steps per element side
     let order = kind.gauss_per_direction() - 1;
     let (m, lattice_along, rows) = (order * around / 4, order * along, order * cap_rows);

@@ -585,3 +585,17 @@ def test_numpy_integers_and_strided_arrays_are_taken_as_numpy_users_pass_them():
     assert len(tubemem.gps_inflation_curve(1.5).to_pandas()) == 100
     with pytest.raises(TypeError, match="an integer number of points"):
         tubemem.gps_inflation_curve(1.5, points=2.5)
+
+
+def test_case_validates_the_whole_plan_on_construction(tmp_path):
+    """Issue #24 item 8: `tubemem.Case(...)` accepted a mesh the generator refuses and plates
+    above the tube; both failed only in `run`, after a folder had been written."""
+    import tomllib
+
+    tables = tomllib.loads(SMALL_CASE)
+    with pytest.raises(ValueError, match=r"`around` = 30: elements around must be a multiple of 8"):
+        tubemem.Case(**dict(tables, mesh=dict(tables["mesh"], around=30)))
+    stages = [tables["stage"][0], dict(tables["stage"][1], target_rho=1.5)]
+    with pytest.raises(ValueError, match=r"`target_rho` = 1.5: the plates must close on the tube"):
+        tubemem.Case(**dict(tables, stage=stages))
+    assert not any(tmp_path.iterdir())
