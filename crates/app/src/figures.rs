@@ -186,6 +186,121 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
     (if from_zero && lo >= 0.0 { lo } else { lo - pad }, hi + pad)
 }
 
+/// The share of the plot's width and, per legend line, of its height that a legend covers
+/// (the legend's 16-pixel font on the 1200 × 800 canvas, with its swatch and padding; a long
+/// label is wider).
+const LEGEND_WIDTH: f64 = 0.5;
+const LEGEND_LINE: f64 = 0.045;
+
+/// The axes' ranges of the figure's top panel: every point of its curves and markers inside,
+/// with a margin.
+pub fn axes(fig: &Figure) -> ((f64, f64), (f64, f64)) {
+    let all = || {
+        fig.series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+    };
+    (
+        range(all().map(|p| p.0), false),
+        range(all().map(|p| p.1), fig.y_from_zero),
+    )
+}
+
+/// What a figure shows, for tests of the plots: its points (curve and marker points), those not
+/// drawn inside its axes (not finite), and the marker points under its legend.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FigureAudit {
+    pub points: usize,
+    pub outside: usize,
+    pub under_legend: usize,
+    /// curves of a single point, which draw nothing
+    pub lone_points: usize,
+}
+
+/// The [`FigureAudit`] of the top panel of `fig` as [`render_svg`] draws it.
+pub fn audit(fig: &Figure) -> FigureAudit {
+    let (x, y) = axes(fig);
+    let all: Vec<(f64, f64)> = fig
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
+        .copied()
+        .collect();
+    let inside = |p: &(f64, f64)| (x.0..=x.1).contains(&p.0) && (y.0..=y.1).contains(&p.1);
+    let corner = legend_corner(fig, x, y);
+    let lines = fig.series.len() + fig.markers.len();
+    let (w, h) = (LEGEND_WIDTH, (LEGEND_LINE * lines as f64 + 0.03).min(0.9));
+    let (left, upper) = match corner {
+        SeriesLabelPosition::UpperRight => (false, true),
+        SeriesLabelPosition::LowerLeft => (true, false),
+        SeriesLabelPosition::LowerRight => (false, false),
+        _ => (true, true),
+    };
+    let under = |p: &&(f64, f64)| {
+        let (u, v) = ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
+        (if left { u <= w } else { u >= 1.0 - w }) && (if upper { v >= 1.0 - h } else { v <= h })
+    };
+    FigureAudit {
+        points: all
+            .iter()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .count(),
+        outside: all.iter().filter(|p| !inside(p)).count(),
+        under_legend: fig
+            .markers
+            .iter()
+            .flat_map(|m| m.points.iter())
+            .filter(under)
+            .count(),
+        lone_points: fig.series.iter().filter(|s| s.points.len() == 1).count(),
+    }
+}
+
+/// The corner of the plot where the legend covers the fewest points (curve and marker points,
+/// a curve's segments sampled between its points), the upper left on a tie.
+pub fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
+    let lines = fig.series.len() + fig.markers.len();
+    let (w, h) = (LEGEND_WIDTH, (LEGEND_LINE * lines as f64 + 0.03).min(0.9));
+    let unit = |p: (f64, f64)| ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
+    let mut pts: Vec<(f64, f64)> = fig
+        .markers
+        .iter()
+        .flat_map(|m| m.points.iter().map(|&p| unit(p)))
+        .collect();
+    for s in &fig.series {
+        for seg in s.points.windows(2) {
+            let (a, b) = (unit(seg[0]), unit(seg[1]));
+            pts.extend((0..8).map(|k| {
+                let t = k as f64 / 8.0;
+                (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))
+            }));
+        }
+        if let Some(&p) = s.points.last() {
+            pts.push(unit(p));
+        }
+    }
+    let covered = |left: bool, upper: bool| {
+        pts.iter()
+            .filter(|(u, v)| {
+                (if left { *u <= w } else { *u >= 1.0 - w })
+                    && (if upper { *v >= 1.0 - h } else { *v <= h })
+            })
+            .count()
+    };
+    [
+        (SeriesLabelPosition::UpperLeft, true, true),
+        (SeriesLabelPosition::UpperRight, false, true),
+        (SeriesLabelPosition::LowerLeft, true, false),
+        (SeriesLabelPosition::LowerRight, false, false),
+    ]
+    .into_iter()
+    .min_by_key(|(_, left, upper)| covered(*left, *upper))
+    .map_or(SeriesLabelPosition::UpperLeft, |c| c.0)
+}
+
 fn stroke_pattern(s: Stroke) -> Option<(u32, u32)> {
     match s {
         Stroke::Solid => None,
@@ -283,14 +398,7 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
             }
             None => (root, None),
         };
-        let all = || {
-            fig.series
-                .iter()
-                .flat_map(|s| s.points.iter())
-                .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
-        };
-        let (mut x0, mut x1) = range(all().map(|p| p.0), false);
-        let (mut y0, mut y1) = range(all().map(|p| p.1), fig.y_from_zero);
+        let ((mut x0, mut x1), (mut y0, mut y1)) = axes(fig);
         if fig.equal_aspect {
             // the plot area's shape: the canvas less the label areas and margins
             let (w, h) = top.dim_in_pixel();
@@ -346,7 +454,7 @@ pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(legend_corner(fig, (x0, x1), (y0, y1)))
             .label_font(("sans-serif", 16))
             .background_style(WHITE.mix(0.92))
             .border_style(BLACK)

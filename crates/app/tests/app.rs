@@ -1263,3 +1263,125 @@ fn a_uniform_tube_reports_no_bulge_fronts() {
     assert!(out.join("steps.csv").exists());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// The study of the user's tube of issue #24 (verify/examples/mr_lr15_ls1.4.toml: Mooney–Rivlin
+/// α = 0.08, L/R = 15, λs* = 1.4, squeezed to ρ = 0.9), full and --quick:
+/// - item 5: the closed-form check gates the squeeze force and χ as well as ϖ, each tolerance
+///   built from checks that passed, its source saying what is measured and what estimated;
+///   the verdict is the same with and without --quick (it had been 3.4e-2 against 2.1e-2);
+/// - item 4: the progress count runs 1…5 of 5 over the whole study (it restarted per round),
+///   and every plot has points, all inside its axes, none under its legend, no lone point;
+/// - item 12: the invariance core (27 % of this short tube) is reported, not a failure of the
+///   mid-span verdict.
+#[test]
+fn the_study_gates_the_squeeze_force_and_gives_one_verdict_with_and_without_quick() {
+    use tubemem_app::verify::{study::run_study, Event, Status, VerifyOptions};
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let case = root.join("verify/examples/mr_lr15_ls1.4.toml");
+    let opts = VerifyOptions {
+        python: Some("/nonexistent/python".into()),
+        ..Default::default()
+    };
+    let mut verdicts = vec![];
+    for quick in [false, true] {
+        let out = tmp(&format!("study-{quick}"));
+        let counts = std::sync::Mutex::new(vec![]);
+        let progress = |e: Event| {
+            if let Event::Finished { done, total, .. } = e {
+                counts.lock().unwrap().push((done, total));
+            }
+        };
+        let s = run_study(&case, &out, quick, &opts, &progress).unwrap();
+        let mut counts = counts.into_inner().unwrap();
+        counts.sort();
+        assert_eq!(
+            counts,
+            (1..=5).map(|d| (d, 5)).collect::<Vec<_>>(),
+            "quick {quick}"
+        );
+        let cf = s.results.iter().find(|r| r.name == "closed-form").unwrap();
+        for q in ["final_w", "final_force", "final_chi"] {
+            let m = cf
+                .measures
+                .iter()
+                .find(|m| m.quantity == q)
+                .unwrap_or_else(|| panic!("quick {quick}: no {q} in {:?}", cf.measures));
+            let source = m.source.as_deref().unwrap();
+            assert!(
+                m.tolerance.is_some()
+                    && source.contains("measured: FE against GPS")
+                    && source.contains("estimated:"),
+                "{q}: {source}"
+            );
+            assert!(
+                m.pass,
+                "quick {quick}: {q} {} > {:?}",
+                m.measured, m.tolerance
+            );
+        }
+        for r in &s.results {
+            if r.status == Status::Skipped {
+                continue;
+            }
+            assert!(
+                matches!(r.status, Status::Pass),
+                "quick {quick}: {} {:?}: {}",
+                r.name,
+                r.status,
+                r.message
+            );
+            let a = r.figure.unwrap_or_else(|| panic!("{}: no plot", r.name));
+            assert!(
+                a.points >= 2 && a.outside == 0 && a.under_legend == 0 && a.lone_points == 0,
+                "quick {quick}: {}: {a:?}",
+                r.name
+            );
+        }
+        assert!(
+            s.verdict
+                .contains("the middle 27 % is translation invariant"),
+            "{}",
+            s.verdict
+        );
+        verdicts.push(s.verdict.split(':').next().unwrap().to_string());
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    assert_eq!(
+        verdicts[0],
+        "At mid-span GPS describes this tube, to within its mesh and end effects"
+    );
+    assert_eq!(verdicts[0], verdicts[1]);
+}
+
+/// Issue #24 item 12: a study of a valid case with `around = 24` had errored in its convergence
+/// check (it halved the mesh to 12 around, which the generator refuses). The family refines
+/// upward, 24, 48, 96, with --quick too (24 does not halve to a valid mesh).
+#[test]
+fn the_study_of_24_around_refines_upward() {
+    use tubemem_app::verify::{study::run_study, Status, VerifyOptions};
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let d = tmp("study-24");
+    std::fs::create_dir_all(&d).unwrap();
+    let case = d.join("case24.toml");
+    std::fs::write(
+        &case,
+        std::fs::read_to_string(root.join("cases/small_abb30_ls1.2.toml"))
+            .unwrap()
+            .replace("around = 16", "around = 24"),
+    )
+    .unwrap();
+    let opts = VerifyOptions {
+        python: Some("/nonexistent/python".into()),
+        ..Default::default()
+    };
+    let s = run_study(&case, &d.join("out"), true, &opts, &|_| {}).unwrap();
+    let conv = s.results.iter().find(|r| r.name == "convergence").unwrap();
+    assert_eq!(conv.status, Status::Pass, "{}", conv.message);
+    assert_eq!(conv.details["around"], serde_json::json!([24, 48, 96]));
+    assert!(
+        s.verdict.starts_with("At mid-span GPS describes this tube"),
+        "{}",
+        s.verdict
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -89,7 +89,7 @@ pub fn run(a: VerifyArgs) -> u8 {
     let (names, results, verdict) = if let Some(case) = &a.case {
         let _ = writeln!(
             std::io::stderr(),
-            "study of {}: end effect, invariance and references, then the mesh convergence, then the closed form",
+            "study of {}: end effect, invariance, references and the mesh convergence, then the closed form",
             case.display()
         );
         match verify::study::run_study(case, &a.out, a.quick, &opts, &progress) {

@@ -326,7 +326,7 @@ fn the_case_study_says_whether_gps_describes_the_tube() {
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(
-        out.starts_with("GPS describes the mid-span of this tube"),
+        out.starts_with("At mid-span GPS describes this tube"),
         "{out}"
     );
     assert_eq!(

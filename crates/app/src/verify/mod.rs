@@ -160,6 +160,9 @@ pub struct CheckResult {
     pub plot: Option<String>,
     #[serde(skip)]
     pub png: Option<Vec<u8>>,
+    /// what the plot shows (for the tests of the report's plots)
+    #[serde(skip)]
+    pub figure: Option<crate::figures::FigureAudit>,
 }
 
 /// What [`run_checks`] reports as it goes.
@@ -271,6 +274,7 @@ impl CheckResult {
             details: serde_json::Value::Null,
             plot: None,
             png: None,
+            figure: None,
         }
     }
 }
@@ -519,6 +523,7 @@ const COLORS: [RGBColor; 6] = [
 
 /// Draw a small figure to PNG bytes (for the HTML report).
 fn plot(fig: &Figure, r: &mut CheckResult) {
+    r.figure = Some(crate::figures::audit(fig));
     let p = PathBuf::from(format!("{}.png", r.name));
     if let Ok(svg) = render_svg(fig, &p) {
         r.png = rasterize(&svg, 70.0, &p).ok();
@@ -583,13 +588,18 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                     None => step_pair(s, q),
                 },
             };
+            // plotted as the share of the tolerance used, every quantity on one scale; a
+            // `final_` quantity's curve shows every step, against the last step's tolerance
+            let curve = match q.strip_prefix("final_") {
+                Some(inner) if s.gps_applicable != Some(false) => step_pair(s, inner),
+                _ => pair,
+            };
+            if let Some((fe, cf)) = curve.filter(|_| tol.value > 0.0) {
+                pts.push(((i + 1) as f64, rel(fe, cf).abs() / tol.value));
+            }
             if let Some((fe, cf)) = pair {
                 let e = rel(fe, cf);
                 compared += 1;
-                // plotted as the share of the tolerance used: every quantity on one scale
-                if tol.value > 0.0 {
-                    pts.push(((i + 1) as f64, e.abs() / tol.value));
-                }
                 if worst.is_none_or(|(w, _)| e.abs() > w.abs()) {
                     worst = Some((e, s));
                 }
@@ -914,7 +924,44 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         if phi.iter().any(|v| !v.is_finite()) {
             return Err(format!("`{q}` is not a value of these runs"));
         }
+        let ordered = c
+            .spec
+            .order_quantities
+            .as_ref()
+            .is_none_or(|o| o.contains(q));
         match stats::gci(phi, r21, r32) {
+            // an oscillating family has no order: its uncertainty is half the range of its
+            // values (Stern, Wilson, Coleman & Paterson 2001, oscillatory convergence)
+            Err(stats::GciError::Oscillatory { .. }) if !ordered => {
+                let (lo, hi) = phi
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                        (a.min(v), b.max(v))
+                    });
+                let u = 0.5 * (hi - lo) / phi[0].abs();
+                r.measures.push(Measure::reported(
+                    &format!("{q} uncertainty"),
+                    u,
+                    format!(
+                        "oscillatory convergence ({:.6e}, {:.6e}, {:.6e}, coarse to fine): no order; half the range over the finest value (Stern et al. 2001)",
+                        phi[2], phi[1], phi[0]
+                    ),
+                ));
+                table.push(serde_json::json!({
+                    "quantity": q, "values": vals, "oscillatory": true, "uncertainty": u,
+                }));
+                series.push(Series {
+                    label: format!("{q}: φ/φ_finest − 1 (oscillatory)"),
+                    points: h
+                        .iter()
+                        .zip(&vals)
+                        .map(|(hh, v)| ((hh * arounds[fine] as f64).powi(2), rel(*v, phi[0])))
+                        .collect(),
+                    color: COLORS[qi % COLORS.len()],
+                    stroke: Stroke::Dashed,
+                    width: 2,
+                });
+            }
             Err(e) => {
                 r.measures.push(Measure {
                     quantity: format!("{q} order"),
@@ -930,7 +977,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                 );
             }
             Ok(g) => {
-                if let Some(exp) = &c.spec.expected_order {
+                if let Some(exp) = c.spec.expected_order.as_ref().filter(|_| ordered) {
                     r.measures.push(Measure::expected(
                         &format!("{q} "),
                         "p",
@@ -977,21 +1024,26 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                     "extrapolated": g.extrapolated, "gci_fine": g.gci_fine,
                     "relative_error": g.relative_error, "reference": reference,
                 }));
-                if let Some(reference) = reference {
-                    series.push(Series {
-                        label: format!("{q}: FE/GPS − 1"),
-                        points: h
-                            .iter()
-                            .zip(&vals)
-                            .map(|(hh, v)| {
-                                ((hh * arounds[fine] as f64).powi(2), rel(*v, reference))
-                            })
-                            .collect(),
-                        color: COLORS[qi % COLORS.len()],
-                        stroke: Stroke::Solid,
-                        width: 2,
-                    });
-                }
+                // against GPS when the check compares with it, else against the extrapolated
+                // value (the family's own limit: what the mesh error is measured from)
+                let (against, label) = match reference {
+                    Some(reference) => (reference, format!("{q}: FE/GPS − 1")),
+                    None => (
+                        g.extrapolated,
+                        format!("{q}: φ/φ_ext − 1 (p = {:.2})", g.order),
+                    ),
+                };
+                series.push(Series {
+                    label,
+                    points: h
+                        .iter()
+                        .zip(&vals)
+                        .map(|(hh, v)| ((hh * arounds[fine] as f64).powi(2), rel(*v, against)))
+                        .collect(),
+                    color: COLORS[qi % COLORS.len()],
+                    stroke: Stroke::Solid,
+                    width: 2,
+                });
             }
         }
     }
@@ -1003,7 +1055,11 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             ..Figure::new(
                 format!("{}: mesh convergence", c.spec.name),
                 "(h/h_finest)² (h ∝ 1/elements around)",
-                "FE/GPS − 1",
+                if c.spec.compare_reference.unwrap_or(true) {
+                    "FE/GPS − 1"
+                } else {
+                    "relative to the family's limit"
+                },
                 series,
             )
         },
@@ -1015,7 +1071,15 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
 fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let lengths = c.spec.lengths.clone().unwrap_or_default();
     let law = c.spec.law.unwrap_or(stats::EndLaw::Exponential);
-    let q = c.spec.quantity.clone().unwrap_or_else(|| "w".into());
+    // the check's own quantity first, then any others fitted from the same runs
+    let quantities: Vec<String> = match (&c.spec.quantity, &c.spec.quantities) {
+        (Some(q), Some(more)) => std::iter::once(q.clone())
+            .chain(more.iter().filter(|m| *m != q).cloned())
+            .collect(),
+        (None, Some(more)) if !more.is_empty() => more.clone(),
+        (q, _) => vec![q.clone().unwrap_or_else(|| "w".into())],
+    };
+    let q = quantities[0].clone();
     let eps = c.spec.epsilon.unwrap_or(1e-3);
     let base: toml::Table = toml::from_str(&c.case_text).map_err(|e| e.to_string())?;
     let g = base.get("geometry").and_then(|g| g.as_table());
@@ -1025,6 +1089,7 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let l0 =
         num(g.and_then(|g| g.get("length"))).ok_or("the case has no [geometry] length")? / radius;
     let mut errors = vec![];
+    let mut others: Vec<Vec<f64>> = vec![vec![]; quantities.len() - 1];
     for (k, &l) in lengths.iter().enumerate() {
         let text = vary(&c.case_text, |t| {
             if let Some(g) = t.get_mut("geometry").and_then(|g| g.as_table_mut()) {
@@ -1050,6 +1115,9 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         let (fe, cf) =
             step_pair(last, &q).ok_or(format!("`{q}` has no closed form at the last step"))?;
         errors.push(rel(fe, cf));
+        for (o, more) in others.iter_mut().zip(&quantities[1..]) {
+            o.push(step_pair(last, more).map_or(f64::NAN, |(fe, cf)| rel(fe, cf)));
+        }
     }
     let fit =
         stats::fit_end_law(law, &lengths, &errors).ok_or("the end-effect law cannot be fitted")?;
@@ -1080,9 +1148,47 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         needed,
         format!("L/R ≥ {needed:.2} for an end effect |A f(L/R)| ≤ ε = {eps:e}"),
     ));
+    // the other quantities: their laws and lengths, reported
+    let mut fits = serde_json::Map::new();
+    fits.insert(
+        q.clone(),
+        serde_json::json!({"errors": errors, "fit": fit, "length_for_epsilon": needed}),
+    );
+    for (more, errs) in quantities[1..].iter().zip(&others) {
+        let f = errs
+            .iter()
+            .all(|e| e.is_finite())
+            .then(|| stats::fit_end_law(law, &lengths, errs))
+            .flatten();
+        match f {
+            Some(f) => {
+                let n = f.length_for(eps);
+                r.measures.push(Measure::reported(
+                    &format!("length needed ({more})"),
+                    n,
+                    format!(
+                        "{more}: L/R ≥ {n:.2} for ε = {eps:e}; end effect {:+.3e} at L/R = {l0}, fit residual {:.1e}",
+                        f.end_effect(l0),
+                        f.relative_residual
+                    ),
+                ));
+                fits.insert(
+                    more.clone(),
+                    serde_json::json!({"errors": errs, "fit": f, "length_for_epsilon": n}),
+                );
+            }
+            None => {
+                r.measures.push(Measure::reported(
+                    &format!("length needed ({more})"),
+                    f64::NAN,
+                    format!("{more}: the end-effect law cannot be fitted to {errs:?}"),
+                ));
+            }
+        }
+    }
     r.details = serde_json::json!({
         "quantity": q, "lengths": lengths, "errors": errors, "fit": fit,
-        "length_for_epsilon": needed, "epsilon": eps,
+        "length_for_epsilon": needed, "epsilon": eps, "fits": fits,
     });
     let law_text = match law {
         stats::EndLaw::Exponential => format!(
@@ -1092,45 +1198,70 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         stats::EndLaw::Inverse => format!("c + A/(L/R): c = {:.3e}, A = {:.4e}", fit.c, fit.a),
     };
     r.message = format!("{law_text}; L/R ≥ {needed:.1} for ε = {eps:e}");
-    let fe_pts: Vec<(f64, f64)> = lengths
-        .iter()
-        .zip(&errors)
-        .map(|(l, e)| (*l, (e - fit.c).abs().max(1e-300).log10()))
-        .collect();
     let (lmin, lmax) = lengths
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), &l| (a.min(l), b.max(l)));
-    let curve: Vec<(f64, f64)> = (0..=60)
-        .map(|j| {
-            let l = lmin + (lmax - lmin) * j as f64 / 60.0;
-            (l, fit.end_effect(l).abs().max(1e-300).log10())
-        })
-        .collect();
+    // each fitted quantity: the FE points and the law, as log10 |FE/GPS − 1 − c|
+    let mut markers = vec![];
+    let mut series = vec![];
+    for (k, name) in quantities.iter().enumerate() {
+        let Some(f) = fits
+            .get(name)
+            .and_then(|e| serde_json::from_value::<stats::EndFit>(e["fit"].clone()).ok())
+        else {
+            continue;
+        };
+        let errs: Vec<f64> = f_errors(&fits[name]);
+        let log = |v: f64| v.abs().max(1e-300).log10();
+        markers.push(Markers {
+            label: format!("FE, {name}"),
+            points: lengths
+                .iter()
+                .zip(&errs)
+                .map(|(l, e)| (*l, log(e - f.c)))
+                .collect(),
+            color: COLORS[k % COLORS.len()],
+            hollow: false,
+        });
+        series.push(Series {
+            label: if k == 0 {
+                format!("{name}: {law_text}")
+            } else {
+                format!("{name}: fitted law")
+            },
+            points: (0..=60)
+                .map(|j| {
+                    let l = lmin + (lmax - lmin) * j as f64 / 60.0;
+                    (l, log(f.end_effect(l)))
+                })
+                .collect(),
+            color: COLORS[k % COLORS.len()],
+            stroke: Stroke::Solid,
+            width: 2,
+        });
+    }
     plot(
         &Figure {
-            markers: vec![Markers {
-                label: "FE".into(),
-                points: fe_pts,
-                color: COLORS[2],
-                hollow: false,
-            }],
+            markers,
             ..Figure::new(
-                format!("{}: end effect on {q}", c.spec.name),
+                format!("{}: end effect on {}", c.spec.name, quantities.join(", ")),
                 "tube length L/R",
                 "log10 |FE/GPS − 1 − c|",
-                vec![Series {
-                    label: format!("fitted law {law_text}"),
-                    points: curve,
-                    color: COLORS[0],
-                    stroke: Stroke::Solid,
-                    width: 2,
-                }],
+                series,
             )
         },
         r,
     );
     // the law's measures decide; when they pass the message is the fit
     Ok(None)
+}
+
+/// The errors of one quantity's entry in an end-effect check's `fits`.
+fn f_errors(entry: &serde_json::Value) -> Vec<f64> {
+    entry["errors"]
+        .as_array()
+        .map(|a| a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect())
+        .unwrap_or_default()
 }
 
 /// The core of one profile: (core length on the +z side, on the −z side (None for a model
@@ -1236,18 +1367,15 @@ fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let Some((fraction, s, why)) = worst else {
         return Err("the run has no per-step profiles ([output] profiles = \"stage-end\"?)".into());
     };
-    let tol = c
-        .spec
-        .min_core_fraction
-        .clone()
-        .ok_or("no min_core_fraction")?;
+    // without `min_core_fraction` the core is reported, not gated
+    let tol = c.spec.min_core_fraction.clone();
     r.measures.push(Measure {
         quantity: "core fraction".into(),
         measured: fraction,
-        tolerance: Some(tol.value),
-        source: Some(tol.source.clone()),
-        pass: fraction >= tol.value,
-        at_least: true,
+        tolerance: tol.as_ref().map(|t| t.value),
+        source: tol.as_ref().map(|t| t.source.clone()),
+        pass: tol.as_ref().is_none_or(|t| fraction >= t.value),
+        at_least: tol.is_some(),
         note: format!(
             "smallest over {} steps, at stage {} step {}: the middle {:.2} R of {:.2} R stay within ε = {eps:e} of mid-span (then {why} leaves it); boundary layer {:.2} R at each cap",
             per_step.len(),
@@ -1258,28 +1386,35 @@ fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
             (1.0 - fraction) * 0.5 * length / report.geometry.radius,
         ),
     });
+    if tol.is_none() {
+        r.message = format!(
+            "the middle {:.0} % of the tube is translation invariant (ε = {eps:e}), at its smallest (stage {} step {}); reported",
+            100.0 * fraction,
+            s.stage,
+            s.step
+        );
+    }
     r.details = serde_json::json!({ "epsilon": eps, "steps": per_step });
     plot(
         &Figure::new(
             format!("{}: translation-invariant core", c.spec.name),
             "step (all stages)",
             "core length / L",
-            vec![
-                Series {
-                    label: format!("core within ε = {eps:e}"),
-                    points: pts.clone(),
-                    color: COLORS[0],
-                    stroke: Stroke::Solid,
-                    width: 2,
-                },
-                Series {
-                    label: "required".into(),
-                    points: vec![(1.0, tol.value), (pts.len().max(1) as f64, tol.value)],
-                    color: COLORS[1],
-                    stroke: Stroke::Dashed,
-                    width: 2,
-                },
-            ],
+            std::iter::once(Series {
+                label: format!("core within ε = {eps:e}"),
+                points: pts.clone(),
+                color: COLORS[0],
+                stroke: Stroke::Solid,
+                width: 2,
+            })
+            .chain(tol.as_ref().map(|t| Series {
+                label: "required".into(),
+                points: vec![(1.0, t.value), (pts.len().max(1) as f64, t.value)],
+                color: COLORS[1],
+                stroke: Stroke::Dashed,
+                width: 2,
+            }))
+            .collect(),
         ),
         r,
     );

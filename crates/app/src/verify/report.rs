@@ -190,8 +190,8 @@ pub fn markdown(r: &Results) -> String {
                 "| {} | {} | {} | {} | {} | {} |",
                 esc_md(&q.quantity),
                 num(q.measured),
-                q.tolerance.map_or("reported".into(), num),
-                if q.pass { "yes" } else { "**no**" },
+                tolerance_cell(q),
+                pass_cell(q, "**no**"),
                 esc_md(&q.note),
                 esc_md(q.source.as_deref().unwrap_or(""))
             );
@@ -273,8 +273,8 @@ pub fn html(r: &Results) -> String {
                     "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                     esc_html(&q.quantity),
                     num(q.measured),
-                    q.tolerance.map_or("reported".into(), num),
-                    if q.pass { "yes" } else { "<b>no</b>" },
+                    tolerance_cell(q),
+                    pass_cell(q, "<b>no</b>"),
                     esc_html(&q.note),
                     esc_html(q.source.as_deref().unwrap_or(""))
                 );
@@ -312,4 +312,24 @@ pub fn write_all(out: &Path, r: &Results) -> crate::Result<Vec<PathBuf>> {
         written.push(p);
     }
     Ok(written)
+}
+
+/// The tolerance column: the value, "reported" for a quantity reported only, "—" for one that
+/// failed with nothing to hold it to (an order that could not be observed).
+fn tolerance_cell(q: &super::Measure) -> String {
+    match (q.tolerance, q.pass) {
+        (Some(t), _) => num(t),
+        (None, true) => "reported".into(),
+        (None, false) => "—".into(),
+    }
+}
+
+/// The pass column: "yes"/`no` against a tolerance, "—" for a reported quantity (it is not
+/// judged), `no` for one that failed without a tolerance.
+fn pass_cell(q: &super::Measure, no: &'static str) -> &'static str {
+    match (q.tolerance, q.pass) {
+        (None, true) => "—",
+        (_, true) => "yes",
+        (_, false) => no,
+    }
 }

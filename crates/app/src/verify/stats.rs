@@ -104,7 +104,7 @@ pub enum EndLaw {
 
 /// A fitted end-effect law. `c` is the part that does not depend on the length (the
 /// discretization's), `a` and `k` the law's amplitude and rate (k = 1 for the inverse law).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EndFit {
     pub law: EndLaw,
     pub c: f64,

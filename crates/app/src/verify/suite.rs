@@ -84,8 +84,14 @@ pub struct CheckSpec {
     /// the exponent of the first member's refinement relative to the case's mesh (e.g. −1:
     /// one step coarser than the case); default 0
     pub start: Option<i32>,
-    /// the quantities studied (default w, lambda_z; and force for a squeeze)
+    /// the quantities studied: convergence, default w, lambda_z, and force for a squeeze;
+    /// end-effect, each fitted from the same runs, the measures of the check on the first
+    /// (default [`quantity`](Self::quantity) alone)
     pub quantities: Option<Vec<String>>,
+    /// convergence: the quantities whose observed order is held to `expected_order` (default
+    /// all of `quantities`); the others report their order, or, where the family oscillates,
+    /// the half range of its values as their uncertainty (Stern et al. 2001)
+    pub order_quantities: Option<Vec<String>>,
     pub expected_order: Option<Expect>,
     /// compare the extrapolated value with the closed form (default true); the `--case`
     /// study leaves that to its closed-form check, which accounts for the end effect too
