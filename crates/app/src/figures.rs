@@ -865,7 +865,17 @@ pub fn write_all(
     // every file rendered first; the folder is checked and written only once all are
     let mut files: Vec<(PathBuf, Vec<u8>)> = vec![];
     let hyps = [(Hypothesis::Gps, GPS_COLOR), (Hypothesis::Ps, PS_COLOR)];
-    let starts = [(1.3, Stroke::Dashed), (6.0, Stroke::Dotted)];
+    // the paper's two starts (Figs. 6 and 7), then each overlaid squeeze's own λs* (Figs. 8, …):
+    // a run is drawn against the curves from where it starts, never against another start's
+    let mut starts = vec![(1.3, Stroke::Dashed), (6.0, Stroke::Dotted)];
+    for o in overlays {
+        for p in &o.squeeze {
+            let l = p.initial_stretch;
+            if l.is_finite() && !starts.iter().any(|(x, _)| same_start(l, *x)) {
+                starts.push((l, Stroke::Dashed));
+            }
+        }
+    }
 
     let mut inflation = vec![];
     for (h, _) in hyps {
@@ -878,13 +888,14 @@ pub fn write_all(
     }
     // flattening[start][hyp]
     let mut flattening: Vec<Vec<Vec<FlatteningState>>> = vec![];
-    for (ls0, _) in starts {
+    for &(ls0, _) in &starts {
         let mut per = vec![];
         for (h, _) in hyps {
             let c = flattening_curve(law, h, ls0, 0.5 * ls0, 201)
                 .map_err(|e| AppError::gps(format!("the flattening curve from λs* = {ls0}"), e))?;
             let p = dir.join(format!(
-                "flattening_ls{ls0:.1}_{}.csv",
+                "flattening_ls{}_{}.csv",
+                start_tag(ls0),
                 h.label().to_lowercase()
             ));
             let text = csv_text(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
@@ -913,7 +924,7 @@ pub fn write_all(
     for ((ls0, stroke), per) in starts.iter().zip(&flattening) {
         for ((h, color), c) in hyps.iter().zip(per) {
             series.push(Series {
-                label: format!("{} flattening from λs* = {ls0:.1}", h.label()),
+                label: format!("{} flattening from λs* = {}", h.label(), start_tag(*ls0)),
                 points: c.iter().map(|s| (s.lambda_s, s.w)).collect(),
                 color: *color,
                 stroke: *stroke,
@@ -1015,8 +1026,9 @@ pub fn write_all(
     )?);
 
     // Figs. 6 and 7
-    for (((ls0, _), per), num) in starts.iter().zip(&flattening).zip([6, 7]) {
-        let mut series: Vec<Series> = hyps
+    for (((ls0, _), per), num) in starts.iter().zip(&flattening).zip(6..) {
+        let tag = start_tag(*ls0);
+        let series: Vec<Series> = hyps
             .iter()
             .zip(per)
             .map(|((h, color), c)| Series {
@@ -1029,35 +1041,18 @@ pub fn write_all(
             .collect();
         let mut markers = vec![];
         let mut errors = vec![];
-        let mut notes = vec![];
+        let notes = vec![];
         for (run, color) in overlays.iter().zip(FE_COLORS.iter().cycle()) {
-            // squeeze steps that start from (about) this λs*
+            // the squeeze steps that start from this λs*
             let pts: Vec<&SqueezePoint> = run
                 .squeeze
                 .iter()
-                .filter(|s| (s.initial_stretch - ls0).abs() < 0.05 * ls0)
+                .filter(|s| same_start(s.initial_stretch, *ls0))
                 .collect();
-            let Some(first) = pts.first() else { continue };
-            let run_ls0 = first.initial_stretch;
-            let mut label = format!("FE: {}", run.label);
-            if (run_ls0 / ls0 - 1.0).abs() > 1e-3 {
-                // the curves start at the paper's λs*; this run's starts elsewhere: say so and
-                // draw the GPS curve from the run's own λs* (the error panel's reference)
-                label = format!("{label} (λs* = {run_ls0:.4})");
-                notes.push(format!(
-                    "{}: the run's λs* = {run_ls0:.4} differs from the curves' {ls0:.1}; thin dashed line: GPS from {run_ls0:.4}",
-                    run.label
-                ));
-                if let Ok(c) = flattening_curve(law, Hypothesis::Gps, run_ls0, 0.5 * run_ls0, 201) {
-                    series.push(Series {
-                        label: format!("GPS from the run's λs* = {run_ls0:.4}"),
-                        points: c.iter().map(|s| (s.displacement, s.force)).collect(),
-                        color: *color,
-                        stroke: Stroke::Dashed,
-                        width: 1,
-                    });
-                }
+            if pts.is_empty() {
+                continue;
             }
+            let label = format!("FE: {}", run.label);
             markers.push(Markers {
                 label: label.clone(),
                 points: pts.iter().map(|s| (s.displacement, s.force)).collect(),
@@ -1088,13 +1083,13 @@ pub fn write_all(
                 panel,
                 notes,
                 ..Figure::new(
-                    format!("Fig. {num} — flattening from λs* = {ls0:.1} ({name})"),
+                    format!("Fig. {num} — flattening from λs* = {tag} ({name})"),
                     "reduced displacement λs* − ρ",
                     "reduced force ϖχ = pc/(πμH)",
                     series,
                 )
             },
-            &dir.join(format!("fig{num}_force_displacement_ls{ls0:.1}")),
+            &dir.join(format!("fig{num}_force_displacement_ls{tag}")),
             opts,
         )?);
     }
@@ -1112,7 +1107,7 @@ pub fn write_all(
     }];
     for ((ls0, stroke), per) in starts.iter().zip(&flattening) {
         series.push(Series {
-            label: format!("GPS flattening from λs* = {ls0:.1}"),
+            label: format!("GPS flattening from λs* = {}", start_tag(*ls0)),
             points: per[0].iter().map(|s| (s.lambda_s, s.lambda_z)).collect(),
             color: RGBColor(20, 150, 90),
             stroke: *stroke,
@@ -1138,6 +1133,25 @@ pub fn write_all(
     )?);
     crate::output_file::create_folder(dir)?;
     crate::output_file::write_owned(dir, FIGURES_MANIFEST, "tubemem figures", &files)
+}
+
+/// Two squeezes start from the same λs* (one figure, one pair of curves) within this relative
+/// difference: a stretch-controlled inflation ends at its target to Newton's tolerance.
+const SAME_START: f64 = 1e-6;
+
+fn same_start(a: f64, b: f64) -> bool {
+    (a / b - 1.0).abs() <= SAME_START
+}
+
+/// A start λs* as the figures' file names and titles write it: one decimal where that is exact
+/// (the paper's 1.3 and 6.0), else up to four, trailing zeros dropped (1.25, 1.4142).
+fn start_tag(l: f64) -> String {
+    if ((l * 10.0).round() - l * 10.0).abs() <= 1e-9 * l.abs().max(1.0) {
+        format!("{l:.1}")
+    } else {
+        let t = format!("{l:.4}");
+        t.trim_end_matches('0').to_string()
+    }
 }
 
 /// The list of the files `tubemem figures` wrote into its folder, so that a later call replaces

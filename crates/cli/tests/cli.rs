@@ -745,7 +745,8 @@ fn squeeze_stage_writes_contact_outputs() {
 /// λs* differs from the curve's is said to, and a run of another law is refused.
 #[test]
 fn figures_overlay_a_run_folder() {
-    // λs* = 1.25 is drawn on Fig. 6 (within 5 % of its 1.3) with the note that it differs
+    // λs* = 1.25 gets curves and a figure of its own (Fig. 8, after the paper's 1.3 and 6.0):
+    // issue #24 item 6, a run had been drawn against the nearest paper start, or left out
     let text = format!(
         "{}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.05\nsteps = 4\n",
         SMALL_CASE.replace("target_stretch = 1.2", "target_stretch = 1.25")
@@ -771,14 +772,23 @@ fn figures_overlay_a_run_folder() {
         "150",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let png = std::fs::read(figs.join("fig6_force_displacement_ls1.3.png")).unwrap();
+    let png = std::fs::read(figs.join("fig8_force_displacement_ls1.25.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"));
     // the PNG's width (IHDR) follows the DPI: 11 in × 150
     assert_eq!(u32::from_be_bytes(png[16..20].try_into().unwrap()), 1650);
-    let svg = std::fs::read_to_string(figs.join("fig6_force_displacement_ls1.3.svg")).unwrap();
+    let svg = std::fs::read_to_string(figs.join("fig8_force_displacement_ls1.25.svg")).unwrap();
     assert!(svg.contains("FE − GPS"), "the error panel");
-    assert!(svg.contains("differs from the curves"), "the λs* note");
+    assert!(svg.contains("flattening from λs* = 1.25"), "its title");
     assert!(svg.contains("ABB, Kuhn N = 30"));
+    assert!(figs.join("flattening_ls1.25_gps.csv").exists());
+    // the paper's figures are drawn still, without the run's points
+    let fig6 = std::fs::read_to_string(figs.join("fig6_force_displacement_ls1.3.svg")).unwrap();
+    assert!(!fig6.contains("FE: run") && !fig6.contains("FE − GPS"));
+    let fig5 = std::fs::read_to_string(figs.join("fig5_pressure_stretch.svg")).unwrap();
+    assert!(
+        fig5.contains("GPS flattening from λs* = 1.25"),
+        "Fig. 5 has its curve"
+    );
     // the points CSV: FE − GPS equals steps.csv's force − gps_force, row by row
     let steps = Steps::read(&run.join("steps.csv"));
     let pts = Steps::read(&figs.join("fe_points_1_run.csv"));
