@@ -38,7 +38,8 @@ def test_run_folder_reads_back(tmp_path, tubemem_exe):
 
 def test_a_mirrored_run_is_the_whole_tube(tmp_path, tubemem_exe):
     """`[output] mirror = true`: the eighth model written as the whole tube — eight copies of
-    the cells, a point cloud symmetric about the three planes, and every cell's normal pointing
+    the cells on points shared across the symmetry planes, a point cloud symmetric about the
+    three planes, and every cell's normal pointing
     out (the enclosed volume of the mirrored surface, computed here by meshio's points and cells
     with the divergence theorem, is eight times the model's)."""
     case = tmp_path / "case.toml"
@@ -62,3 +63,9 @@ def test_a_mirrored_run_is_the_whole_tube(tmp_path, tubemem_exe):
     volume = (tri(a, b, c) + tri(a, c, d)).sum()
     assert np.isclose(volume, summary["stages"][0]["final"]["volume"], rtol=2e-3)
     assert len(mesh.point_data["displacement"]) == len(p)
+    # one point per place (issue #24 item 13: the nodes on the symmetry planes were written once
+    # per copy, so the whole tube was eight unconnected pieces)
+    assert len(np.unique(np.round(p / 1e-9), axis=0)) == len(p)
+    used = np.zeros(len(p), dtype=bool)
+    used[quads.ravel()] = True
+    assert used.all()

@@ -819,6 +819,32 @@ impl Case {
         Ok(case)
     }
 
+    /// The case in one line: the tube, its law, its mesh and its stages.
+    pub fn describe(&self) -> String {
+        let g = &self.geometry;
+        let law = self
+            .material
+            .build()
+            .map(|l| l.name())
+            .unwrap_or_else(|_| "?".into());
+        let mesh = match (&self.mesh.file, self.mesh.around, self.mesh.along) {
+            (Some(f), ..) => format!("mesh file {}", f),
+            (None, Some(a), Some(b)) => format!(
+                "{} {a} × {b}, {}",
+                self.mesh.element.name(),
+                format!("{:?}", self.mesh.symmetry).to_lowercase()
+            ),
+            _ => "no mesh".into(),
+        };
+        let stages: Vec<String> = self.plan.iter().map(|p| p.describe()).collect();
+        format!(
+            "L/R = {}, {} caps; {law}; {mesh}; {}",
+            tubemem_material::Num(g.length / g.radius),
+            format!("{:?}", g.caps).to_lowercase(),
+            stages.join(" → ")
+        )
+    }
+
     /// The hash of the case text the case was parsed from.
     pub fn hash(&self) -> &str {
         &self.hash

@@ -26,7 +26,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::post::{cell_contact_pressure, cell_values, regime_code, RingValues};
-use tubemem_mesh::vtu::{write_pvd, write_vtu, Field};
+use tubemem_mesh::vtu::{write_pvd, write_vtu, Field, FieldValue};
 
 /// The columns of steps.csv. New columns are only ever appended.
 pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
@@ -732,6 +732,7 @@ impl RunWriter {
     fn frame(
         &mut self,
         time: f64,
+        tag: (usize, usize, usize),
         model: &Model,
         state: &State,
         contact: Option<&tubemem_fem::contact::Contact>,
@@ -775,7 +776,7 @@ impl RunWriter {
         } else {
             &[]
         };
-        let m = Mirror::new(axes, model.mesh().nodes.len());
+        let m = Mirror::new(axes, &model.mesh().nodes);
         let (points, quads) = m.geometry(&state.x, &model.mesh().cells());
         let disp = m.vector_field(&disp);
         let cellf: Vec<Vec<f64>> = [&hoop, &axial, &n1, &n2, &wrinkled, &pc]
@@ -804,6 +805,17 @@ impl RunWriter {
                 cell("N2", &cellf[3]),
                 cell("wrinkled", &cellf[4]),
                 cell("contact_pressure", &cellf[5]),
+            ],
+            &[
+                (
+                    "tubemem_version",
+                    FieldValue::Text(env!("CARGO_PKG_VERSION")),
+                ),
+                ("case_hash", FieldValue::Text(&self.case_hash)),
+                // the steps.csv row, stage and step of the frame (0, 0, 0: the reference state)
+                ("steps_csv_row", FieldValue::Numbers(&[tag.0 as f64])),
+                ("stage", FieldValue::Numbers(&[tag.1 as f64])),
+                ("step", FieldValue::Numbers(&[tag.2 as f64])),
             ],
             match self.vtu.vtu_format {
                 crate::case::VtuFormat::Binary => tubemem_mesh::vtu::Encoding::Binary,
@@ -882,11 +894,17 @@ fn atomic_write(path: &Path, text: &str) -> Result<()> {
 struct Mirror {
     /// per copy: the sign of each coordinate
     signs: Vec<[f64; 3]>,
-    nodes: usize,
+    /// the points written, as (copy, node): a node on a symmetry plane only in the first copy
+    /// that reaches it (its mirror image is itself)
+    points: Vec<(usize, usize)>,
+    /// per copy, per node: its point
+    index: Vec<Vec<usize>>,
 }
 
 impl Mirror {
-    fn new(axes: &[usize], nodes: usize) -> Self {
+    /// The copies of a model with the nodes `reference` reflected across the planes x_ax = 0
+    /// of `axes`; a node on a plane (|x_ax| ≤ 1e-12 of the model's size) is one point.
+    fn new(axes: &[usize], reference: &[[f64; 3]]) -> Self {
         let mut signs = vec![[1.0; 3]];
         for &ax in axes {
             let reflected: Vec<[f64; 3]> = signs
@@ -899,16 +917,51 @@ impl Mirror {
                 .collect();
             signs.extend(reflected);
         }
-        Self { signs, nodes }
+        let size = reference
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300);
+        let mut points = vec![];
+        let mut index = vec![vec![0; reference.len()]; signs.len()];
+        for (k, s) in signs.iter().enumerate() {
+            for (i, x) in reference.iter().enumerate() {
+                // the copy whose image of this node is the same point: the signs with every
+                // plane the node lies on unflipped
+                let mut canonical = *s;
+                for &ax in axes {
+                    if x[ax].abs() <= 1e-12 * size {
+                        canonical[ax] = 1.0;
+                    }
+                }
+                let first = signs.iter().position(|t| *t == canonical).unwrap_or(k);
+                index[k][i] = if first < k {
+                    index[first][i]
+                } else {
+                    points.push((k, i));
+                    points.len() - 1
+                };
+            }
+        }
+        Self {
+            signs,
+            points,
+            index,
+        }
     }
 
     fn geometry(&self, x: &[[f64; 3]], quads: &[Vec<usize>]) -> (Vec<[f64; 3]>, Vec<Vec<usize>>) {
-        let mut points = Vec::with_capacity(x.len() * self.signs.len());
+        let points = self
+            .points
+            .iter()
+            .map(|&(k, i)| {
+                let (s, p) = (self.signs[k], x[i]);
+                [s[0] * p[0], s[1] * p[1], s[2] * p[2]]
+            })
+            .collect();
         let mut cells = Vec::with_capacity(quads.len() * self.signs.len());
         for (k, s) in self.signs.iter().enumerate() {
-            points.extend(x.iter().map(|p| [s[0] * p[0], s[1] * p[1], s[2] * p[2]]));
             let flip = s.iter().filter(|v| **v < 0.0).count() % 2 == 1;
-            let o = k * self.nodes;
             // a reflected 9-node cell keeps its mid-side nodes on the matching edges
             const FLIP4: [usize; 4] = [0, 3, 2, 1];
             const FLIP9: [usize; 9] = [0, 3, 2, 1, 7, 6, 5, 4, 8];
@@ -918,18 +971,21 @@ impl Mirror {
                     (true, 4) => &FLIP4,
                     (true, _) => &FLIP9,
                 };
-                order.iter().map(|&a| q[a] + o).collect::<Vec<usize>>()
+                order
+                    .iter()
+                    .map(|&a| self.index[k][q[a]])
+                    .collect::<Vec<usize>>()
             }));
         }
         (points, cells)
     }
 
     fn vector_field(&self, v: &[f64]) -> Vec<f64> {
-        self.signs
+        self.points
             .iter()
-            .flat_map(|s| {
-                v.chunks(3)
-                    .flat_map(move |c| [s[0] * c[0], s[1] * c[1], s[2] * c[2]])
+            .flat_map(|&(k, i)| {
+                let s = self.signs[k];
+                [s[0] * v[3 * i], s[1] * v[3 * i + 1], s[2] * v[3 * i + 2]]
             })
             .collect()
     }
@@ -1028,7 +1084,7 @@ impl Observer for RunWriter {
             &self.dir.join("profiles").join("profiles.csv"),
             &format!("{PROFILES_HEADER}\n"),
         )?;
-        self.all_or_none(|w| w.frame(0.0, model, state, None))
+        self.all_or_none(|w| w.frame(0.0, (0, 0, 0), model, state, None))
     }
 
     /// A converged step's files, all or none: a write that fails (a full disk) undoes the
@@ -1227,7 +1283,14 @@ impl RunWriter {
         };
         if wanted {
             let time = (view.plan.index - 1) as f64 + view.fraction;
-            self.frame(time, view.model, view.state, view.load.contact.as_ref())?;
+            let tag = (self.rows, view.record.stage, view.record.step);
+            self.frame(
+                time,
+                tag,
+                view.model,
+                view.state,
+                view.load.contact.as_ref(),
+            )?;
         }
         // the checkpoint of this step, alternating between two files (the last two are kept)
         if self.checkpoint_every == 0 || !self.rows.is_multiple_of(self.checkpoint_every) {
@@ -1299,6 +1362,13 @@ impl RunWriter {
                     },
                 ],
                 &[],
+                &[
+                    (
+                        "tubemem_version",
+                        FieldValue::Text(env!("CARGO_PKG_VERSION")),
+                    ),
+                    ("case_hash", FieldValue::Text(&self.case_hash)),
+                ],
                 tubemem_mesh::vtu::Encoding::Binary,
             )?;
         }

@@ -456,6 +456,9 @@ pub struct RunReport {
     pub material_spec: MaterialSpec,
     pub geometry: GeometryInfo,
     pub units: String,
+    /// the hash of the case text ([`crate::output::case_hash`]), as in run.json
+    #[serde(default)]
+    pub case_hash: String,
     pub stages: Vec<StageReport>,
     /// what the run noticed that a user should know (a target outside the closed form's
     /// validity, …), in order
@@ -468,6 +471,9 @@ pub struct RunReport {
 pub struct Summary<'a> {
     #[serde(skip_serializing_if = "<[String]>::is_empty")]
     pub warnings: &'a [String],
+    /// the tubemem version that ran the case, and the case text's hash (as run.json)
+    pub tubemem_version: &'static str,
+    pub case_hash: &'a str,
     pub case: &'a str,
     pub mesh: &'a MeshInfo,
     pub material: &'a str,
@@ -483,6 +489,8 @@ impl RunReport {
     /// The summary.json view.
     pub fn summary(&self) -> Summary<'_> {
         Summary {
+            tubemem_version: env!("CARGO_PKG_VERSION"),
+            case_hash: &self.case_hash,
             case: &self.case,
             mesh: &self.mesh,
             material: &self.material,

@@ -946,6 +946,7 @@ pub fn run_with(
             caps: String::new(),
         },
         units: UNITS.into(),
+        case_hash: case.hash().to_string(),
         stages: vec![],
         warnings: vec![],
     });
@@ -1036,6 +1037,7 @@ fn run_inner(
             caps: format!("{:?}", g.caps).to_lowercase(),
         },
         units: UNITS.into(),
+        case_hash: case.hash().to_string(),
         stages: vec![],
         warnings: vec![],
     });

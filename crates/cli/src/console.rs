@@ -200,7 +200,14 @@ impl Observer for Console {
             )?;
         }
         if let Some(d) = s.cap_boundary_layer {
-            say!("         λs is within 0.1 % of its mid-span value from {d:.3} R inside the cap junction (or plug)")?;
+            let end = if report.geometry.caps == "hemisphere" {
+                "cap junction"
+            } else {
+                "plug"
+            };
+            say!(
+                "         λs is within 0.1 % of its mid-span value from {d:.3} R inside the {end}"
+            )?;
         }
         Ok(())
     }

@@ -2253,3 +2253,36 @@ fn an_invalid_plan_is_refused_before_the_folder_is_created() {
         assert!(!out.exists(), "{name}: the folder was created");
     }
 }
+
+/// Issue #24 item 13: the console named the cap junction "(or plug)" whatever the caps; it
+/// names the tube's own end.
+#[test]
+fn the_console_names_the_tubes_own_end() {
+    for (file, end, other) in [
+        ("small_abb30_ls1.2.toml", "inside the cap junction", "plug"),
+        (
+            "inflate_abb30_ls1.3_plugs.toml",
+            "inside the plug",
+            "cap junction",
+        ),
+    ] {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases");
+        let out = tmp(&format!("end-{file}"));
+        let r = tubemem(&[
+            "run",
+            root.join(file).to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let text = String::from_utf8_lossy(&r.stdout);
+        let line = text
+            .lines()
+            .find(|l| l.contains("of its mid-span value from"))
+            .unwrap_or_else(|| panic!("{file}: {text}"));
+        assert!(
+            line.contains(end) && !line.contains(other),
+            "{file}: {line}"
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}

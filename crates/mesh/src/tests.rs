@@ -185,11 +185,18 @@ fn vtu_writer_works_and_rejects_non_finite_fields() {
             components: 1,
             values: &flag,
         }],
+        &[
+            ("case_hash", vtu::FieldValue::Text("abc")),
+            ("step", vtu::FieldValue::Numbers(&[3.0])),
+        ],
         vtu::Encoding::Ascii,
     )
     .unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains(&format!("NumberOfPoints=\"{}\"", mesh.nodes.len())));
+    // the field data: text as its bytes, numbers as Float64
+    assert!(text.contains("<DataArray type=\"UInt8\" Name=\"case_hash\" NumberOfTuples=\"3\" format=\"ascii\">97 98 99</DataArray>"));
+    assert!(text.contains("Name=\"step\" NumberOfTuples=\"1\" format=\"ascii\">3e0</DataArray>"));
     assert!(text.contains("Name=\"displacement\" NumberOfComponents=\"3\""));
     assert_eq!(
         text.lines().filter(|l| *l == "          9").count(),
@@ -207,6 +214,7 @@ fn vtu_writer_works_and_rejects_non_finite_fields() {
             components: 3,
             values: &bad,
         }],
+        &[],
         &[],
         vtu::Encoding::Binary,
     );

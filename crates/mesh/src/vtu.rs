@@ -18,6 +18,14 @@ pub struct Field<'a> {
     pub values: &'a [f64],
 }
 
+/// A value of the file's field data (VTK `FieldData`, one per file, not per point or cell):
+/// numbers as Float64, text as the UInt8 array of its UTF-8 bytes (meshio reads both into
+/// `field_data`; `bytes(m.field_data[name]).decode()` gives the text back).
+pub enum FieldValue<'a> {
+    Numbers(&'a [f64]),
+    Text(&'a str),
+}
+
 fn io_err(path: &Path, e: impl std::fmt::Display) -> MeshError {
     MeshError::Io {
         path: path.display().to_string(),
@@ -118,16 +126,48 @@ fn data_array(out: &mut String, f: &Field, count: usize, encoding: Encoding) -> 
 
 /// Write a quadrilateral surface with point and cell fields: 4-node cells as VTK_QUAD (9),
 /// 9-node cells (corners, mid-sides, centre) as VTK_BIQUADRATIC_QUAD (28).
+/// `field_data`: (name, value) pairs of the file as a whole (a run's version, case hash, step).
+#[allow(clippy::too_many_arguments)]
 pub fn write_vtu<C: AsRef<[usize]>>(
     path: &Path,
     points: &[[f64; 3]],
     quads: &[C],
     point_data: &[Field],
     cell_data: &[Field],
+    field_data: &[(&str, FieldValue)],
     encoding: Encoding,
 ) -> Result<(), MeshError> {
     let mut s = String::with_capacity(64 * (points.len() + quads.len()));
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n");
+    if !field_data.is_empty() {
+        s.push_str("    <FieldData>\n");
+        for (name, value) in field_data {
+            match value {
+                FieldValue::Numbers(v) => {
+                    if v.iter().any(|x| !x.is_finite()) {
+                        return Err(io_err(path, format!("field data `{name}` is not finite")));
+                    }
+                    let text: Vec<String> = v.iter().map(|x| format!("{x:e}")).collect();
+                    let _ = writeln!(
+                        s,
+                        "      <DataArray type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"{}\" format=\"ascii\">{}</DataArray>",
+                        v.len(),
+                        text.join(" ")
+                    );
+                }
+                FieldValue::Text(t) => {
+                    let bytes: Vec<String> = t.bytes().map(|b| b.to_string()).collect();
+                    let _ = writeln!(
+                        s,
+                        "      <DataArray type=\"UInt8\" Name=\"{name}\" NumberOfTuples=\"{}\" format=\"ascii\">{}</DataArray>",
+                        bytes.len(),
+                        bytes.join(" ")
+                    );
+                }
+            }
+        }
+        s.push_str("    </FieldData>\n");
+    }
     let _ = writeln!(
         s,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",

@@ -667,6 +667,43 @@ fn critical_columns(report: &tubemem_app::report::RunReport) -> Vec<(String, Vec
     header_columns(tubemem_app::output::CRITICAL_HEADER, &rows)
 }
 
+/// The columns that count (stages, steps, rows, iterations, …): integers in a DataFrame.
+const INTEGER_COLUMNS: [&str; 9] = [
+    "case",
+    "row",
+    "stage",
+    "step",
+    "front",
+    "kind",
+    "newton_iterations",
+    "negative_pivots",
+    "critical",
+];
+
+/// Make the [`INTEGER_COLUMNS`] of DataFrame `df` integers: int64 where every value is a whole
+/// number, pandas' nullable Int64 where some are missing (a failed sweep member's row).
+fn integer_columns(df: &Bound<'_, PyAny>) -> PyResult<()> {
+    let columns: Vec<String> = df.getattr("columns")?.call_method0("tolist")?.extract()?;
+    for c in INTEGER_COLUMNS {
+        if !columns.iter().any(|x| x == c) {
+            continue;
+        }
+        let col = df.get_item(c)?;
+        let missing: bool = col.call_method0("isna")?.call_method0("any")?.extract()?;
+        let present = col.call_method0("dropna")?;
+        let whole: bool = present
+            .call_method0("round")?
+            .call_method1("eq", (&present,))?
+            .call_method0("all")?
+            .extract()?;
+        if whole {
+            let to = if missing { "Int64" } else { "int64" };
+            df.set_item(c, col.call_method1("astype", (to,))?)?;
+        }
+    }
+    Ok(())
+}
+
 /// The bulge fronts of a run's steps: the columns of fronts.csv.
 fn front_columns(report: &tubemem_app::report::RunReport) -> Vec<(String, Vec<f64>)> {
     let rows: Vec<Vec<f64>> = report
@@ -741,13 +778,16 @@ impl Table {
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
         self.data.bind(py).copy()
     }
-    /// A pandas DataFrame (pandas is imported on demand; n-d columns are flattened).
+    /// A pandas DataFrame (pandas is imported on demand; n-d columns are flattened; the
+    /// counting columns, `stage`, `step`, `row`, …, are integers).
     fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let flat = pyo3::types::PyDict::new(py);
         for c in &self.columns {
             flat.set_item(c, self.__getitem__(py, c)?.call_method0("ravel")?)?;
         }
-        py.import("pandas")?.call_method1("DataFrame", (flat,))
+        let df = py.import("pandas")?.call_method1("DataFrame", (flat,))?;
+        integer_columns(&df)?;
+        Ok(df)
     }
     fn __repr__(&self) -> String {
         format!(
@@ -902,8 +942,14 @@ impl PyCase {
         py.import("tomllib")?
             .call_method1("loads", (self.toml.as_str(),))
     }
+    /// The tube, its law, its mesh and its stages in one line, e.g. `<tubemem.Case: L/R = 15,
+    /// hemisphere caps; mooney-rivlin (μ = 1, α = 0.08); quad4 32 × 120, eighth; inflate
+    /// (volume) to λs* = 1.4 → squeeze to ρ = 0.9>`.
     fn __repr__(&self) -> String {
-        format!("<tubemem.Case: {} bytes of TOML>", self.toml.len())
+        match tubemem_app::case::Case::parse(&self.toml) {
+            Ok(c) => format!("<tubemem.Case: {}>", c.describe()),
+            Err(_) => format!("<tubemem.Case: {} bytes of TOML>", self.toml.len()),
+        }
     }
     fn __eq__(&self, other: &Self) -> bool {
         self.toml == other.toml
@@ -1322,7 +1368,9 @@ fn sweep<'py>(
             rows.append(row)?;
         }
     }
-    py.import("pandas")?.call_method1("DataFrame", (rows,))
+    let df = py.import("pandas")?.call_method1("DataFrame", (rows,))?;
+    integer_columns(&df)?;
+    Ok(df)
 }
 
 /// Run verification suites (TOML files, as `tubemem verify`) or, with `case=`, the study of one

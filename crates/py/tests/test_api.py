@@ -599,3 +599,39 @@ def test_case_validates_the_whole_plan_on_construction(tmp_path):
     with pytest.raises(ValueError, match=r"`target_rho` = 1.5: the plates must close on the tube"):
         tubemem.Case(**dict(tables, stage=stages))
     assert not any(tmp_path.iterdir())
+
+
+def test_minor_defects_of_issue_24_item_13(tmp_path):
+    """Issue #24 item 13: `to_pandas()` gives stage and step as integers (they were float64); a
+    Case prints what it is (it printed "312 bytes of TOML"); with `vtu = "stage-end"` each VTU
+    says which steps.csv row, stage and step it is (the frame numbers do not match the rows),
+    and the VTUs and summary.json carry the version and the case hash (only run.json had them)."""
+    import json
+
+    import meshio
+
+    text = SMALL_CASE + '\n[output]\nvtu = "stage-end"\n'
+    case = tubemem.Case.from_toml(text)
+    shown = repr(case)
+    assert shown.startswith("<tubemem.Case: L/R = 8, hemisphere caps;") and "squeeze" in shown, shown
+    r = tubemem.run(case, str(tmp_path / "run"))
+    df = r.to_pandas()
+    assert str(df["stage"].dtype) == "int64" and str(df["step"].dtype) == "int64"
+    run_json = json.loads((tmp_path / "run" / "run.json").read_text())
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["case_hash"] == run_json["case_hash"] and summary["tubemem_version"] == run_json["tubemem"]
+    steps = list(csv.DictReader(open(tmp_path / "run" / "steps.csv")))
+    # frames: the reference state and the end of each of the two stages
+    for k in range(3):
+        m = meshio.read(r.vtu(k))
+        fd = m.field_data
+        row = int(fd["steps_csv_row"][0])
+        assert bytes(fd["case_hash"]).decode() == run_json["case_hash"]
+        assert bytes(fd["tubemem_version"]).decode() == run_json["tubemem"]
+        if k == 0:
+            assert row == 0 and int(fd["stage"][0]) == 0
+            continue
+        # the frame of stage k's end is the last steps.csv row of stage k
+        last = max(i for i, s in enumerate(steps, start=1) if int(s["stage"]) == k)
+        assert row == last, (k, row, last)
+        assert int(fd["stage"][0]) == k and int(fd["step"][0]) == int(steps[last - 1]["step"])

@@ -1458,8 +1458,8 @@ fn json_diff(
         }
         (Value::Object(x), Value::Object(y)) => {
             for (k, v) in y {
-                if k == "case" {
-                    continue; // a label of where the run was started
+                if k == "case" || k == "tubemem_version" {
+                    continue; // a label of where the run was started; the build that ran it
                 }
                 let p = format!("{path}.{k}");
                 match x.get(k) {
