@@ -812,6 +812,36 @@ impl Case {
 
     /// Parse and validate case text (TOML).
     pub fn parse(text: &str) -> Result<Self, CaseError> {
+        // every missing parameter of the law at once (serde names only the first)
+        if let Some(m) = toml::from_str::<toml::Table>(text)
+            .ok()
+            .and_then(|t| t.get("material")?.as_table().cloned())
+        {
+            let model = m.get("model").and_then(|v| v.as_str()).unwrap_or("");
+            let known =
+                |keys: &[&str]| m.keys().all(|k| k == "model" || keys.contains(&k.as_str()));
+            // (an unknown key, often a misspelt one, is serde's to name)
+            if let Some((_, keys)) = MaterialSpec::MODELS
+                .iter()
+                .find(|(n, keys)| *n == model && known(keys))
+            {
+                let missing: Vec<String> = keys
+                    .iter()
+                    .filter(|k| !m.contains_key(**k))
+                    .map(|k| format!("`{k}`"))
+                    .collect();
+                if !missing.is_empty() {
+                    invalid!(
+                        "[material] `model` = \"{model}\" needs {}: missing {}",
+                        keys.iter()
+                            .map(|k| format!("`{k}`"))
+                            .collect::<Vec<_>>()
+                            .join(" and "),
+                        missing.join(" and ")
+                    );
+                }
+            }
+        }
         let mut case: Case = toml::from_str(text)
             .map_err(|e| CaseError::Syntax(tubemem_material::tidy_numbers(&e.to_string())))?;
         case.plan = case.validate()?;

@@ -423,6 +423,13 @@ pub enum Wrinkling {
 }
 
 impl MaterialSpec {
+    /// Each `model` a case file names, with the parameters it requires.
+    pub const MODELS: [(&'static str, &'static [&'static str]); 3] = [
+        ("abb", &["shear_modulus", "kuhn"]),
+        ("mooney-rivlin", &["shear_modulus", "alpha"]),
+        ("neo-hookean", &["shear_modulus"]),
+    ];
+
     /// The law with the chosen wrinkling model.
     pub fn build_with(&self, wrinkling: Wrinkling) -> Result<Box<dyn MembraneLaw>, MaterialError> {
         Ok(match (wrinkling, *self) {

@@ -482,7 +482,7 @@ fn run_parsed<'py>(
     let inputs = tubemem_app::output_file::case_inputs(std::path::Path::new(label), case);
     let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
     let mut writer = RunWriter::create(out, mode, case.hash(), &inputs)
-        .map_err(|e| PyValueError::new_err(e.chain()))?
+        .map_err(|e| PyValueError::new_err(pythonic(&e.chain())))?
         .checkpoint_every(case.solver.checkpoint_every)
         .frames_of(case.output);
     let flag = Arc::new(AtomicBool::new(false));
@@ -894,13 +894,24 @@ impl PyCase {
         Ok(Self { toml, base_dir })
     }
 
+    /// A case from a dict of its tables: its errors name dict paths (`material.kuhm`,
+    /// `stage[1].target_rho`), not the lines of the TOML it is turned into.
     fn from_value(d: &Bound<'_, PyAny>, base_dir: PathBuf) -> PyResult<Self> {
         let value: serde_json::Value = from_py(d, "case")?;
         let table = toml::Value::try_from(value)
             .map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
         let text =
             toml::to_string(&table).map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
-        Self::parse(text, base_dir)
+        match tubemem_app::case::Case::parse(&text) {
+            Ok(_) => Ok(Self {
+                toml: text,
+                base_dir,
+            }),
+            Err(e) => Err(PyValueError::new_err(dict_message(
+                &tubemem_app::error_chain(&e),
+                &text,
+            ))),
+        }
     }
 }
 
@@ -942,9 +953,7 @@ impl PyCase {
         py.import("tomllib")?
             .call_method1("loads", (self.toml.as_str(),))
     }
-    /// The tube, its law, its mesh and its stages in one line, e.g. `<tubemem.Case: L/R = 15,
-    /// hemisphere caps; mooney-rivlin (μ = 1, α = 0.08); quad4 32 × 120, eighth; inflate
-    /// (volume) to λs* = 1.4 → squeeze to ρ = 0.9>`.
+    /// The tube, its law, its mesh and its stages in one line ([`tubemem_app::case::Case::describe`]).
     fn __repr__(&self) -> String {
         match tubemem_app::case::Case::parse(&self.toml) {
             Ok(c) => format!("<tubemem.Case: {}>", c.describe()),
@@ -954,6 +963,111 @@ impl PyCase {
     fn __eq__(&self, other: &Self) -> bool {
         self.toml == other.toml
     }
+}
+
+/// The dict path of line `line` (1-based) of the TOML text a case dict was turned into: its
+/// table (`stage[k]` for the k-th `[[stage]]`, 0-based as the list) and its key.
+fn dict_path(text: &str, line: usize) -> String {
+    let mut table = String::new();
+    let mut stages = 0usize;
+    for (k, l) in text.lines().enumerate() {
+        let t = l.trim();
+        if let Some(name) = t.strip_prefix("[[").and_then(|r| r.strip_suffix("]]")) {
+            let count = if name == "stage" {
+                stages += 1;
+                stages
+            } else {
+                1
+            };
+            table = format!("{name}[{}]", count - 1);
+        } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+            table = name.to_string();
+        }
+        if k + 1 == line {
+            let key = t.split('=').next().unwrap_or("").trim();
+            return match (table.is_empty(), key.is_empty() || t.starts_with('[')) {
+                (true, _) => key.to_string(),
+                (false, true) => table,
+                (false, false) => format!("{table}.{key}"),
+            };
+        }
+    }
+    table
+}
+
+/// A case error as a Python user reads it: a TOML parse error of the generated text becomes
+/// the dict path it points at and its reason; the case file's `[[stage]] N: \`key\`` and
+/// `[table] \`key\`` become `stage[N-1].key` and `table.key`.
+fn dict_message(msg: &str, text: &str) -> String {
+    if let Some(rest) = msg.split("TOML parse error at line ").nth(1) {
+        let line: usize = rest
+            .split(|c: char| !c.is_ascii_digit())
+            .next()
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(0);
+        let reason = rest.lines().last().unwrap_or("").trim();
+        let mut path = dict_path(text, line);
+        // an unknown key reported at its table: the key itself
+        if let Some(key) = reason
+            .strip_prefix("unknown field `")
+            .and_then(|r| r.split('`').next())
+        {
+            if !path.ends_with(&format!(".{key}")) {
+                path = format!("{path}.{key}");
+            }
+        }
+        return format!("case dict: {path}: {reason}");
+    }
+    format!("case dict: {}", pythonic(msg))
+}
+
+/// The case file's names in a message, as the dict paths and arguments of the Python API:
+/// `[[stage]] N: \`key\`` → `stage[N-1].key`, `[[stage]] N` → `stage[N-1]`, `[table] \`key\``
+/// → `table.key`, and the CLI's `--overwrite`, `--out`, `--resume` → `overwrite=True`, `out`,
+/// the CLI's `tubemem run --resume`.
+fn pythonic(msg: &str) -> String {
+    let mut out = String::with_capacity(msg.len());
+    let mut rest = msg;
+    while !rest.is_empty() {
+        if let Some(after) = rest.strip_prefix("[[stage]] ") {
+            let digits: String = after.chars().take_while(|c| c.is_ascii_digit()).collect();
+            if let Ok(n) = digits.parse::<usize>() {
+                let mut tail = &after[digits.len()..];
+                let mut path = format!("stage[{}]", n.saturating_sub(1));
+                if let Some(key) = tail
+                    .strip_prefix(": `")
+                    .and_then(|t| t.split_once('`'))
+                    .filter(|(k, _)| k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'))
+                {
+                    path = format!("{path}.{}", key.0);
+                    tail = key.1;
+                }
+                out.push_str(&path);
+                rest = tail;
+                continue;
+            }
+        }
+        if let Some(after) = rest.strip_prefix('[') {
+            if let Some((name, tail)) = after.split_once("] `") {
+                if let Some((key, tail)) = tail.split_once('`') {
+                    if !name.is_empty()
+                        && name.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+                        && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+                    {
+                        out.push_str(&format!("{name}.{key}"));
+                        rest = tail;
+                        continue;
+                    }
+                }
+            }
+        }
+        let c = rest.chars().next().unwrap_or(' ');
+        out.push(c);
+        rest = &rest[c.len_utf8()..];
+    }
+    out.replace("--overwrite", "overwrite=True")
+        .replace("another --out", "another `out`")
+        .replace("--resume", "the CLI's `tubemem run --resume`")
 }
 
 /// A case given as a `Case`, a path to a TOML file, TOML text, or a dict of the case file's

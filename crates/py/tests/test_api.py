@@ -306,7 +306,8 @@ def test_run_returns_arrays_equal_to_steps_csv_and_takes_cases_as_dicts(tmp_path
         csv_col = np.array([float(r[k]) if r[k] else np.nan for r in rows])
         np.testing.assert_array_equal(a.steps[k], csv_col)
     assert a.summary["case"] == "case dict from Python" and b.summary["case"] == "case text from Python"
-    assert {**a.summary, "case": ""} == {**b.summary, "case": ""}
+    # the same run but for its label and the hash of its text (the dict becomes its own TOML)
+    assert {**a.summary, "case": "", "case_hash": ""} == {**b.summary, "case": "", "case_hash": ""}
     assert a.summary["stages"][1]["kind"] == "squeeze"
     assert a.vtu(0).name == "step_00000.vtu" and a.vtu(len(rows)).exists()
     with pytest.raises(ValueError, match="frame"):
@@ -593,10 +594,10 @@ def test_case_validates_the_whole_plan_on_construction(tmp_path):
     import tomllib
 
     tables = tomllib.loads(SMALL_CASE)
-    with pytest.raises(ValueError, match=r"`around` = 30: elements around must be a multiple of 8"):
+    with pytest.raises(ValueError, match=r"mesh\.around = 30: elements around must be a multiple of 8"):
         tubemem.Case(**dict(tables, mesh=dict(tables["mesh"], around=30)))
     stages = [tables["stage"][0], dict(tables["stage"][1], target_rho=1.5)]
-    with pytest.raises(ValueError, match=r"`target_rho` = 1.5: the plates must close on the tube"):
+    with pytest.raises(ValueError, match=r"stage\[1\]\.target_rho = 1.5: the plates must close on the tube"):
         tubemem.Case(**dict(tables, stage=stages))
     assert not any(tmp_path.iterdir())
 
@@ -635,3 +636,25 @@ def test_minor_defects_of_issue_24_item_13(tmp_path):
         last = max(i for i, s in enumerate(steps, start=1) if int(s["stage"]) == k)
         assert row == last, (k, row, last)
         assert int(fd["stage"][0]) == k and int(fd["step"][0]) == int(steps[last - 1]["step"])
+
+
+def test_python_errors_name_dict_paths_and_arguments(tmp_path):
+    """Issue #24 item 9: a misspelt dict key was reported at "line 19" of a TOML the user never
+    wrote, a folder in the way asked for --overwrite, and a Mooney-Rivlin dict without alpha
+    reported only the missing shear_modulus."""
+    import tomllib
+
+    tables = tomllib.loads(SMALL_CASE)
+    with pytest.raises(ValueError) as e:
+        tubemem.Case.from_dict(dict(tables, material={"model": "abb", "shear_modulus": 1.0, "kuhm": 3}))
+    msg = str(e.value)
+    assert "material.kuhm" in msg and "TOML" not in msg and "line" not in msg, msg
+    with pytest.raises(ValueError) as e:
+        tubemem.Case(**dict(tables, stage=[tables["stage"][0], {"kind": "squeeze", "target_roh": 0.9}]))
+    assert "stage[1].target_roh" in str(e.value) and "TOML" not in str(e.value), str(e.value)
+    with pytest.raises(ValueError, match=r"missing `shear_modulus` and `alpha`"):
+        tubemem.Case(**dict(tables, material={"model": "mooney-rivlin"}))
+    tubemem.run(tubemem.Case(**tables), str(tmp_path / "r"))
+    with pytest.raises(ValueError) as e:
+        tubemem.run(tubemem.Case(**tables), str(tmp_path / "r"))
+    assert "overwrite=True" in str(e.value) and "--overwrite" not in str(e.value), str(e.value)

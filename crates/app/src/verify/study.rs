@@ -379,6 +379,12 @@ pub fn run_study(
         let mut unjudged = vec![];
         for a in &allowances {
             match measure(&a.quantity) {
+                // no step to compare: the last step is not a uniform tube (a bulge)
+                Some(m) if m.measured.is_nan() => broken.push(format!(
+                    "{} cannot be compared at the last step ({}): the tube is not uniform there, and GPS is a uniform tube",
+                    label(&a.quantity),
+                    m.note
+                )),
                 Some(m) if m.pass => held.push(format!(
                     "{} agrees to {:.1e} (allowed {:.1e})",
                     label(&a.quantity),
@@ -432,11 +438,11 @@ pub fn run_study(
                     // beyond both limit points the uniform state is stable again, but the path
                     // to it went through a bulge, whose fronts may still be near the caps
                     Some(mn) => verdict.push_str(&format!(
-                        "the target λs* = {ls} lies beyond both GPS limit points (maximum ϖ = {:.4} at λs = {:.3}, minimum {:.4} at {:.3}): a uniform tube is stable there again, but the path to it passes a bulge that propagates to the caps, and the tube may still be transitioning near them; ",
+                        "The target λs* = {ls} lies beyond both GPS limit points (maximum ϖ = {:.4} at λs = {:.3}, minimum {:.4} at {:.3}): a uniform tube is stable there again, but the path to it passes a bulge that propagates to the caps, and the tube may still be transitioning near them. ",
                         mx.w, mx.lambda_s, mn.w, mn.lambda_s
                     )),
                     None => verdict.push_str(&format!(
-                        "the target λs* = {ls} lies past the GPS pressure maximum (ϖ = {:.4} at λs = {:.3}), where the uniform state is unstable and a bulge forms; ",
+                        "The target λs* = {ls} lies past the GPS pressure maximum (ϖ = {:.4} at λs = {:.3}), where the uniform state is unstable and a bulge forms. ",
                         mx.w, mx.lambda_s
                     )),
                 }
