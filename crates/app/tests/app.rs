@@ -141,10 +141,14 @@ fn profiles_at_stage_ends_only() {
 
 /// A stage whose precondition fails (the plates would start above the tube) is recorded: the
 /// report and summary.json carry the failed stage with its message, and the error names the
-/// stage and the key.
+/// stage and the key. (After a stretch-controlled inflation the case validation refuses such
+/// plates before anything runs; after a volume-ratio target only the run knows the tube's
+/// height.)
 #[test]
 fn a_precondition_failure_is_recorded() {
-    let case = Case::parse(&format!("{SMALL}{}", SQUEEZE.replace("1.0", "5.0"))).unwrap();
+    let small = SMALL.replace("target_stretch = 1.2", "target_volume_ratio = 1.44");
+    assert_ne!(small, SMALL);
+    let case = Case::parse(&format!("{small}{}", SQUEEZE.replace("1.0", "5.0"))).unwrap();
     let out = tmp("precondition");
     let mut writer = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let outcome = run(&case, "small", &mut [&mut writer]);
