@@ -6,8 +6,11 @@
 //! [geometry]
 //! radius = 1.0          # reference radius R (results are per R)
 //! length = 20.0         # cylinder length L (between the cap junctions)
-//! thickness = 0.01      # undeformed thickness H (dimensional output only)
+//! thickness = 0.01      # undeformed thickness H (optional; needed by [units])
 //! caps = "hemisphere"   # or "rigid-plug": open tube tied to two rigid discs
+//!
+//! [units]               # optional: the numbers are SI (m, Pa); the outputs add SI values
+//! system = "SI"
 //!
 //! [material]
 //! model = "abb"         # "abb" | "mooney-rivlin" | "neo-hookean"
@@ -114,6 +117,9 @@ pub struct Case {
     pub solver: SolverSpec,
     #[serde(default)]
     pub output: OutputSpec,
+    /// `[units]`: the system the case's numbers are in (none: outputs dimensionless)
+    #[serde(default)]
+    pub units: Option<UnitsSpec>,
     #[serde(rename = "stage")]
     pub stages: Vec<StageSpec>,
     /// the stages resolved by validation (filled by [`Case::parse`])
@@ -254,14 +260,26 @@ fn default_max_iterations() -> usize {
 pub struct Geometry {
     pub radius: f64,
     pub length: f64,
-    #[serde(default = "one")]
-    pub thickness: f64,
+    /// H: changes no dimensionless output (ϖ = pR/(μH)); needed by `[units]`
+    #[serde(default)]
+    pub thickness: Option<f64>,
     #[serde(default)]
     pub caps: Caps,
 }
 
-fn one() -> f64 {
-    1.0
+/// `[units]`: `system = "SI"` says the case's radius, length and thickness are in metres and
+/// its shear modulus in pascals; the outputs then carry dimensional values beside the
+/// dimensionless ones (pressure in Pa, resultants and forces per length in N/m).
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct UnitsSpec {
+    pub system: UnitSystem,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+pub enum UnitSystem {
+    #[serde(rename = "SI")]
+    Si,
 }
 
 #[derive(Debug, Deserialize, Serialize, Default, PartialEq, Eq, Clone, Copy)]
@@ -875,6 +893,17 @@ impl Case {
         )
     }
 
+    /// The scales R, H, μ of `[units]` (None: the outputs stay dimensionless).
+    pub fn scales(&self) -> Option<tubemem_gps::Scales> {
+        self.units?;
+        let mu = match self.material {
+            MaterialSpec::Abb { shear_modulus, .. }
+            | MaterialSpec::MooneyRivlin { shear_modulus, .. }
+            | MaterialSpec::NeoHookean { shear_modulus } => shear_modulus,
+        };
+        tubemem_gps::Scales::new(self.geometry.radius, self.geometry.thickness?, mu).ok()
+    }
+
     /// The hash of the case text the case was parsed from.
     pub fn hash(&self) -> &str {
         &self.hash
@@ -893,11 +922,19 @@ impl Case {
 
     fn validate(&self) -> Result<Vec<StagePlan>, CaseError> {
         let g = &self.geometry;
+        if self.units.is_some() && g.thickness.is_none() {
+            invalid!(
+                "[units] `system` = \"SI\" needs [geometry] `thickness` (H, in m): the pressure scale μH/R and the force scale πμH take it"
+            );
+        }
         for (k, v) in [
-            ("radius", g.radius),
-            ("length", g.length),
+            ("radius", Some(g.radius)),
+            ("length", Some(g.length)),
             ("thickness", g.thickness),
-        ] {
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| Some((k, v?)))
+        {
             if !(v.is_finite() && v > 0.0) {
                 invalid!(
                     "[geometry] `{k}` = {}: must be finite and > 0",

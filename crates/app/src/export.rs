@@ -143,7 +143,9 @@ pub fn abaqus_deck(
     }
     let mesh = build_mesh(case)?;
     let r = g.radius;
-    let h = g.thickness;
+    // without [units] the deck is dimensionless like the run: H = 1 (ϖ = pR/(μH) and the
+    // forces over πμH do not depend on it)
+    let h = g.thickness.unwrap_or(1.0);
     let p_scale = mu * h / r;
     let mut s = String::new();
     let _ = writeln!(s, "*HEADING");

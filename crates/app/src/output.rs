@@ -184,6 +184,40 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
 pub const FRONTS_HEADER: &str = "row,stage,step,w,volume,front,z_ref";
 
 /// One steps.csv line of a step (integers as integers, empty fields for what it lacks).
+/// The SI columns steps.csv adds after [`STEPS_HEADER`] with `[units] system = "SI"`: the
+/// mid-span pressure p = ϖ μH/R, the resultants n μH, and in a squeeze the plate force per
+/// length force · πμH and the plates' half-gap ρR.
+pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m";
+
+/// steps.csv's header: [`STEPS_HEADER`], and [`SI_HEADER`] with units.
+pub fn steps_header(units: bool) -> String {
+    if units {
+        format!("{STEPS_HEADER},{SI_HEADER}")
+    } else {
+        STEPS_HEADER.to_string()
+    }
+}
+
+/// The [`SI_HEADER`] values of a step (empty where the step has none).
+pub fn si_values(s: &tubemem_gps::Scales, r: &StepRecord) -> [Option<f64>; 5] {
+    let v = crate::report::SiValues::of(s, &r.midspan, r.contact.as_ref().map(|c| &c.values));
+    [
+        Some(v.pressure_pa),
+        Some(v.n_s_n_per_m),
+        Some(v.n_z_n_per_m),
+        v.force_n_per_m,
+        v.half_gap_m,
+    ]
+}
+
+fn si_row(s: &tubemem_gps::Scales, r: &StepRecord) -> String {
+    si_values(s, r)
+        .iter()
+        .map(|v| v.map_or(String::new(), |x| format!("{x}")))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
 pub fn format_row(r: &StepRecord) -> String {
     let fields: Vec<String> = step_row(r)
         .into_iter()
@@ -1079,7 +1113,10 @@ impl Observer for RunWriter {
             let d = self.dir.join(sub);
             std::fs::create_dir_all(&d).map_err(|e| AppError::io(&d, e))?;
         }
-        atomic_write(&self.dir.join("steps.csv"), &format!("{STEPS_HEADER}\n"))?;
+        atomic_write(
+            &self.dir.join("steps.csv"),
+            &format!("{}\n", steps_header(report.scales.is_some())),
+        )?;
         atomic_write(
             &self.dir.join("profiles").join("profiles.csv"),
             &format!("{PROFILES_HEADER}\n"),
@@ -1200,10 +1237,15 @@ impl RunWriter {
             self.journal
                 .append(&path, ITERATIONS_HEADER, &csv_rows(&rows))?;
         }
+        let units = view.report.scales;
+        let row = match &units {
+            None => format_row(view.record),
+            Some(sc) => format!("{},{}", format_row(view.record), si_row(sc, view.record)),
+        };
         self.journal.append(
             &self.dir.join("steps.csv"),
-            STEPS_HEADER,
-            &format!("{}\n", format_row(view.record)),
+            &steps_header(units.is_some()),
+            &format!("{row}\n"),
         )?;
         self.rows += 1;
         if !view.record.walls.is_empty() && view.fraction >= 1.0 {

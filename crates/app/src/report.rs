@@ -35,7 +35,9 @@ pub struct MeshInfo {
 pub struct GeometryInfo {
     pub radius: f64,
     pub length: f64,
-    pub thickness: f64,
+    /// as the case gave it (no value is made up when it did not)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
     pub caps: String,
 }
 
@@ -459,6 +461,9 @@ pub struct RunReport {
     /// the hash of the case text ([`crate::output::case_hash`]), as in run.json
     #[serde(default)]
     pub case_hash: String,
+    /// `[units]`: R, H, μ in SI (None: dimensionless)
+    #[serde(default)]
+    pub scales: Option<tubemem_gps::Scales>,
     pub stages: Vec<StageReport>,
     /// what the run noticed that a user should know (a target outside the closed form's
     /// validity, …), in order
@@ -479,8 +484,42 @@ pub struct Summary<'a> {
     pub material: &'a str,
     pub material_spec: &'a MaterialSpec,
     pub geometry: &'a GeometryInfo,
-    pub units: &'a str,
+    /// the text of [`UNITS`] without `[units]`; with it, the scales and the SI factors
+    pub units: serde_json::Value,
     pub stages: Vec<&'a StageOutcome>,
+    /// with `[units]`: each finished stage's final state in SI
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_si: Option<Vec<Option<SiValues>>>,
+}
+
+/// A state in SI units (`[units] system = "SI"`): p = ϖ μH/R (eq. 67), N = n μH, the plate
+/// force per length F = force · πμH (eq. 80), lengths times R.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SiValues {
+    pub pressure_pa: f64,
+    pub n_s_n_per_m: f64,
+    pub n_z_n_per_m: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub force_n_per_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub half_gap_m: Option<f64>,
+}
+
+impl SiValues {
+    /// The SI values of mid-span `m` (and of the plates' `contact`) at scales `s`.
+    pub fn of(
+        s: &tubemem_gps::Scales,
+        m: &MidSpan,
+        contact: Option<&tubemem_fem::post::ContactValues>,
+    ) -> Self {
+        Self {
+            pressure_pa: s.pressure(m.w),
+            n_s_n_per_m: s.resultant(m.n_s),
+            n_z_n_per_m: s.resultant(m.n_z),
+            force_n_per_m: contact.map(|c| s.force_per_length(c.force)),
+            half_gap_m: contact.map(|c| c.rho * s.radius),
+        }
+    }
 }
 
 pub const UNITS: &str = "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH), force = plate force per length/(πμH)";
@@ -496,8 +535,33 @@ impl RunReport {
             material: &self.material,
             material_spec: &self.material_spec,
             geometry: &self.geometry,
-            units: &self.units,
+            units: match &self.scales {
+                None => serde_json::Value::String(self.units.clone()),
+                Some(s) => serde_json::json!({
+                    "system": "SI",
+                    "radius_m": s.radius,
+                    "thickness_m": s.thickness,
+                    "shear_modulus_pa": s.shear_modulus,
+                    "pressure_pa_per_w": s.pressure(1.0),
+                    "n_per_m_per_resultant": s.resultant(1.0),
+                    "n_per_m_per_force": s.force_per_length(1.0),
+                    "m_per_length": s.radius,
+                }),
+            },
             stages: self.stages.iter().map(|s| &s.outcome).collect(),
+            final_si: self.scales.map(|sc| {
+                self.stages
+                    .iter()
+                    .map(|st| {
+                        let last = st.steps.last()?;
+                        Some(SiValues::of(
+                            &sc,
+                            &last.midspan,
+                            last.contact.as_ref().map(|c| &c.values),
+                        ))
+                    })
+                    .collect()
+            }),
             warnings: &self.warnings,
         }
     }

@@ -947,6 +947,7 @@ pub fn run_with(
         },
         units: UNITS.into(),
         case_hash: case.hash().to_string(),
+        scales: case.scales(),
         stages: vec![],
         warnings: vec![],
     });
@@ -1038,6 +1039,7 @@ fn run_inner(
         },
         units: UNITS.into(),
         case_hash: case.hash().to_string(),
+        scales: case.scales(),
         stages: vec![],
         warnings: vec![],
     });

@@ -1389,3 +1389,72 @@ fn the_study_of_24_around_refines_upward() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Issue #24 item 10: physical units. With `[units] system = "SI"` (R = 5 mm, H = 0.5 mm,
+/// μ = 0.4 MPa) steps.csv and summary.json carry SI values beside the dimensionless ones:
+/// p = ϖ μH/R (the paper's eq. 67), the plate force per length ϖχ·πμH (eq. 80), the plates'
+/// half-gap ρR — computed here from the case's numbers. Without `[units]` nothing dimensional
+/// is written, and an omitted thickness is not reported as 1.
+#[test]
+fn units_give_dimensional_columns_and_no_units_write_no_made_up_value() {
+    let si = format!("{SMALL}{SQUEEZE}")
+        .replace("radius = 1.0", "radius = 0.005\nthickness = 0.0005")
+        .replace("length = 8.0", "length = 0.04")
+        .replace("shear_modulus = 1.0", "shear_modulus = 4.0e5")
+        + "\n[units]\nsystem = \"SI\"\n";
+    let case = Case::parse(&si).unwrap();
+    let out = tmp("units-si");
+    let mut w = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
+    let report = run(&case, "si", &mut [&mut w]).into_result().unwrap();
+    let (mu, h, r) = (4.0e5, 5.0e-4, 5.0e-3);
+    let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let (w_col, p_col) = (column(&csv, "w"), column(&csv, "pressure_pa"));
+    let (f_col, fsi) = (column(&csv, "force"), column(&csv, "force_n_per_m"));
+    let (rho, gap) = (column(&csv, "rho"), column(&csv, "half_gap_m"));
+    assert_eq!(w_col.len(), report.steps().count());
+    for k in 0..w_col.len() {
+        let wk: f64 = w_col[k].parse().unwrap();
+        let pk: f64 = p_col[k].parse().unwrap();
+        assert!((pk / (wk * mu * h / r) - 1.0).abs() < 1e-14, "row {k}");
+        if !f_col[k].is_empty() {
+            let (f, g): (f64, f64) = (f_col[k].parse().unwrap(), fsi[k].parse().unwrap());
+            assert!((g / (f * std::f64::consts::PI * mu * h) - 1.0).abs() < 1e-14);
+            let (rh, gm): (f64, f64) = (rho[k].parse().unwrap(), gap[k].parse().unwrap());
+            assert!((gm / (rh * r) - 1.0).abs() < 1e-14);
+        } else {
+            assert!(fsi[k].is_empty());
+        }
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["units"]["system"], "SI");
+    assert_eq!(s["units"]["pressure_pa_per_w"], mu * h / r);
+    let last_w: f64 = w_col.last().unwrap().parse().unwrap();
+    let p_final = s["final_si"][1]["pressure_pa"].as_f64().unwrap();
+    assert!((p_final / (last_w * mu * h / r) - 1.0).abs() < 1e-14);
+    assert_eq!(s["geometry"]["thickness"], 5.0e-4);
+    // the same tube without units: dimensionless outputs equal to the SI run's, no SI column,
+    // no made-up thickness
+    let plain = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
+    let out2 = tmp("units-none");
+    let mut w2 = RunWriter::create(&out2, FolderMode::Fresh, plain.hash(), &[]).unwrap();
+    run(&plain, "plain", &mut [&mut w2]).into_result().unwrap();
+    let csv2 = std::fs::read_to_string(out2.join("steps.csv")).unwrap();
+    assert!(!csv2.lines().next().unwrap().contains("pressure_pa"));
+    assert_eq!(column(&csv2, "w"), w_col);
+    let s2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out2.join("summary.json")).unwrap()).unwrap();
+    assert!(
+        s2["geometry"].get("thickness").is_none(),
+        "{}",
+        s2["geometry"]
+    );
+    assert!(s2["units"].is_string() && s2.get("final_si").is_none());
+    // [units] without a thickness is refused, naming what it needs
+    let err = Case::parse(&(format!("{SMALL}{SQUEEZE}") + "\n[units]\nsystem = \"SI\"\n"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("[geometry] `thickness`"), "{err}");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&out2);
+}

@@ -636,9 +636,20 @@ fn default_case() -> &'static str {
 
 /// The steps of a report as (steps.csv column, values) pairs, NaN where a column does not apply.
 fn step_columns(report: &tubemem_app::report::RunReport) -> Vec<(&'static str, Vec<f64>)> {
-    let rows: Vec<Vec<Option<f64>>> = report.steps().map(tubemem_app::output::step_row).collect();
+    let rows: Vec<Vec<Option<f64>>> = report
+        .steps()
+        .map(|s| {
+            let mut row = tubemem_app::output::step_row(s);
+            if let Some(sc) = &report.scales {
+                row.extend(tubemem_app::output::si_values(sc, s));
+            }
+            row
+        })
+        .collect();
+    let si = report.scales.map_or("", |_| tubemem_app::output::SI_HEADER);
     tubemem_app::output::STEPS_HEADER
         .split(',')
+        .chain(si.split(',').filter(|c| !c.is_empty()))
         .enumerate()
         .map(|(j, name)| {
             (

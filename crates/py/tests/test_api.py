@@ -658,3 +658,21 @@ def test_python_errors_name_dict_paths_and_arguments(tmp_path):
     with pytest.raises(ValueError) as e:
         tubemem.run(tubemem.Case(**tables), str(tmp_path / "r"))
     assert "overwrite=True" in str(e.value) and "--overwrite" not in str(e.value), str(e.value)
+
+
+def test_units_reach_the_python_tables(tmp_path):
+    """Issue #24 item 10: with `[units] system = "SI"` the Run's steps have the SI columns of
+    steps.csv (p = w mu H / R, eq. 67), and its summary the scales."""
+    import numpy as np
+
+    text = (
+        SMALL_CASE.replace("radius = 1.0", "radius = 0.005\nthickness = 0.0005")
+        .replace("length = 8.0", "length = 0.04")
+        .replace("shear_modulus = 1.0", "shear_modulus = 4.0e5")
+        + '\n[units]\nsystem = "SI"\n'
+    )
+    r = tubemem.run(text, str(tmp_path / "si"))
+    np.testing.assert_allclose(r.steps["pressure_pa"], r.steps["w"] * 4.0e5 * 0.0005 / 0.005, rtol=1e-14)
+    assert r.summary["units"]["system"] == "SI"
+    rows = list(csv.DictReader(open(tmp_path / "si" / "steps.csv")))
+    np.testing.assert_array_equal(r.steps["pressure_pa"], [float(x["pressure_pa"]) for x in rows])
