@@ -2190,7 +2190,11 @@ fn a_run_killed_at_any_moment_resumes_bit_identical() {
             && !killed.join("checkpoints").join("ckpt-a.bin").exists()
         {
             // killed before its first checkpoint was renamed into place: nothing to resume
-            assert!(String::from_utf8_lossy(&o.stderr).contains("start it afresh with --overwrite"));
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(
+                err.contains("start it afresh with --overwrite"),
+                "{rows}: {err}"
+            );
             continue;
         }
         assert!(

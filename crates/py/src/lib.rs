@@ -466,16 +466,13 @@ fn run_parsed<'py>(
                 "progress = {name:?}: a callable, \"tqdm\" or None"
             )));
         }
-        let tqdm = py.import("tqdm.auto").map_err(|_| {
-            pyo3::exceptions::PyImportError::new_err(
-                "progress=\"tqdm\" needs the tqdm package: pip install tqdm",
-            )
-        })?;
-        let kwargs = pyo3::types::PyDict::new(py);
-        kwargs.set_item("total", case.plan().len() as f64)?;
-        kwargs.set_item("unit", "stage")?;
-        kwargs.set_item("desc", "tubemem")?;
-        bar = Some(tqdm.getattr("tqdm")?.call((), Some(&kwargs))?);
+        bar = Some(tqdm_bar(
+            py,
+            "progress=\"tqdm\"",
+            case.plan().len() as f64,
+            "stage",
+            "tubemem",
+        )?);
         progress = None;
     }
     // the case file (when the label is its path) and its mesh: never written over
@@ -1226,6 +1223,27 @@ fn _sweep_one<'py>(
     member_dict(py, index, &out, &result)
 }
 
+/// A tqdm bar of `total` `unit`s (tqdm imported on demand: it is optional); `arg` is the
+/// argument that asked for it, for the message when tqdm is missing.
+fn tqdm_bar<'py>(
+    py: Python<'py>,
+    arg: &str,
+    total: f64,
+    unit: &str,
+    desc: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let tqdm = py.import("tqdm.auto").map_err(|_| {
+        pyo3::exceptions::PyImportError::new_err(format!(
+            "{arg} needs the tqdm package: pip install tqdm"
+        ))
+    })?;
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs.set_item("total", total)?;
+    kwargs.set_item("unit", unit)?;
+    kwargs.set_item("desc", desc)?;
+    tqdm.getattr("tqdm")?.call((), Some(&kwargs))
+}
+
 /// The sweep's progress: a tqdm bar over the members, a callable given a dict per finished
 /// member, or nothing.
 enum SweepProgress<'py> {
@@ -1245,16 +1263,13 @@ impl<'py> SweepProgress<'py> {
                     "sweep(progress={name:?}): a callable, \"tqdm\" or None"
                 )));
             }
-            let tqdm = py.import("tqdm.auto").map_err(|_| {
-                pyo3::exceptions::PyImportError::new_err(
-                    "sweep(progress=\"tqdm\") needs the tqdm package: pip install tqdm",
-                )
-            })?;
-            let kwargs = pyo3::types::PyDict::new(py);
-            kwargs.set_item("total", total)?;
-            kwargs.set_item("unit", "case")?;
-            kwargs.set_item("desc", "tubemem sweep")?;
-            return Ok(Self::Bar(tqdm.getattr("tqdm")?.call((), Some(&kwargs))?));
+            return Ok(Self::Bar(tqdm_bar(
+                py,
+                "sweep(progress=\"tqdm\")",
+                total as f64,
+                "case",
+                "tubemem sweep",
+            )?));
         }
         if !p.is_callable() {
             return Err(PyValueError::new_err(

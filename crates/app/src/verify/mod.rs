@@ -672,13 +672,23 @@ fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         stroke: Stroke::Dashed,
         width: 1,
     });
+    // a `final_` quantity is judged at the last step only: its curve shows the others against
+    // that step's tolerance, for the trend
+    let notes = if c.spec.tolerance.keys().any(|q| q.starts_with("final_")) {
+        vec!["final_*: judged at the last step only; the earlier steps are shown against its tolerance".to_string()]
+    } else {
+        vec![]
+    };
     plot(
-        &Figure::new(
-            format!("{}: FE against GPS at every step", c.spec.name),
-            "step (all stages)",
-            "share of the tolerance used",
-            series,
-        ),
+        &Figure {
+            notes,
+            ..Figure::new(
+                format!("{}: FE against GPS at every step", c.spec.name),
+                "step (all stages)",
+                "share of the tolerance used",
+                series,
+            )
+        },
         r,
     );
     Ok(None)
