@@ -468,20 +468,40 @@ fn default_steps() -> usize {
     8
 }
 
-/// What a stage drives, once validated.
+/// What a stage drives, once validated. Written (summary.json) under the case file's own key,
+/// `{"key": "target_stretch", "value": 1.3}` (it had been `{"control": "stretch", …}`, which
+/// read as a control the case never named: issue #24 item 11; the old names are read too).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "control", content = "value", rename_all = "kebab-case")]
+#[serde(tag = "key", content = "value")]
 pub enum Target {
     /// reduced pressure ϖ, pressure control
+    #[serde(rename = "target_pressure", alias = "pressure")]
     Pressure(f64),
     /// mid-span hoop stretch λs*, reached with the pressure as a Lagrange multiplier
+    #[serde(rename = "target_stretch", alias = "stretch")]
     Stretch(f64),
     /// total enclosed volume over its reference value, volume control
+    #[serde(rename = "target_volume_ratio", alias = "volume-ratio")]
     VolumeRatio(f64),
     /// squeeze between plates y = ±ρR with the gas closed in
+    #[serde(rename = "target_rho", alias = "rho")]
     Rho(f64),
     /// the stage's planes (their number) moved from `offset` to `target` with the gas closed
+    #[serde(rename = "planes", alias = "confine")]
     Confine(usize),
+}
+
+impl StagePlan {
+    /// The stage's `control` as the case file names it: "pressure", "volume" or "arc-length"
+    /// (None: a squeeze or confine stage stepped by load, which names no control).
+    pub fn control(&self) -> Option<&'static str> {
+        match (self.arc_length, self.target) {
+            (true, _) => Some("arc-length"),
+            (false, Target::Pressure(_)) => Some("pressure"),
+            (false, Target::Stretch(_) | Target::VolumeRatio(_)) => Some("volume"),
+            (false, Target::Rho(_) | Target::Confine(_)) => None,
+        }
+    }
 }
 
 impl Target {

@@ -328,6 +328,9 @@ pub struct Wrinkling {
 pub struct StageSummary {
     pub index: usize,
     pub kind: String,
+    /// the case file's `control` ([`crate::case::StagePlan::control`])
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<String>,
     pub target: Target,
     #[serde(rename = "final")]
     pub final_state: StageFinal,

@@ -1644,6 +1644,7 @@ fn run_inner(
             } else {
                 "inflate".into()
             },
+            control: plan.control().map(String::from),
             target: plan.target,
             final_state: StageFinal {
                 midspan: ms,

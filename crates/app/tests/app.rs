@@ -70,7 +70,9 @@ fn the_files_are_the_report() {
     assert_eq!(profile, "profiles/stage2_final.csv");
     assert!(out.join(profile).exists());
     // the target is plain data, not a debug string
-    assert_eq!(on_disk["stages"][0]["target"]["control"], "stretch");
+    // the case file's words: its control and its target key (issue #24 item 11)
+    assert_eq!(on_disk["stages"][0]["control"], "volume");
+    assert_eq!(on_disk["stages"][0]["target"]["key"], "target_stretch");
     assert_eq!(on_disk["stages"][0]["target"]["value"], 1.2);
     // profiles.csv: every step's profile, as in the report, field for field
     let text = std::fs::read_to_string(out.join("profiles/profiles.csv")).unwrap();

@@ -66,8 +66,8 @@ pub struct ConfineArgs {
     )]
     planes: Vec<String>,
     /// The inflated hoop stretch λs* at which the gas is closed in (the walls then move in
-    /// from first contact to their offsets d).
-    #[arg(long, conflicts_with = "pressure")]
+    /// from first contact to their offsets d; `--target-stretch` is an alias).
+    #[arg(long, conflicts_with = "pressure", visible_alias = "target-stretch")]
     initial_stretch: Option<f64>,
     /// A given reduced pressure ϖ instead (no gas law).
     #[arg(long)]
@@ -308,11 +308,13 @@ pub struct FlattenArgs {
     material: MaterialArgs,
     #[arg(long, value_enum, default_value = "gps")]
     hypothesis: Hyp,
-    /// The inflated hoop stretch λs* at which the gas is closed in.
-    #[arg(long)]
+    /// The inflated hoop stretch λs* at which the gas is closed in (the case file's
+    /// `target_stretch` of the inflation; `--target-stretch` is an alias).
+    #[arg(long, visible_alias = "target-stretch")]
     initial_stretch: f64,
-    /// Half-gap ρ = r/R (0 < ρ < λs*) for a single state.
-    #[arg(long)]
+    /// Half-gap ρ = r/R (0 < ρ < λs*) for a single state (the case file's `target_rho`;
+    /// `--target-rho` is an alias).
+    #[arg(long, visible_alias = "target-rho")]
     rho: Option<f64>,
     /// Last ρ of a curve that starts at ρ = λs*.
     #[arg(long)]
@@ -359,7 +361,36 @@ fn print_state<T: Serialize>(state: &T, json: bool) -> Result<()> {
     Ok(())
 }
 
+/// An error of the closed form names its parameter as the library calls it (`lambda_s`);
+/// the user gave a flag: name the flag, with the parameter after it.
+fn flagged(e: anyhow::Error, names: &[(&str, &str)]) -> anyhow::Error {
+    let mut msg = format!("{e:#}");
+    for (name, flag) in names {
+        msg = msg.replace(&format!("`{name}`"), &format!("{flag} (`{name}`)"));
+    }
+    anyhow::anyhow!(msg)
+}
+
 pub fn run(cmd: GpsCommand) -> Result<()> {
+    let names: &[(&str, &str)] = match &cmd {
+        GpsCommand::Inflate(a) if a.stretch.is_some() => &[("lambda_s", "--stretch")],
+        GpsCommand::Inflate(_) => &[("lambda_s", "--from/--to"), ("points", "--points")],
+        GpsCommand::Flatten(_) => &[
+            ("initial_stretch", "--initial-stretch"),
+            ("rho", "--rho"),
+            ("points", "--points"),
+        ],
+        GpsCommand::Confine(_) => &[
+            ("initial_stretch", "--initial-stretch"),
+            ("pressure", "--pressure"),
+            ("points", "--points"),
+        ],
+        GpsCommand::Limits(_) => &[],
+    };
+    run_command(cmd).map_err(|e| flagged(e, names))
+}
+
+fn run_command(cmd: GpsCommand) -> Result<()> {
     match cmd {
         GpsCommand::Inflate(a) => {
             let law = a.material.build()?;

@@ -972,8 +972,49 @@ fn output_errors_and_resource_caps_are_clear_errors() {
             "--stretch",
             "1e308",
         ],
-        "`lambda_s` = 1e308",
+        "--stretch (`lambda_s`) = 1e308",
     );
+}
+
+/// Issue #24 item 11, the CLI's part: an error of `tubemem gps` names the flag the user gave
+/// (it named the library's `lambda_s`), and the case file's `target_stretch`/`target_rho` are
+/// accepted as aliases of `--initial-stretch`/`--rho`.
+#[test]
+fn gps_errors_name_the_flag_and_the_case_words_are_aliases() {
+    let m = ["--material", "abb", "--kuhn", "30"];
+    let run = |args: &[&str]| {
+        let mut a = vec!["gps"];
+        a.extend_from_slice(args);
+        a.extend_from_slice(&m);
+        tubemem(&a)
+    };
+    let o = run(&["inflate", "--stretch", "0.9"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--stretch (`lambda_s`) = 0.9"),
+        "{err}"
+    );
+    let o = run(&["flatten", "--initial-stretch", "1.3", "--rho", "1.5"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("--rho (`rho`) = 1.5"), "{err}");
+    let a = run(&[
+        "flatten",
+        "--initial-stretch",
+        "1.3",
+        "--rho",
+        "0.8",
+        "--json",
+    ]);
+    let b = run(&[
+        "flatten",
+        "--target-stretch",
+        "1.3",
+        "--target-rho",
+        "0.8",
+        "--json",
+    ]);
+    assert!(a.status.success() && b.status.success());
+    assert_eq!(a.stdout, b.stdout);
 }
 
 /// Malformed user meshes are refused with the plug or node at fault: an empty plug ring
