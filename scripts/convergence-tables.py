@@ -188,7 +188,7 @@ def confine_row(d, s):
     err = walls["force"][sel] / walls["local_force"][sel] - 1.0
     steps = walls["step"][sel]
     final = err[steps == steps.max()]
-    summary_local = s["stages"][-1]["relative_error_vs_gps_at_fe_pressure"]
+    summary_local = s["stages"][-1]["relative_error_vs_local"]
     return {
         "lambda_s": summary_local["lambda_s"], "lambda_z": summary_local["lambda_z"],
         "wall_force_end": float(final[np.argmax(np.abs(final))]),

@@ -833,10 +833,11 @@ impl RunWriter {
                 values: &disp,
             }],
             &[
-                cell("hoop_stretch", &cellf[0]),
-                cell("axial_stretch", &cellf[1]),
-                cell("N1", &cellf[2]),
-                cell("N2", &cellf[3]),
+                // the names of steps.csv (λs, λz), and n_1 ≥ n_2 the principal resultants
+                cell("lambda_s", &cellf[0]),
+                cell("lambda_z", &cellf[1]),
+                cell("n_1", &cellf[2]),
+                cell("n_2", &cellf[3]),
                 cell("wrinkled", &cellf[4]),
                 cell("contact_pressure", &cellf[5]),
             ],

@@ -343,9 +343,19 @@ pub struct StageSummary {
     pub ps: ClosedFormState,
     pub relative_error_vs_gps: RelativeErrors,
     pub relative_error_vs_ps: RelativeErrors,
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// the GPS section under the FE's own mid-span pressure: `local` as in steps.csv's
+    /// `local_*` columns (the old key `gps_at_fe_pressure` is read too)
+    #[serde(
+        rename = "local",
+        alias = "gps_at_fe_pressure",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub gps_at_fe_pressure: Option<LocalSection>,
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(
+        rename = "relative_error_vs_local",
+        alias = "relative_error_vs_gps_at_fe_pressure",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub relative_error_vs_gps_at_fe_pressure: Option<RelativeErrors>,
     /// a confine stage: each wall at the end, FE against GPS and the section at the FE's
     /// pressure
@@ -374,6 +384,10 @@ pub struct WallSummary {
     pub local: Option<tubemem_gps::confine::WallContact>,
     /// FE/GPS − 1 of the force per unit length
     pub force_error_vs_gps: Option<f64>,
+    #[serde(
+        rename = "force_error_vs_local",
+        alias = "force_error_vs_gps_at_fe_pressure"
+    )]
     pub force_error_vs_gps_at_fe_pressure: Option<f64>,
 }
 

@@ -1460,3 +1460,60 @@ fn units_give_dimensional_columns_and_no_units_write_no_made_up_value() {
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&out2);
 }
+
+/// Issue #24 item 11: one vocabulary across the outputs (the README's "Names" table). A
+/// squeeze's steps.csv, summary.json and VTU use the same names — `lambda_s`, `lambda_z`,
+/// `local` for the section under the FE's pressure, the case file's `control` and target key —
+/// and none of the retired ones (`hoop_stretch`, `N1`, `gps_at_fe_pressure`,
+/// `"control": "stretch"`).
+#[test]
+fn the_outputs_speak_one_vocabulary() {
+    let case = Case::parse(&format!("{SMALL}{SQUEEZE}")).unwrap();
+    let out = tmp("vocabulary");
+    let mut w = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
+    run(&case, "small", &mut [&mut w]).into_result().unwrap();
+    let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let header = steps.lines().next().unwrap();
+    for c in ["lambda_s", "lambda_z", "local_lambda_s", "local_force"] {
+        assert!(header.split(',').any(|h| h == c), "steps.csv lacks {c}");
+    }
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let s: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert!(s["stages"][1]["local"].is_object(), "{}", s["stages"][1]);
+    assert_eq!(s["stages"][1]["target"]["key"], "target_rho");
+    let vtu = std::fs::read_dir(out.join("vtu"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .max()
+        .unwrap();
+    let frame = std::fs::read_to_string(vtu).unwrap();
+    for name in [
+        "lambda_s",
+        "lambda_z",
+        "n_1",
+        "n_2",
+        "wrinkled",
+        "contact_pressure",
+    ] {
+        assert!(
+            frame.contains(&format!("Name=\"{name}\"")),
+            "the VTU lacks {name}"
+        );
+    }
+    for retired in [
+        "hoop_stretch",
+        "axial_stretch",
+        "Name=\"N1\"",
+        "gps_at_fe_pressure",
+    ] {
+        assert!(
+            !frame.contains(retired) && !summary.contains(retired),
+            "{retired}"
+        );
+    }
+    assert!(
+        !summary.contains("\"control\": \"stretch\"")
+            && !summary.contains("\"control\":\"stretch\"")
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -695,20 +695,17 @@ fn squeeze_stage_writes_contact_outputs() {
     let st = &s["stages"][1];
     // every squeeze row carries the closed form; the last one is the summary's
     assert_eq!(steps.num(last, "gps_force"), num(&st["gps"], "force"));
-    assert_eq!(
-        steps.num(last, "local_force"),
-        num(&st["gps_at_fe_pressure"], "force")
-    );
+    assert_eq!(steps.num(last, "local_force"), num(&st["local"], "force"));
     // the GPS section under the FE's own pressure: at this 16-around mesh, with the default
     // contact (augmented, at the nodes), the measured errors are λs +5.9e-4, λz −2.4e-3,
     // χ −14.4 % (the flat zone is about one element wide at ρ = 1.0, and the nodes resolve its
     // edge only to an element; the Gauss-point penalty gives −7.6 %); bounds 5e-3 for the
     // stretches (the fem crate measures 4.3e-3 at 16 around for L/R = 20, ρ = 0.8) and 20 % for χ
-    let loc = &st["relative_error_vs_gps_at_fe_pressure"];
+    let loc = &st["relative_error_vs_local"];
     assert!(num(loc, "lambda_s").abs() < 5e-3, "{loc}");
     assert!(num(loc, "lambda_z").abs() < 5e-3, "{loc}");
     assert!(num(loc, "chi").abs() < 0.2, "{loc}");
-    assert_eq!(num(&st["gps_at_fe_pressure"], "w"), num(&st["final"], "w"));
+    assert_eq!(num(&st["local"], "w"), num(&st["final"], "w"));
     assert_eq!(st["kind"], "squeeze");
     let (fin, gps) = (&st["final"], &st["gps"]);
     for k in [
