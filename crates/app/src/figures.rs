@@ -618,6 +618,8 @@ pub struct Overlay {
     /// where it came from (the run folder), for messages
     pub source: PathBuf,
     pub material: MaterialSpec,
+    /// the run's `[units]` scales (None: dimensionless)
+    pub scales: Option<tubemem_gps::Scales>,
     /// (λs, ϖ) of the inflation steps
     pub inflation: Vec<(f64, f64)>,
     pub squeeze: Vec<SqueezePoint>,
@@ -630,6 +632,7 @@ impl Overlay {
             label: label.to_string(),
             source: source.to_path_buf(),
             material: report.material_spec,
+            scales: report.scales,
             inflation: vec![],
             squeeze: vec![],
         };
@@ -692,6 +695,12 @@ impl Overlay {
             col("force")?,
             col("gps_force").ok(),
         );
+        // summary.json's `units`: the scales of a run with `[units]`, else a text
+        let units = summary.get("units").filter(|u| u.is_object());
+        let scales = units.and_then(|u| {
+            let f = |k: &str| u.get(k).and_then(|v| v.as_f64());
+            tubemem_gps::Scales::new(f("radius_m")?, f("thickness_m")?, f("shear_modulus_pa")?).ok()
+        });
         let mut o = Overlay {
             label: dir
                 .file_name()
@@ -699,6 +708,7 @@ impl Overlay {
                 .unwrap_or_else(|| dir.display().to_string()),
             source: dir.to_path_buf(),
             material,
+            scales,
             inflation: vec![],
             squeeze: vec![],
         };
@@ -862,6 +872,32 @@ pub fn write_all(
     let built = spec.build()?;
     let law = built.as_ref();
     let name = law_label(&spec);
+    // the overlays' `[units]`, when they all have the same: pressures in kPa, forces per length
+    // in N/m and plate approaches in mm on Figs. 5–8 (the CSVs stay dimensionless)
+    let units = overlays
+        .first()
+        .and_then(|o| o.scales)
+        .filter(|s| overlays.iter().all(|o| o.scales == Some(*s)));
+    let pressure_fig = |f: Figure| match units {
+        Some(s) => scaled(
+            f,
+            1.0,
+            s.pressure(1.0) / 1e3,
+            None,
+            "pressure p = ϖμH/R (kPa)",
+        ),
+        None => f,
+    };
+    let force_fig = |f: Figure| match units {
+        Some(s) => scaled(
+            f,
+            2.0 * s.radius * 1e3,
+            s.force_per_length(1.0),
+            Some("plate approach 2R(λs* − ρ) (mm)"),
+            "plate force per length (N/m)",
+        ),
+        None => f,
+    };
     // every file rendered first; the folder is checked and written only once all are
     let mut files: Vec<(PathBuf, Vec<u8>)> = vec![];
     let hyps = [(Hypothesis::Gps, GPS_COLOR), (Hypothesis::Ps, PS_COLOR)];
@@ -998,7 +1034,7 @@ pub fn write_all(
         .filter(|m| !m.points.is_empty())
         .collect();
     files.extend(render_files(
-        &Figure {
+        &pressure_fig(Figure {
             markers,
             ..Figure::new(
                 format!("Fig. 5 — reduced pressure vs hoop stretch ({name})"),
@@ -1006,12 +1042,12 @@ pub fn write_all(
                 "reduced pressure ϖ = pR/(μH)",
                 series,
             )
-        },
+        }),
         &dir.join("fig5_pressure_stretch"),
         opts,
     )?);
     files.extend(render_files(
-        &Figure {
+        &pressure_fig(Figure {
             markers: zoom_markers,
             y_from_zero: false,
             ..Figure::new(
@@ -1020,7 +1056,7 @@ pub fn write_all(
                 "reduced pressure ϖ = pR/(μH)",
                 zoom_series,
             )
-        },
+        }),
         &dir.join("fig5_zoom_ls1.3"),
         opts,
     )?);
@@ -1078,7 +1114,7 @@ pub fn write_all(
             markers: errors,
         });
         files.extend(render_files(
-            &Figure {
+            &force_fig(Figure {
                 markers,
                 panel,
                 notes,
@@ -1088,7 +1124,7 @@ pub fn write_all(
                     "reduced force ϖχ = pc/(πμH)",
                     series,
                 )
-            },
+            }),
             &dir.join(format!("fig{num}_force_displacement_ls{tag}")),
             opts,
         )?);
@@ -1133,6 +1169,38 @@ pub fn write_all(
     )?);
     crate::output_file::create_folder(dir)?;
     crate::output_file::write_owned(dir, FIGURES_MANIFEST, "tubemem figures", &files)
+}
+
+/// `fig` with x and y (and its panel's y) multiplied by `sx`, `sy`, and its axes renamed: the
+/// dimensional figures of runs with `[units]`.
+fn scaled(mut fig: Figure, sx: f64, sy: f64, x_label: Option<&str>, y_label: &str) -> Figure {
+    let scale = |pts: &mut Vec<(f64, f64)>| {
+        for p in pts.iter_mut() {
+            *p = (p.0 * sx, p.1 * sy);
+        }
+    };
+    for s in &mut fig.series {
+        scale(&mut s.points);
+    }
+    for m in &mut fig.markers {
+        scale(&mut m.points);
+    }
+    if let Some(panel) = &mut fig.panel {
+        for s in &mut panel.series {
+            scale(&mut s.points);
+        }
+        for m in &mut panel.markers {
+            for p in m.points.iter_mut() {
+                *p = (p.0 * sx, p.1 * sy);
+            }
+        }
+        panel.y_label = format!("{} (N/m)", panel.y_label);
+    }
+    if let Some(x) = x_label {
+        fig.x_label = x.to_string();
+    }
+    fig.y_label = y_label.to_string();
+    fig
 }
 
 /// Two squeezes start from the same λs* (one figure, one pair of curves) within this relative

@@ -2328,3 +2328,49 @@ fn the_console_names_the_tubes_own_end() {
         let _ = std::fs::remove_dir_all(&out);
     }
 }
+
+/// Issue #24 item 10, the figures: overlaid runs with `[units] system = "SI"` (R = 5 mm,
+/// H = 0.5 mm, μ = 0.4 MPa: μH/R = 40 kPa) get dimensional axes — pressure in kPa on Fig. 5,
+/// plate approach in mm and force per length in N/m on their force figure; the same runs
+/// without units keep the reduced axes.
+#[test]
+fn figures_of_runs_with_units_have_dimensional_axes() {
+    let si = format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.05\nsteps = 3\n")
+        .replace("radius = 1.0", "radius = 0.005\nthickness = 0.0005")
+        .replace("length = 8.0", "length = 0.04")
+        .replace("shear_modulus = 1.0", "shear_modulus = 4.0e5")
+        + "\n[units]\nsystem = \"SI\"\n";
+    let case = write_case("figures-units", &si);
+    let d = case.parent().unwrap().to_path_buf();
+    let run = d.join("run");
+    assert!(tubemem(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let figs = d.join("figs");
+    let o = tubemem(&[
+        "figures",
+        "--out",
+        figs.to_str().unwrap(),
+        "--overlay",
+        run.to_str().unwrap(),
+        "--format",
+        "svg",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let fig5 = std::fs::read_to_string(figs.join("fig5_pressure_stretch.svg")).unwrap();
+    assert!(fig5.contains("pressure p = ϖμH/R (kPa)"), "Fig. 5's axis");
+    // its tick labels reach the tens of kPa (ϖ ≈ 0.5 at λs = 1.2 is 20 kPa), not ϖ's < 1
+    let ticks: Vec<f64> = fig5
+        .split('>')
+        .filter_map(|t| t.split('<').next()?.trim().parse::<f64>().ok())
+        .collect();
+    assert!(ticks.iter().any(|&t| t >= 10.0), "{ticks:?}");
+    let fig8 = std::fs::read_to_string(figs.join("fig8_force_displacement_ls1.2.svg")).unwrap();
+    assert!(fig8.contains("plate force per length (N/m)") && fig8.contains("(mm)"));
+    assert!(!fig8.contains("reduced force"));
+}
