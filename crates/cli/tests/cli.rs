@@ -459,6 +459,31 @@ impl Steps {
     }
 }
 
+/// Run `case` into `run/` beside it, then `tubemem figures --out figs --overlay run EXTRA…`;
+/// (run folder, figures folder).
+fn overlay_figures(case: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
+    let d = case.parent().unwrap();
+    let (run, figs) = (d.join("run"), d.join("figs"));
+    let o = tubemem(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut args = vec![
+        "figures",
+        "--out",
+        figs.to_str().unwrap(),
+        "--overlay",
+        run.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = tubemem(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (run, figs)
+}
+
 fn write_case(name: &str, text: &str) -> PathBuf {
     let d = tmp(name);
     let p = d.join("case.toml");
@@ -748,27 +773,7 @@ fn figures_overlay_a_run_folder() {
         "{}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.05\nsteps = 4\n",
         SMALL_CASE.replace("target_stretch = 1.2", "target_stretch = 1.25")
     );
-    let case = write_case("overlay", &text);
-    let run = case.parent().unwrap().join("run");
-    assert!(tubemem(&[
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap()
-    ])
-    .status
-    .success());
-    let figs = case.parent().unwrap().join("figs");
-    let o = tubemem(&[
-        "figures",
-        "--out",
-        figs.to_str().unwrap(),
-        "--overlay",
-        run.to_str().unwrap(),
-        "--dpi",
-        "150",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (run, figs) = overlay_figures(&write_case("overlay", &text), &["--dpi", "150"]);
     let png = std::fs::read(figs.join("fig8_force_displacement_ls1.25.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"));
     // the PNG's width (IHDR) follows the DPI: 11 in × 150
@@ -857,7 +862,7 @@ fn figures_overlay_a_run_folder() {
         ],
         "the run is Mooney–Rivlin, α = 0.1, the curves are ABB, Kuhn N = 30",
     );
-    let not_a_run = case.parent().unwrap();
+    let not_a_run = run.parent().unwrap();
     assert_clean_failure(
         &[
             "figures",
@@ -2340,28 +2345,7 @@ fn figures_of_runs_with_units_have_dimensional_axes() {
         .replace("length = 8.0", "length = 0.04")
         .replace("shear_modulus = 1.0", "shear_modulus = 4.0e5")
         + "\n[units]\nsystem = \"SI\"\n";
-    let case = write_case("figures-units", &si);
-    let d = case.parent().unwrap().to_path_buf();
-    let run = d.join("run");
-    assert!(tubemem(&[
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap()
-    ])
-    .status
-    .success());
-    let figs = d.join("figs");
-    let o = tubemem(&[
-        "figures",
-        "--out",
-        figs.to_str().unwrap(),
-        "--overlay",
-        run.to_str().unwrap(),
-        "--format",
-        "svg",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, figs) = overlay_figures(&write_case("figures-units", &si), &["--format", "svg"]);
     let fig5 = std::fs::read_to_string(figs.join("fig5_pressure_stretch.svg")).unwrap();
     assert!(fig5.contains("pressure p = ϖμH/R (kPa)"), "Fig. 5's axis");
     // its tick labels reach the tens of kPa (ϖ ≈ 0.5 at λs = 1.2 is 20 kPa), not ϖ's < 1
