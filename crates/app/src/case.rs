@@ -125,9 +125,20 @@ pub struct Case {
     /// the stages resolved by validation (filled by [`Case::parse`])
     #[serde(skip)]
     plan: Vec<StagePlan>,
-    /// the hash of the case text ([`crate::output::case_hash`])
+    /// the hash of the case text ([`case_hash`])
     #[serde(skip)]
     hash: String,
+}
+
+/// FNV-1a (64 bit) of the case text: the record of which case ran (run.json, summary.json,
+/// checkpoints, the VTU field data). The case owns it, so the case module depends on no writer.
+pub fn case_hash(text: &str) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("fnv1a64:{h:016x}")
 }
 
 /// Which converged steps get a VTU frame.
@@ -883,7 +894,7 @@ impl Case {
         let mut case: Case = toml::from_str(text)
             .map_err(|e| CaseError::Syntax(tubemem_material::tidy_numbers(&e.to_string())))?;
         case.plan = case.validate()?;
-        case.hash = crate::output::case_hash(text);
+        case.hash = case_hash(text);
         Ok(case)
     }
 

@@ -397,15 +397,8 @@ fn remove_own_files(path: &Path, folder: &str) -> Result<()> {
 /// would pass this is asked to write fewer or smaller frames rather than fill the disk).
 pub const MAX_VTU_BYTES: u64 = 8 << 30;
 
-/// FNV-1a (64 bit) of the case text: the manifest's record of which case ran.
-pub fn case_hash(text: &str) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in text.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("fnv1a64:{h:016x}")
-}
+/// The case text's hash (kept here for the writers; it belongs to the case).
+pub use crate::case::case_hash;
 
 fn unix_now() -> f64 {
     std::time::SystemTime::now()

@@ -475,7 +475,7 @@ pub struct RunReport {
     pub material_spec: MaterialSpec,
     pub geometry: GeometryInfo,
     pub units: String,
-    /// the hash of the case text ([`crate::output::case_hash`]), as in run.json
+    /// the hash of the case text ([`crate::case::case_hash`]), as in run.json
     #[serde(default)]
     pub case_hash: String,
     /// `[units]`: R, H, μ in SI (None: dimensionless)

@@ -531,3 +531,43 @@ pub enum StageError<E> {
         source: E,
     },
 }
+
+impl<E> std::fmt::Display for StageError<E> {
+    /// What stopped, naming where; the cause is the [`std::error::Error::source`].
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Solve(_) => write!(f, "the stage's solve failed"),
+            Self::Observer { stage, step, .. } => {
+                write!(f, "stage {stage} step {step}: the step's observer failed")
+            }
+        }
+    }
+}
+
+impl<E: std::error::Error + 'static> std::error::Error for StageError<E> {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Self::Solve(e) => Some(e),
+            Self::Observer { source, .. } => Some(source),
+        }
+    }
+}
+
+#[cfg(test)]
+mod error_tests {
+    use super::StageError;
+    use std::error::Error;
+
+    /// A stage's error is a `std::error::Error` whose source is its cause (issue #22: it was
+    /// neither `Display` nor `Error`, so front ends could not walk its chain).
+    #[test]
+    fn a_stage_error_keeps_its_cause_as_source() {
+        let e: StageError<std::io::Error> = StageError::Observer {
+            stage: 2,
+            step: 5,
+            source: std::io::Error::other("disk full"),
+        };
+        assert_eq!(e.to_string(), "stage 2 step 5: the step's observer failed");
+        assert_eq!(e.source().unwrap().to_string(), "disk full");
+    }
+}
