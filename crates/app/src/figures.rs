@@ -186,9 +186,10 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
     (if from_zero && lo >= 0.0 { lo } else { lo - pad }, hi + pad)
 }
 
-/// The share of the plot's width and, per legend line, of its height that a legend covers
-/// (the legend's 16-pixel font on the 1200 × 800 canvas, with its swatch and padding; a long
-/// label is wider).
+/// The share of the plot's width and, per legend line, of its height that a legend covers:
+/// estimates on the safe side, not measured (on the 1100 × 760 canvas a 16-pixel legend line
+/// takes roughly 20 of the plot's ~630 pixels, 0.03; a swatch and a label of 40 characters
+/// about a third of its width), so a point near the legend counts as under it.
 const LEGEND_WIDTH: f64 = 0.5;
 const LEGEND_LINE: f64 = 0.045;
 
@@ -219,6 +220,19 @@ pub struct FigureAudit {
     pub lone_points: usize,
 }
 
+/// The share of the plot's width and height that the legend of `fig` covers.
+fn legend_size(fig: &Figure) -> (f64, f64) {
+    let lines = fig.series.len() + fig.markers.len();
+    (LEGEND_WIDTH, (LEGEND_LINE * lines as f64 + 0.03).min(0.9))
+}
+
+/// Whether the point (u, v) of the unit plot square lies under a legend of `size` in the
+/// corner (`left`, `upper`).
+fn under_legend(u: f64, v: f64, left: bool, upper: bool, size: (f64, f64)) -> bool {
+    let (w, h) = size;
+    (if left { u <= w } else { u >= 1.0 - w }) && (if upper { v >= 1.0 - h } else { v <= h })
+}
+
 /// The [`FigureAudit`] of the top panel of `fig` as [`render_svg`] draws it.
 pub fn audit(fig: &Figure) -> FigureAudit {
     let (x, y) = axes(fig);
@@ -230,10 +244,8 @@ pub fn audit(fig: &Figure) -> FigureAudit {
         .copied()
         .collect();
     let inside = |p: &(f64, f64)| (x.0..=x.1).contains(&p.0) && (y.0..=y.1).contains(&p.1);
-    let corner = legend_corner(fig, x, y);
-    let lines = fig.series.len() + fig.markers.len();
-    let (w, h) = (LEGEND_WIDTH, (LEGEND_LINE * lines as f64 + 0.03).min(0.9));
-    let (left, upper) = match corner {
+    let size = legend_size(fig);
+    let (left, upper) = match legend_corner(fig, x, y) {
         SeriesLabelPosition::UpperRight => (false, true),
         SeriesLabelPosition::LowerLeft => (true, false),
         SeriesLabelPosition::LowerRight => (false, false),
@@ -241,7 +253,7 @@ pub fn audit(fig: &Figure) -> FigureAudit {
     };
     let under = |p: &&(f64, f64)| {
         let (u, v) = ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
-        (if left { u <= w } else { u >= 1.0 - w }) && (if upper { v >= 1.0 - h } else { v <= h })
+        under_legend(u, v, left, upper, size)
     };
     FigureAudit {
         points: all
@@ -262,8 +274,7 @@ pub fn audit(fig: &Figure) -> FigureAudit {
 /// The corner of the plot where the legend covers the fewest points (curve and marker points,
 /// a curve's segments sampled between its points), the upper left on a tie.
 pub fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
-    let lines = fig.series.len() + fig.markers.len();
-    let (w, h) = (LEGEND_WIDTH, (LEGEND_LINE * lines as f64 + 0.03).min(0.9));
+    let size = legend_size(fig);
     let unit = |p: (f64, f64)| ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
     let mut pts: Vec<(f64, f64)> = fig
         .markers
@@ -284,10 +295,7 @@ pub fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> SeriesLabelP
     }
     let covered = |left: bool, upper: bool| {
         pts.iter()
-            .filter(|(u, v)| {
-                (if left { *u <= w } else { *u >= 1.0 - w })
-                    && (if upper { *v >= 1.0 - h } else { *v <= h })
-            })
+            .filter(|(u, v)| under_legend(*u, *v, left, upper, size))
             .count()
     };
     [
@@ -1190,9 +1198,7 @@ fn scaled(mut fig: Figure, sx: f64, sy: f64, x_label: Option<&str>, y_label: &st
             scale(&mut s.points);
         }
         for m in &mut panel.markers {
-            for p in m.points.iter_mut() {
-                *p = (p.0 * sx, p.1 * sy);
-            }
+            scale(&mut m.points);
         }
         panel.y_label = format!("{} (N/m)", panel.y_label);
     }

@@ -1409,6 +1409,8 @@ fn units_give_dimensional_columns_and_no_units_write_no_made_up_value() {
     let mut w = RunWriter::create(&out, FolderMode::Fresh, case.hash(), &[]).unwrap();
     let report = run(&case, "si", &mut [&mut w]).into_result().unwrap();
     let (mu, h, r) = (4.0e5, 5.0e-4, 5.0e-3);
+    // each SI value is two or three products of the dimensionless one, printed at shortest
+    // round trip: equal here to a few ulps, so 1e-14 relative
     let csv = std::fs::read_to_string(out.join("steps.csv")).unwrap();
     let (w_col, p_col) = (column(&csv, "w"), column(&csv, "pressure_pa"));
     let (f_col, fsi) = (column(&csv, "force"), column(&csv, "force_n_per_m"));

@@ -396,12 +396,31 @@ fn run_outcome(
         None => Ok(outcome.report),
         // the exception policy: bad input is ValueError, a solve that fails TubememError
         Some(e) if e.is_input_error() => Err(PyValueError::new_err(e.chain())),
-        Some(e) => Err(TubememError::new_err(format!(
-            "{}; the converged steps are in {}",
-            e.chain(),
-            out.display()
-        ))),
+        Some(e) => Err(TubememError::new_err(failure_message(&e, out))),
     }
+}
+
+/// A failed run's message: its whole chain, and where its converged steps are.
+fn failure_message(e: &tubemem_app::AppError, out: &std::path::Path) -> String {
+    format!(
+        "{}; the converged steps are in {}",
+        e.chain(),
+        out.display()
+    )
+}
+
+/// The writer of a run of `case` into `out`, with the case's checkpoint and frame settings.
+fn run_writer(
+    case: &tubemem_app::case::Case,
+    out: &std::path::Path,
+    mode: tubemem_app::output::FolderMode,
+    inputs: &[&std::path::Path],
+) -> Result<tubemem_app::output::RunWriter, tubemem_app::AppError> {
+    Ok(
+        tubemem_app::output::RunWriter::create(out, mode, case.hash(), inputs)?
+            .checkpoint_every(case.solver.checkpoint_every)
+            .frames_of(case.output),
+    )
 }
 
 /// A converged step, sent from the run's thread to the interpreter's.
@@ -451,7 +470,7 @@ fn run_parsed<'py>(
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::mpsc::RecvTimeoutError;
     use std::sync::Arc;
-    use tubemem_app::output::{FolderMode, RunWriter};
+    use tubemem_app::output::FolderMode;
     let mode = if overwrite {
         FolderMode::Overwrite
     } else {
@@ -478,10 +497,8 @@ fn run_parsed<'py>(
     // the case file (when the label is its path) and its mesh: never written over
     let inputs = tubemem_app::output_file::case_inputs(std::path::Path::new(label), case);
     let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let mut writer = RunWriter::create(out, mode, case.hash(), &inputs)
-        .map_err(|e| PyValueError::new_err(pythonic(&e.chain())))?
-        .checkpoint_every(case.solver.checkpoint_every)
-        .frames_of(case.output);
+    let mut writer = run_writer(case, out, mode, &inputs)
+        .map_err(|e| PyValueError::new_err(pythonic(&e.chain())))?;
     let flag = Arc::new(AtomicBool::new(false));
     let options = tubemem_app::run::RunOptions {
         interrupt: Some(flag.clone()),
@@ -1155,12 +1172,9 @@ fn sweep_member(
     out: &std::path::Path,
     stop: &std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> Result<tubemem_app::report::RunReport, String> {
-    use tubemem_app::output::{FolderMode, RunWriter};
     let case = tubemem_app::case::Case::parse(text).map_err(|e| tubemem_app::error_chain(&e))?;
-    let mut writer = RunWriter::create(out, FolderMode::Overwrite, case.hash(), &[])
-        .map_err(|e| e.chain())?
-        .checkpoint_every(case.solver.checkpoint_every)
-        .frames_of(case.output);
+    let mut writer = run_writer(&case, out, tubemem_app::output::FolderMode::Overwrite, &[])
+        .map_err(|e| e.chain())?;
     let options = tubemem_app::run::RunOptions {
         interrupt: Some(stop.clone()),
         ..Default::default()
@@ -1170,11 +1184,7 @@ fn sweep_member(
     match outcome.error {
         None => Ok(outcome.report),
         Some(e) if e.is_input_error() => Err(e.chain()),
-        Some(e) => Err(format!(
-            "{}; the converged steps are in {}",
-            e.chain(),
-            out.display()
-        )),
+        Some(e) => Err(failure_message(&e, out)),
     }
 }
 

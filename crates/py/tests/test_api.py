@@ -672,6 +672,7 @@ def test_units_reach_the_python_tables(tmp_path):
         + '\n[units]\nsystem = "SI"\n'
     )
     r = tubemem.run(text, str(tmp_path / "si"))
+    # three products in another order than the Rust side's: a few ulps apart, so 1e-14
     np.testing.assert_allclose(r.steps["pressure_pa"], r.steps["w"] * 4.0e5 * 0.0005 / 0.005, rtol=1e-14)
     assert r.summary["units"]["system"] == "SI"
     rows = list(csv.DictReader(open(tmp_path / "si" / "steps.csv")))

@@ -934,6 +934,13 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         if phi.iter().any(|v| !v.is_finite()) {
             return Err(format!("`{q}` is not a value of these runs"));
         }
+        // the family's values relative to `v`, against (h/h_finest)²
+        let against = |v: f64| -> Vec<(f64, f64)> {
+            h.iter()
+                .zip(&vals)
+                .map(|(hh, x)| ((hh * arounds[fine] as f64).powi(2), rel(*x, v)))
+                .collect()
+        };
         let ordered = c
             .spec
             .order_quantities
@@ -962,11 +969,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                 }));
                 series.push(Series {
                     label: format!("{q}: φ/φ_finest − 1 (oscillatory)"),
-                    points: h
-                        .iter()
-                        .zip(&vals)
-                        .map(|(hh, v)| ((hh * arounds[fine] as f64).powi(2), rel(*v, phi[0])))
-                        .collect(),
+                    points: against(phi[0]),
                     color: COLORS[qi % COLORS.len()],
                     stroke: Stroke::Dashed,
                     width: 2,
@@ -1036,7 +1039,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                 }));
                 // against GPS when the check compares with it, else against the extrapolated
                 // value (the family's own limit: what the mesh error is measured from)
-                let (against, label) = match reference {
+                let (reference_value, label) = match reference {
                     Some(reference) => (reference, format!("{q}: FE/GPS − 1")),
                     None => (
                         g.extrapolated,
@@ -1045,11 +1048,7 @@ fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                 };
                 series.push(Series {
                     label,
-                    points: h
-                        .iter()
-                        .zip(&vals)
-                        .map(|(hh, v)| ((hh * arounds[fine] as f64).powi(2), rel(*v, against)))
-                        .collect(),
+                    points: against(reference_value),
                     color: COLORS[qi % COLORS.len()],
                     stroke: Stroke::Solid,
                     width: 2,
@@ -1158,7 +1157,9 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
         needed,
         format!("L/R ≥ {needed:.2} for an end effect |A f(L/R)| ≤ ε = {eps:e}"),
     ));
-    // the other quantities: their laws and lengths, reported
+    // the other quantities: their laws and lengths, reported; (quantity, errors, fit) of each
+    // fitted one, for the details and the plot
+    let mut fitted: Vec<(&str, &[f64], stats::EndFit)> = vec![(q.as_str(), &errors, fit)];
     let mut fits = serde_json::Map::new();
     fits.insert(
         q.clone(),
@@ -1186,6 +1187,7 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
                     more.clone(),
                     serde_json::json!({"errors": errs, "fit": f, "length_for_epsilon": n}),
                 );
+                fitted.push((more.as_str(), errs, f));
             }
             None => {
                 r.measures.push(Measure::reported(
@@ -1214,20 +1216,13 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     // each fitted quantity: the FE points and the law, as log10 |FE/GPS − 1 − c|
     let mut markers = vec![];
     let mut series = vec![];
-    for (k, name) in quantities.iter().enumerate() {
-        let Some(f) = fits
-            .get(name)
-            .and_then(|e| serde_json::from_value::<stats::EndFit>(e["fit"].clone()).ok())
-        else {
-            continue;
-        };
-        let errs: Vec<f64> = f_errors(&fits[name]);
-        let log = |v: f64| v.abs().max(1e-300).log10();
+    let log = |v: f64| v.abs().max(1e-300).log10();
+    for (k, &(name, errs, f)) in fitted.iter().enumerate() {
         markers.push(Markers {
             label: format!("FE, {name}"),
             points: lengths
                 .iter()
-                .zip(&errs)
+                .zip(errs)
                 .map(|(l, e)| (*l, log(e - f.c)))
                 .collect(),
             color: COLORS[k % COLORS.len()],
@@ -1264,14 +1259,6 @@ fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     );
     // the law's measures decide; when they pass the message is the fit
     Ok(None)
-}
-
-/// The errors of one quantity's entry in an end-effect check's `fits`.
-fn f_errors(entry: &serde_json::Value) -> Vec<f64> {
-    entry["errors"]
-        .as_array()
-        .map(|a| a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect())
-        .unwrap_or_default()
 }
 
 /// The core of one profile: (core length on the +z side, on the −z side (None for a model
