@@ -11,7 +11,9 @@
 //! | [`dofs`] | equation numbering: symmetry planes, rigid-body pins, rigid plugs |
 //! | [`pattern`] | the sparsity pattern, built once |
 //! | [`linsolve`] | sparse LDLᵀ on faer (symbolic once, numeric per iteration), inertia |
-//! | [`model`] | assembly of the membrane and contact terms plus the enclosed volume; loads; the membrane problem; the contact augmentation loop |
+//! | [`term`] | force terms: the public [`term::Term`] / [`term::ElementTerm`] interface, the membrane and contact terms |
+//! | [`model`] | the model: assembly of the terms plus the enclosed volume, loads, solves, stability, the membrane problem |
+//! | [`continuation`] | arc-length continuation with located critical points |
 //! | [`newton`] | a damped Newton driver that knows nothing of membranes |
 //! | [`stepping`] | load stepping with cut-back and growth |
 //! | [`post`] | mid-span values, profiles, contact values, cell values |
@@ -37,6 +39,7 @@ pub mod pattern;
 pub mod post;
 pub mod slide;
 pub mod stepping;
+pub mod term;
 
 pub use newton::NewtonSettings;
 
@@ -71,6 +74,13 @@ pub enum FemError {
         gauss_point: usize,
         #[source]
         source: MaterialError,
+    },
+    #[error("term `{term}` at element {element}")]
+    Term {
+        term: String,
+        element: usize,
+        #[source]
+        source: Box<FemError>,
     },
     #[error("node {node} belongs to no element: every node must be a corner of a quad")]
     UnusedNode { node: usize },

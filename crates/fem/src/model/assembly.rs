@@ -6,22 +6,28 @@
 
 use super::*;
 
-/// What one element contributes besides the enclosed volume: the hyperelastic membrane
-/// ([`crate::element`]) and, if any, penalty contact with rigid planes ([`crate::contact`]).
-#[derive(Clone, Copy)]
-pub(super) struct Terms<'a> {
-    pub(super) law: &'a dyn MembraneLaw,
-    pub(super) contact: Option<&'a Contact>,
-    /// the contact multipliers of every element ([`State::multipliers`]; empty: none)
-    pub(super) multipliers: &'a [f64],
-    /// positions whose contact status selects the contact's branch
-    /// ([`Contact::kernel_on_branch`]; none: the positions assembled)
-    pub(super) branch: Option<&'a [[f64; 3]]>,
+/// How an assembly of N-node elements calls an added [`Term`] (its `add_quad4` or `add_quad9`).
+pub(super) type Dispatch<const N: usize, const D: usize> = for<'x> fn(
+    &dyn Term,
+    &ElementAt<'x, N>,
+    &mut SVector<f64, D>,
+    Option<&mut SMatrix<f64, D, D>>,
+) -> Result<f64, FemError>;
+
+/// What one element contributes besides the enclosed volume: the hyperelastic membrane, the
+/// contact with rigid planes if the load has any, and the terms added to the model, in this
+/// order.
+pub(super) struct Terms<'a, const N: usize, const D: usize> {
+    pub(super) membrane: MembraneTerm<'a>,
+    pub(super) contact: Option<ContactTerm<'a>>,
+    pub(super) added: &'a [Box<dyn Term>],
+    pub(super) dispatch: Dispatch<N, D>,
+    pub(super) mesh_nodes: &'a [[f64; 3]],
 }
 
-impl Terms<'_> {
+impl<const N: usize, const D: usize> Terms<'_, N, D> {
     /// Add the energy (returned), residual and, if asked, the stiffness of element `e`.
-    fn add<const N: usize, const D: usize>(
+    fn add(
         &self,
         e: usize,
         el: &RefElement<N>,
@@ -29,18 +35,24 @@ impl Terms<'_> {
         r: &mut SVector<f64, D>,
         mut k: Option<&mut SMatrix<f64, D, D>>,
     ) -> Result<f64, FemError> {
-        let mut energy =
-            membrane_kernel(self.law, el, xe, r, k.as_deref_mut()).map_err(|(gp, source)| {
-                FemError::Material {
+        let at = ElementAt {
+            index: e,
+            reference: el,
+            x: xe,
+            mesh_nodes: self.mesh_nodes,
+        };
+        let mut energy = self.membrane.add(&at, r, k.as_deref_mut())?;
+        if let Some(c) = &self.contact {
+            energy += c.add(&at, r, k.as_deref_mut())?;
+        }
+        for t in self.added {
+            energy += (self.dispatch)(t.as_ref(), &at, r, k.as_deref_mut()).map_err(|source| {
+                FemError::Term {
+                    term: t.name().to_string(),
                     element: e,
-                    gauss_point: gp,
-                    source,
+                    source: Box::new(source),
                 }
             })?;
-        if let Some(c) = self.contact {
-            let lambda = c.element_history(self.multipliers, e, c.samples(el).len());
-            let branch = self.branch.map(|b| el.gather(b));
-            energy += c.kernel_on_branch(el, xe, branch.as_ref(), lambda, r, k);
         }
         Ok(energy)
     }
@@ -113,15 +125,36 @@ impl Model {
         multipliers: &[f64],
         branch: Option<&[[f64; 3]]>,
     ) -> Result<Assembled, FemError> {
-        let terms = Terms {
+        let membrane = MembraneTerm {
             law: self.law.as_ref(),
+        };
+        let contact = contact.map(|contact| ContactTerm {
             contact,
             multipliers,
             branch,
-        };
+        });
+        let (added, mesh_nodes) = (&self.terms[..], &self.mesh.nodes[..]);
         match &self.elements {
-            Elements::Quad4(els) => self.assemble_with::<4, 12>(els, x, tangent, terms),
-            Elements::Quad9(els) => self.assemble_with::<9, 27>(els, x, tangent, terms),
+            Elements::Quad4(els) => {
+                let terms = Terms::<4, 12> {
+                    membrane,
+                    contact,
+                    added,
+                    dispatch: |t, el, r, k| t.add_quad4(el, r, k),
+                    mesh_nodes,
+                };
+                self.assemble_with(els, x, tangent, &terms)
+            }
+            Elements::Quad9(els) => {
+                let terms = Terms::<9, 27> {
+                    membrane,
+                    contact,
+                    added,
+                    dispatch: |t, el, r, k| t.add_quad9(el, r, k),
+                    mesh_nodes,
+                };
+                self.assemble_with(els, x, tangent, &terms)
+            }
         }
     }
 
@@ -131,7 +164,7 @@ impl Model {
         elements: &[RefElement<N>],
         x: &[[f64; 3]],
         tangent: bool,
-        terms: Terms<'_>,
+        terms: &Terms<'_, N, D>,
     ) -> Result<Assembled, FemError> {
         // Each element writes its D × D entries straight into its own contiguous range of
         // the value arrays (the pattern lists entries element by element); the vectors and
@@ -233,7 +266,7 @@ impl Model {
         e: usize,
         el: &RefElement<N>,
         x: &[[f64; 3]],
-        terms: Terms<'_>,
+        terms: &Terms<'_, N, D>,
         mats: Option<(&mut SMatrix<f64, D, D>, &mut SMatrix<f64, D, D>)>,
     ) -> Result<Local<D>, FemError> {
         let xe = el.gather(x);

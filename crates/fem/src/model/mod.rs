@@ -32,13 +32,13 @@
 
 use crate::contact::{Contact, Enforcement, MovingPlanes, UpdateSize};
 use crate::dofs::DofMap;
-use crate::element::membrane_kernel;
 use crate::geometry::{RefElement, Vec3};
 use crate::linsolve::SparseLdlt;
 use crate::newton::{
     self, Augmentation, Evaluation, Inertia, Linearization, NewtonError, NewtonSettings,
 };
 use crate::pattern::Pattern;
+use crate::term::{ContactTerm, ElementAt, ElementTerm, MembraneTerm, Term};
 use crate::FemError;
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
@@ -69,6 +69,8 @@ pub struct Model {
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     mesh: Mesh,
     law: Box<dyn MembraneLaw>,
+    /// force terms added to the membrane and the contact ([`Model::add_term`])
+    terms: Vec<Box<dyn Term>>,
     elements: Elements,
     dofs: DofMap,
     pattern: Pattern,
@@ -107,6 +109,7 @@ impl Model {
             interrupt: None,
             mesh,
             law,
+            terms: Vec::new(),
             elements,
             dofs,
             pattern,
@@ -188,6 +191,17 @@ impl Model {
 
     pub fn law(&self) -> &dyn MembraneLaw {
         self.law.as_ref()
+    }
+
+    /// Add a force term ([`crate::term`]): every assembly from now on sums it, element by
+    /// element, after the membrane and the contact.
+    pub fn add_term(&mut self, term: Box<dyn Term>) {
+        self.terms.push(term);
+    }
+
+    /// The names of the added terms, in the order they are summed.
+    pub fn term_names(&self) -> Vec<&str> {
+        self.terms.iter().map(|t| t.name()).collect()
     }
 
     pub fn elements(&self) -> &Elements {

@@ -55,7 +55,6 @@ pub(super) type TrialAssembly = (State, Assembled, f64);
 /// The membrane equilibrium under one load, as a [`newton::Problem`]: the state is (x, p), the
 /// step (Δx on the free dofs, Δp). With `arc`, the pressure is an unknown and the arc-length
 /// constraint closes the system.
-
 pub(super) struct MembraneProblem<'a> {
     pub(super) model: &'a mut Model,
     pub(super) load: &'a Load,
