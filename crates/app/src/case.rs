@@ -80,13 +80,34 @@ pub enum CaseError {
         #[source]
         source: Box<CaseError>,
     },
-    #[error("{0}")]
-    Syntax(String),
+    #[error(transparent)]
+    Syntax(TomlSyntax),
     #[error("{0}")]
     Invalid(String),
     #[error("[material]")]
     Material(#[source] MaterialError),
 }
+
+/// The TOML reader's error, kept whole ([`TomlSyntax::toml`]: its message, line and column, and
+/// byte span); it displays as the reader's message with its numbers as written in the file
+/// (`1e308`, not the 309 digits of Rust's `{}`).
+#[derive(Debug)]
+pub struct TomlSyntax(pub toml::de::Error);
+
+impl TomlSyntax {
+    /// The TOML reader's own error.
+    pub fn toml(&self) -> &toml::de::Error {
+        &self.0
+    }
+}
+
+impl std::fmt::Display for TomlSyntax {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&tubemem_material::tidy_numbers(&self.0.to_string()))
+    }
+}
+
+impl std::error::Error for TomlSyntax {}
 
 /// The longest tube, in radii: 10,000 (the README's studies go to L/R = 80; at 10,000 even one
 /// element per radius along is 10,000 rings).
@@ -845,10 +866,10 @@ impl Case {
     /// Read and validate a case file; user mesh paths are relative to its folder.
     pub fn read(path: &Path) -> Result<Self, CaseError> {
         let text =
-            tubemem_mesh::io::read_text_limited(path, MAX_CASE_FILE_BYTES).map_err(|reason| {
+            tubemem_mesh::io::read_text_limited(path, MAX_CASE_FILE_BYTES).map_err(|source| {
                 CaseError::Read {
                     path: path.to_path_buf(),
-                    source: std::io::Error::other(reason),
+                    source,
                 }
             })?;
         let mut case = Self::parse(&text).map_err(|e| CaseError::In {
@@ -891,8 +912,7 @@ impl Case {
                 }
             }
         }
-        let mut case: Case = toml::from_str(text)
-            .map_err(|e| CaseError::Syntax(tubemem_material::tidy_numbers(&e.to_string())))?;
+        let mut case: Case = toml::from_str(text).map_err(|e| CaseError::Syntax(TomlSyntax(e)))?;
         case.plan = case.validate()?;
         case.hash = case_hash(text);
         Ok(case)

@@ -294,18 +294,18 @@ pub enum ArcError<E, O> {
 impl<E: fmt::Display, O: fmt::Display> fmt::Display for ArcError<E, O> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Tangent { step, source } => {
-                write!(f, "the path tangent at step {step} failed: {source}")
+            Self::Tangent { step, .. } => {
+                write!(f, "the path tangent at step {step} failed")
             }
             Self::Stalled {
                 step,
                 ds,
                 cuts,
                 load,
-                source,
+                ..
             } => write!(
                 f,
-                "arc-length step {step} from load {load:.9} did not converge after {cuts} halvings (Δs = {ds:.3e}): {source}"
+                "arc-length step {step} from load {load:.9} did not converge after {cuts} halvings (Δs = {ds:.3e})"
             ),
             Self::StepLimit {
                 steps,
@@ -319,8 +319,26 @@ impl<E: fmt::Display, O: fmt::Display> fmt::Display for ArcError<E, O> {
                 f,
                 "arc-length step {step} from load {load:.9}: the path turns by more than the allowed angle even within Δs = {ds:.3e}"
             ),
-            Self::Observer { step, source } => write!(f, "step {step}: {source}"),
-            Self::Final { step, source } => write!(f, "step {step}: {source}"),
+            Self::Observer { step, .. } => write!(f, "the observer failed at step {step}"),
+            Self::Final { step, .. } => write!(f, "stopped at step {step}"),
+        }
+    }
+}
+
+/// The cause of a failed path, as `source()`: the problem's error, or the observer's. Each
+/// variant's own message does not repeat it.
+impl<E, O> std::error::Error for ArcError<E, O>
+where
+    E: std::error::Error + 'static,
+    O: std::error::Error + 'static,
+{
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Self::Tangent { source, .. }
+            | Self::Stalled { source, .. }
+            | Self::Final { source, .. } => Some(source),
+            Self::Observer { source, .. } => Some(source),
+            Self::StepLimit { .. } | Self::Turn { .. } => None,
         }
     }
 }

@@ -105,8 +105,8 @@ pub enum FemError {
     /// iterations.
     #[error("interrupted")]
     Interrupted,
-    #[error("sparse factorization failed: {reason}")]
-    Factorization { reason: String },
+    #[error("sparse factorization failed")]
+    Factorization(#[from] linsolve::FactorizationError),
     #[error("invalid parameter `{name}` = {}: {requirement}", tubemem_material::Num(*value))]
     InvalidParameter {
         name: &'static str,

@@ -11,12 +11,14 @@
 
 use crate::FemError;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltError;
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
     SymbolicCholeskyRaw,
 };
 use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{CreationError, FaerError};
 
 /// Storage of the factor: faer's choice by flop ratio, or forced (for tests and benchmarks).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -28,6 +30,20 @@ pub enum Layout {
 }
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
+
+/// How the sparse factorization failed, with faer's error as the source. A zero pivot of the
+/// numeric LDLᵀ is not one of these: it is [`FemError::ZeroPivot`], with its index.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum FactorizationError {
+    #[error("cannot build the sparsity pattern")]
+    Pattern(#[source] CreationError),
+    #[error("the symbolic analysis failed")]
+    Symbolic(#[source] FaerError),
+    #[error("cannot fill the matrix")]
+    Fill(#[source] FaerError),
+    #[error("no memory for the factorization's workspace")]
+    Workspace(#[source] FaerError),
+}
 
 /// A symmetric sparse matrix pattern (lower triangle) with its symbolic factorization.
 pub struct SparseLdlt {
@@ -59,12 +75,8 @@ impl SparseLdlt {
             .iter()
             .map(|&(r, c)| Pair::new(r.max(c), r.min(c)))
             .collect();
-        let (pattern, argsort) =
-            SymbolicSparseColMat::try_new_from_indices(n, n, &idx).map_err(|e| {
-                FemError::Factorization {
-                    reason: format!("cannot build the sparsity pattern: {e:?}"),
-                }
-            })?;
+        let (pattern, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx)
+            .map_err(FactorizationError::Pattern)?;
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: match layout {
                 Layout::Auto => SupernodalThreshold::AUTO,
@@ -75,9 +87,7 @@ impl SparseLdlt {
         };
         let symbolic =
             factorize_symbolic_cholesky(pattern.as_ref(), Side::Lower, Default::default(), params)
-                .map_err(|e| FemError::Factorization {
-                    reason: format!("symbolic analysis failed: {e:?}"),
-                })?;
+                .map_err(FactorizationError::Symbolic)?;
         let l_values = vec![0.0; symbolic.len_val()];
         Ok(Self {
             n,
@@ -151,16 +161,13 @@ impl SparseLdlt {
             return Err(FemError::NonFiniteEntry { entry });
         }
         let mat = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
-            .map_err(|e| FemError::Factorization {
-                reason: format!("cannot fill the matrix: {e:?}"),
-            })?;
+            .map_err(FactorizationError::Fill)?;
         let par = self.par;
         let req = self
             .symbolic
             .factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
-        let mut mem = MemBuffer::try_new(req).map_err(|_| FemError::Factorization {
-            reason: "out of memory for the factorization workspace".into(),
-        })?;
+        let mut mem = MemBuffer::try_new(req)
+            .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?;
         let reg = LdltRegularization {
             dynamic_regularization_signs: None,
             dynamic_regularization_delta: 0.0,
@@ -176,8 +183,8 @@ impl SparseLdlt {
                 MemStack::new(&mut mem),
                 Default::default(),
             )
-            .map_err(|e| FemError::Factorization {
-                reason: format!("LDLᵀ breakdown: {e:?} (singular tangent)"),
+            .map_err(|e| match e {
+                LdltError::ZeroPivot { index } => FemError::ZeroPivot { index, value: 0.0 },
             })?;
         let d = self.pivots();
         if let Some(index) = d.iter().position(|v| !v.is_finite() || *v == 0.0) {

@@ -37,31 +37,43 @@ pub const MAX_MESH_FILE_BYTES: u64 = 256 << 20;
 
 /// Read at most `limit` bytes of a text file; a longer file (or a device such as /dev/zero)
 /// is refused with its limit named.
-pub fn read_text_limited(path: &Path, limit: u64) -> Result<String, String> {
+pub fn read_text_limited(path: &Path, limit: u64) -> std::io::Result<String> {
     use std::io::Read;
-    let f = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let f = std::fs::File::open(path)?;
     let mut buf = Vec::new();
-    f.take(limit + 1)
-        .read_to_end(&mut buf)
-        .map_err(|e| e.to_string())?;
+    f.take(limit + 1).read_to_end(&mut buf)?;
     if buf.len() as u64 > limit {
-        return Err(format!(
-            "larger than the {} MiB this file may have",
-            limit as f64 / (1u64 << 20) as f64
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "larger than the {} MiB this file may have",
+                limit as f64 / (1u64 << 20) as f64
+            ),
         ));
     }
-    String::from_utf8(buf).map_err(|e| format!("not UTF-8 text ({e})"))
+    String::from_utf8(buf)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, NotUtf8(e)))
 }
+
+/// A file that is not UTF-8 text (the conversion's error as the source).
+#[derive(Debug, thiserror::Error)]
+#[error("not UTF-8 text")]
+pub struct NotUtf8(#[source] pub std::string::FromUtf8Error);
 
 /// Read and check a JSON mesh; coordinates are divided by `radius` (to units of R).
 pub fn read_json(path: &Path, radius: f64) -> Result<Mesh, MeshError> {
-    let err = |reason: String| MeshError::Io {
+    let err = |reason: String| MeshError::File {
         path: path.display().to_string(),
         reason,
     };
-    let text = read_text_limited(path, MAX_MESH_FILE_BYTES).map_err(err)?;
-    let f: MeshFile =
-        serde_json::from_str(&text).map_err(|e| err(format!("not a tubemem mesh file: {e}")))?;
+    let text = read_text_limited(path, MAX_MESH_FILE_BYTES).map_err(|e| MeshError::Io {
+        path: path.display().to_string(),
+        source: crate::Shared::new(e),
+    })?;
+    let f: MeshFile = serde_json::from_str(&text).map_err(|e| MeshError::Json {
+        path: path.display().to_string(),
+        source: crate::Shared::new(e),
+    })?;
     if f.nodes.is_empty() || f.quads.is_empty() {
         return Err(err("the mesh has no nodes or no quads".into()));
     }
@@ -129,12 +141,12 @@ pub fn write_json(path: &Path, mesh: &Mesh) -> Result<(), MeshError> {
         symmetry: mesh.symmetry,
         plugs: mesh.plugs.clone(),
     };
-    let text = serde_json::to_string(&f).map_err(|e| MeshError::Io {
+    let text = serde_json::to_string(&f).map_err(|e| MeshError::Json {
         path: path.display().to_string(),
-        reason: e.to_string(),
+        source: crate::Shared::new(e),
     })?;
     crate::file::write_whole(path, text.as_bytes()).map_err(|e| MeshError::Io {
         path: path.display().to_string(),
-        reason: e.to_string(),
+        source: crate::Shared::new(e),
     })
 }

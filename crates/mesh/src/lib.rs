@@ -81,10 +81,65 @@ pub enum MeshError {
     InwardNormals { volume: f64 },
     #[error("plug {plug}: {reason}")]
     InvalidPlug { plug: usize, reason: String },
+    /// the file system refused a read or a write
+    #[error("{path}")]
+    Io {
+        path: String,
+        #[source]
+        source: Shared<std::io::Error>,
+    },
+    /// a mesh file that is not JSON of the mesh format
+    #[error("{path}: not a tubemem mesh file")]
+    Json {
+        path: String,
+        #[source]
+        source: Shared<serde_json::Error>,
+    },
+    /// a file whose content the reader or writer cannot take (named in `reason`)
     #[error("{path}: {reason}")]
-    Io { path: String, reason: String },
+    File { path: String, reason: String },
     #[error("the mesh is not the case's tube: {reason}")]
     NotTheTube { reason: String },
+}
+
+/// Another crate's error, shared so that [`MeshError`] stays `Clone` and comparable (two are
+/// equal when their messages are). It displays as the error itself and passes its source on;
+/// [`Shared::get`] gives the error back.
+#[derive(Debug)]
+pub struct Shared<E>(pub std::sync::Arc<E>);
+
+impl<E> Shared<E> {
+    pub fn new(e: E) -> Self {
+        Self(std::sync::Arc::new(e))
+    }
+    /// The error itself.
+    pub fn get(&self) -> &E {
+        &self.0
+    }
+}
+
+impl<E> Clone for Shared<E> {
+    fn clone(&self) -> Self {
+        Self(self.0.clone())
+    }
+}
+
+impl<E: std::fmt::Display> PartialEq for Shared<E> {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.to_string() == other.0.to_string()
+    }
+}
+
+impl<E: std::fmt::Display> std::fmt::Display for Shared<E> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl<E: std::error::Error> std::error::Error for Shared<E> {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
 }
 
 /// How far (in R) a user mesh's node may lie off the case's tube ([`Mesh::check_tube`]): 1e-2.

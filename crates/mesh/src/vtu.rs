@@ -26,10 +26,19 @@ pub enum FieldValue<'a> {
     Text(&'a str),
 }
 
-fn io_err(path: &Path, e: impl std::fmt::Display) -> MeshError {
-    MeshError::Io {
+/// What this writer cannot write (a non-finite value, a cell it does not know).
+fn content_err(path: &Path, e: impl std::fmt::Display) -> MeshError {
+    MeshError::File {
         path: path.display().to_string(),
         reason: e.to_string(),
+    }
+}
+
+/// The file system's refusal.
+fn io_err(path: &Path, e: std::io::Error) -> MeshError {
+    MeshError::Io {
+        path: path.display().to_string(),
+        source: crate::Shared::new(e),
     }
 }
 
@@ -145,7 +154,10 @@ pub fn write_vtu<C: AsRef<[usize]>>(
             match value {
                 FieldValue::Numbers(v) => {
                     if v.iter().any(|x| !x.is_finite()) {
-                        return Err(io_err(path, format!("field data `{name}` is not finite")));
+                        return Err(content_err(
+                            path,
+                            format!("field data `{name}` is not finite"),
+                        ));
                     }
                     let text: Vec<String> = v.iter().map(|x| format!("{x:e}")).collect();
                     let _ = writeln!(
@@ -175,7 +187,7 @@ pub fn write_vtu<C: AsRef<[usize]>>(
         quads.len()
     );
     if points.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(io_err(path, "a node coordinate is not finite"));
+        return Err(content_err(path, "a node coordinate is not finite"));
     }
     s.push_str("      <Points>\n");
     let coords: Vec<f64> = points.iter().flatten().copied().collect();
@@ -204,14 +216,14 @@ pub fn write_vtu<C: AsRef<[usize]>>(
             4 => 9,  // VTK_QUAD
             9 => 28, // VTK_BIQUADRATIC_QUAD
             n => {
-                return Err(io_err(
+                return Err(content_err(
                     path,
                     format!("cell {e} has {n} nodes: only 4- and 9-node quads are written"),
                 ))
             }
         });
         if let Some(&i) = q.iter().find(|&&i| i >= points.len()) {
-            return Err(io_err(
+            return Err(content_err(
                 path,
                 format!("cell {e} refers to node {i} of {}", points.len()),
             ));
@@ -248,11 +260,11 @@ pub fn write_vtu<C: AsRef<[usize]>>(
     );
     s.push_str("      </Cells>\n      <PointData>\n");
     for f in point_data {
-        data_array(&mut s, f, points.len(), encoding).map_err(|e| io_err(path, e))?;
+        data_array(&mut s, f, points.len(), encoding).map_err(|e| content_err(path, e))?;
     }
     s.push_str("      </PointData>\n      <CellData>\n");
     for f in cell_data {
-        data_array(&mut s, f, quads.len(), encoding).map_err(|e| io_err(path, e))?;
+        data_array(&mut s, f, quads.len(), encoding).map_err(|e| content_err(path, e))?;
     }
     s.push_str("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
     crate::file::write_whole(path, s.as_bytes()).map_err(|e| io_err(path, e))
