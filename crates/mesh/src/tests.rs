@@ -301,8 +301,15 @@ fn json_mesh_round_trip_and_rejection() {
         "{\n  \"nodes\": [[0, 0, 0]],\n  \"quads\": [[0, 1, 2,]]\n}",
     )
     .unwrap();
-    let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
-    assert!(e.contains("line 3"), "{e}");
+    // the JSON reader's error is kept as the source, and the chain names the line
+    let err = crate::io::read_json(&p, 1.0).unwrap_err();
+    let source = std::error::Error::source(&err).expect("the JSON error as source");
+    let e = format!("{err}: {source}");
+    assert!(matches!(err, crate::MeshError::Json { .. }), "{err:?}");
+    assert!(
+        e.contains("not a tubemem mesh file") && e.contains("line 3"),
+        "{e}"
+    );
     // an element of neither 4 nor 9 nodes, and a mesh mixing the two
     std::fs::write(&p, "{\"nodes\": [[0, 0, 0]], \"quads\": [[0, 1, 2]]}").unwrap();
     let e = crate::io::read_json(&p, 1.0).unwrap_err().to_string();
