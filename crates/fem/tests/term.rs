@@ -137,7 +137,7 @@ fn an_added_term_s_tangent_matches_central_differences_of_its_force() {
                 kv[i]
             );
         }
-        // and the term is in the assembly: the energy grows by its own value
+        // and the term is in the assembly: the same positions have more energy with it than without
         let with = model.assemble(&x, false, None).unwrap().energy;
         let bare = tube(kind, 8).assemble(&x, false, None).unwrap().energy;
         assert!(with > bare, "{kind:?}: the foundation added no energy");
