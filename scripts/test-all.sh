@@ -19,6 +19,10 @@ echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy (all targets, warnings are errors)"
 cargo clippy --workspace --all-targets -- -D warnings
+echo "== cargo doc (library docs, rustdoc warnings are errors)"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --lib
+echo "== module cycles (a module may not depend on one that depends on it)"
+python3 scripts/module-cycles.py
 echo "== cargo test (workspace)"
 cargo test --workspace
 # The Python tests drive the release binary (the same one users run).

@@ -22,17 +22,7 @@ use crate::{AppError, Result};
 use std::f64::consts::{FRAC_PI_2, PI};
 use tubemem_gps::section_at_pressure;
 
-/// Where the fitted node lines go.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Fit {
-    /// the contact edges' reference angles, from the x axis, in [0, 2π) (radians)
-    pub edges: Vec<f64>,
-    /// the locating solve's mid-span pressure ϖ at the stage's end (`None`: the angle was
-    /// given as `contact_edge_angle`)
-    pub pressure: Option<f64>,
-    /// the locating solve's elements around
-    pub locator_around: Option<usize>,
-}
+pub use crate::report::ContactEdgeFit as Fit;
 
 /// The plates' four edges (from the x axis) at `a` from their symmetry line x = 0.
 fn plate_edges(a: f64) -> Vec<f64> {
@@ -74,11 +64,13 @@ pub(crate) fn wall_section_edges(
 }
 
 /// Where the case's mesh is fitted to the contact edges of its last contact stage, or `None`
-/// without `fit_contact_edge` or `contact_edge_angle`. `interrupt` stops the locating solve
-/// ([`crate::run::RunOptions::interrupt`]; the run is then [`AppError::Interrupted`]).
+/// without `fit_contact_edge` or `contact_edge_angle`. `solve` runs the locating case (the
+/// run's own [`crate::run::run_with`], with its interrupt: the run is then
+/// [`AppError::Interrupted`]); it is passed in so that this module, which a run uses to build
+/// its mesh, does not itself depend on the run.
 pub fn contact_edges(
     case: &Case,
-    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    solve: &mut dyn FnMut(&Case) -> crate::report::RunOutcome,
 ) -> Result<Option<Fit>> {
     if !case.mesh.fit_contact_edge && case.mesh.contact_edge_angle.is_none() {
         return Ok(None);
@@ -102,7 +94,7 @@ pub fn contact_edges(
         .into());
     };
     let law = case.material.build()?;
-    let located = locate(case, k, interrupt)?;
+    let located = locate(case, k, solve)?;
     let w = located.w;
     let context = |what: &str| {
         format!(
@@ -146,7 +138,7 @@ pub const LOCATOR_AROUND: usize = 16;
 fn locate(
     case: &Case,
     k: usize,
-    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    solve: &mut dyn FnMut(&Case) -> crate::report::RunOutcome,
 ) -> Result<tubemem_fem::post::MidSpan> {
     let mut coarse = case.clone();
     let around = case.mesh.around.unwrap_or(LOCATOR_AROUND);
@@ -166,11 +158,7 @@ fn locate(
     coarse.mesh.contact_edge_angle = None;
     coarse.stages.truncate(k + 1);
     coarse.truncate_plan(k + 1);
-    let options = crate::run::RunOptions {
-        interrupt: interrupt.cloned(),
-        ..Default::default()
-    };
-    let outcome = crate::run::run_with(&coarse, "contact-edge locator", &options, &mut []);
+    let outcome = solve(&coarse);
     let located = outcome.report.stages.get(k).and_then(|s| match &s.outcome {
         crate::report::StageOutcome::Finished(f) => Some(f.final_state.midspan),
         _ => None,

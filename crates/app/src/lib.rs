@@ -12,7 +12,7 @@
 //! * [`case`]: the case file and its validation into a plan of [`case::StagePlan`]s (stage targets resolved
 //!   once).
 //! * [`run`]: the FE run: [`run::run`] returns a [`report::RunReport`] and calls
-//!   [`run::Observer`]s at every converged step and stage end.
+//!   [`observer::Observer`]s at every converged step and stage end.
 //! * [`output`]: the writer that turns the report into files while the run goes on.
 //! * [`curves`], [`figures`], [`main_job`]: closed-form curves, the paper's figures, and the
 //!   main job on the embedded default case.
@@ -20,6 +20,7 @@
 //! Errors are typed ([`AppError`], [`case::CaseError`]) and keep their cause as `source()`.
 
 pub mod case;
+pub mod checkpoint;
 pub mod curves;
 pub mod edge_fit;
 pub mod edge_track;
@@ -27,6 +28,8 @@ pub mod export;
 pub mod figures;
 mod journal;
 pub mod main_job;
+pub mod model_setup;
+pub mod observer;
 pub mod output;
 pub mod output_file;
 pub mod report;

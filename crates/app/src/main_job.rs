@@ -8,9 +8,10 @@
 //! 3. The figures (Figs. 5–7, λz) with the FE points overlaid.
 
 use crate::case::Case;
+use crate::observer::Observer;
 use crate::output::{FolderMode, RunWriter};
 use crate::report::RunReport;
-use crate::run::{run, Observer};
+use crate::run::run;
 use crate::{figures, AppError, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

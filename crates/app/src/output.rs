@@ -18,8 +18,9 @@
 //! dies with its process), and refuses a folder that already holds a run unless told to
 //! overwrite it, so frames of an earlier run can never mix with a new one.
 
+use crate::checkpoint::{read_checkpoint, write_checkpoint, Checkpoint};
+use crate::observer::{BoxError, Observer, StepView};
 use crate::report::{RunReport, StepRecord};
-use crate::run::{BoxError, Checkpoint, Observer, StepView};
 use crate::{AppError, Result};
 use std::fs::File;
 use std::io::Write;
@@ -446,92 +447,6 @@ pub struct RunWriter {
     vtu: crate::case::OutputSpec,
 }
 
-/// The first checkpoint format: the state's positions and pressure (and the previous state's).
-const CHECKPOINT_MAGIC_V1: &[u8; 12] = b"TUBEMEMCKPT1";
-/// The second adds the state's contact multipliers (an augmented-Lagrangian squeeze).
-const CHECKPOINT_MAGIC: &[u8; 12] = b"TUBEMEMCKPT2";
-
-/// Write a checkpoint: magic, header length (u64 LE), the header as JSON (exact floats), the
-/// node count and the multiplier count (u64 LE), the positions, the pressure and the
-/// multipliers as f64 LE, then the previous state's positions and pressure when there is one.
-fn write_checkpoint(path: &Path, ck: &Checkpoint) -> Result<()> {
-    let header = serde_json::to_vec(ck).map_err(|e| AppError::Output {
-        what: path.display().to_string(),
-        source: Box::new(e),
-    })?;
-    let mut buf =
-        Vec::with_capacity(48 + header.len() + 48 * ck.x.len() + 8 * ck.multipliers.len());
-    buf.extend_from_slice(CHECKPOINT_MAGIC);
-    buf.extend_from_slice(&(header.len() as u64).to_le_bytes());
-    buf.extend_from_slice(&header);
-    buf.extend_from_slice(&(ck.x.len() as u64).to_le_bytes());
-    buf.extend_from_slice(&(ck.multipliers.len() as u64).to_le_bytes());
-    for p in &ck.x {
-        for v in p {
-            buf.extend_from_slice(&v.to_le_bytes());
-        }
-    }
-    buf.extend_from_slice(&ck.p.to_le_bytes());
-    for v in &ck.multipliers {
-        buf.extend_from_slice(&v.to_le_bytes());
-    }
-    // the stepping's previous state, same layout, when there is one (an older checkpoint
-    // without it reads as none)
-    if let Some((x, p)) = &ck.previous {
-        for q in x {
-            for v in q {
-                buf.extend_from_slice(&v.to_le_bytes());
-            }
-        }
-        buf.extend_from_slice(&p.to_le_bytes());
-    }
-    crate::output_file::write_whole(path, &buf)
-}
-
-/// Read a checkpoint written by [`write_checkpoint`]; `None` if it is not a whole one.
-fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
-    let buf = std::fs::read(path).ok()?;
-    let (rest, v2) = match buf.strip_prefix(CHECKPOINT_MAGIC) {
-        Some(r) => (r, true),
-        None => (buf.strip_prefix(CHECKPOINT_MAGIC_V1)?, false),
-    };
-    let u64_at =
-        |b: &[u8]| -> Option<u64> { Some(u64::from_le_bytes(b.get(..8)?.try_into().ok()?)) };
-    let hl = usize::try_from(u64_at(rest)?).ok()?;
-    let header = rest.get(8..8usize.checked_add(hl)?)?;
-    let mut ck: Checkpoint = serde_json::from_slice(header).ok()?;
-    let rest = rest.get(8 + hl..)?;
-    let n = usize::try_from(u64_at(rest)?).ok()?;
-    let (m, data) = if v2 {
-        let rest = rest.get(8..)?;
-        (usize::try_from(u64_at(rest)?).ok()?, rest.get(8..)?)
-    } else {
-        (0, rest.get(8..)?)
-    };
-    let one = n.checked_mul(24)?.checked_add(8)?;
-    let state_len = one.checked_add(m.checked_mul(8)?)?;
-    if data.len() != state_len && data.len() != state_len.checked_add(one)? {
-        return None;
-    }
-    // the length is checked above: 3n coordinates and the pressure, 8 bytes each
-    let v: Vec<f64> = data
-        .chunks_exact(8)
-        .map(|c| {
-            let mut b = [0u8; 8];
-            b.copy_from_slice(c);
-            f64::from_le_bytes(b)
-        })
-        .collect();
-    let positions =
-        |w: &[f64]| -> Vec<[f64; 3]> { w.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
-    ck.x = positions(&v[..3 * n]);
-    ck.p = v[3 * n];
-    let s = 3 * n + 1 + m;
-    ck.multipliers = v[3 * n + 1..s].to_vec();
-    ck.previous = (v.len() > s).then(|| (positions(&v[s..s + 3 * n]), v[s + 3 * n]));
-    Some(ck)
-}
-
 impl RunWriter {
     /// Take the folder `dir` for a run of the case whose text hashes to `case_hash`
     /// ([`case_hash`]): create it, lock it, and refuse (`Fresh`) or clear (`Overwrite`) an
@@ -605,11 +520,8 @@ impl RunWriter {
             .filter_map(|k| read_checkpoint(&dir.join("checkpoints").join(format!("ckpt-{k}.bin"))))
             .max_by_key(|c| c.rows)
             .ok_or_else(|| folder("no whole checkpoint in checkpoints/".into()))?;
-        if ck.case_hash != case_hash {
-            return Err(folder(format!(
-                "the case has changed since the run started (hash {} then, {case_hash} now): resume with the same case file, or start afresh with --overwrite",
-                ck.case_hash
-            )));
+        if let Some(message) = ck.mismatch(case_hash, None) {
+            return Err(folder(message));
         }
         // steps.csv: the header and the checkpoint's rows
         let path = dir.join("steps.csv");

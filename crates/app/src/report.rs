@@ -28,7 +28,7 @@ pub struct MeshInfo {
     pub factor_flops: f64,
     /// where the hoop node line was fitted to the contact edge (`[mesh] fit_contact_edge`)
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub contact_edge_fit: Option<crate::edge_fit::Fit>,
+    pub contact_edge_fit: Option<ContactEdgeFit>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -600,4 +600,31 @@ impl RunReport {
 /// (FE − closed form)/|closed form|.
 pub fn rel(fe: f64, cf: f64) -> f64 {
     (fe - cf) / cf.abs().max(1e-300)
+}
+
+/// Where the fitted node lines go (`[mesh] fit_contact_edge`, [`crate::edge_fit`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ContactEdgeFit {
+    /// the contact edges' reference angles, from the x axis, in [0, 2π) (radians)
+    pub edges: Vec<f64>,
+    /// the locating solve's mid-span pressure ϖ at the stage's end (`None`: the angle was
+    /// given as `contact_edge_angle`)
+    pub pressure: Option<f64>,
+    /// the locating solve's elements around
+    pub locator_around: Option<usize>,
+}
+
+/// A run's outcome: the report (always, with every converged step) and the error if it failed.
+pub struct RunOutcome {
+    pub report: RunReport,
+    pub error: Option<crate::AppError>,
+}
+
+impl RunOutcome {
+    pub fn into_result(self) -> crate::Result<RunReport> {
+        match self.error {
+            None => Ok(self.report),
+            Some(e) => Err(e),
+        }
+    }
 }

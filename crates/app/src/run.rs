@@ -1,7 +1,10 @@
 //! The FE run of a case: plan → mesh → model → stepping → [`RunReport`], with observers called
 //! at every converged step (writers, progress displays, interrupt checks).
 
-use crate::case::{Caps, Case, PenaltySpec, StagePlan, Target};
+use crate::case::{Case, PenaltySpec, StagePlan, Target};
+use crate::checkpoint::{checkpoint_edges, Checkpoint, StageContext};
+use crate::model_setup::{check_memory, equations_estimate, sideways_planes};
+use crate::observer::{BoxError, Observer, StepView};
 use crate::report::*;
 use crate::{AppError, Result};
 use tubemem_fem::contact::{penalty_for, Contact, Enforcement, MovingPlanes};
@@ -12,80 +15,12 @@ use tubemem_fem::stepping::{run_stage_refitted, Stage, StageError, StepInfo, Ste
 use tubemem_fem::NewtonSettings;
 use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
-use tubemem_mesh::hoop::HoopMap;
-use tubemem_mesh::tube::{capped_tube_fitted_of, plugged_tube_of};
-use tubemem_mesh::Mesh;
 
 /// The largest penetration of the plates, as a fraction of the plate half-gap ρ, that a squeeze
 /// step accepts: 5 %. Beyond it the contact is not resolved (the shipped squeezes penetrate
 /// 0.2 % of ρ at the default tolerance), and the results would be the penalty's, not the
 /// membrane's.
 pub const MAX_PENETRATION_FRACTION: f64 = 0.05;
-
-/// An observer's error: it stops the run (which then reports it with stage and step).
-pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
-
-/// What an observer sees at a converged step.
-pub struct StepView<'a> {
-    /// the run so far: the finished stages
-    pub report: &'a RunReport,
-    /// the current stage's steps so far, this one last
-    pub stage_steps: &'a [StepRecord],
-    /// the critical points the current stage has located so far (arc-length stages)
-    pub stage_critical_points: &'a [CriticalRecord],
-    /// how the current stage was set up, and where its stepping stands (for checkpoints)
-    pub context: &'a StageContext,
-    pub progress: tubemem_fem::stepping::StepState,
-    pub model: &'a Model,
-    pub state: &'a State,
-    pub load: &'a Load,
-    pub plan: &'a StagePlan,
-    pub stages: usize,
-    pub record: &'a StepRecord,
-    /// the fraction of the stage done
-    pub fraction: f64,
-    /// the converged state before this one in the stage (the stepping's secant predictor
-    /// continues from both after a restart)
-    pub previous: Option<&'a State>,
-}
-
-/// Called by [`run`] as it goes. Every method has a no-op default.
-pub trait Observer {
-    /// The model is built and `state` is the reference configuration.
-    fn started(
-        &mut self,
-        _report: &RunReport,
-        _model: &Model,
-        _state: &State,
-    ) -> Result<(), BoxError> {
-        Ok(())
-    }
-    fn stage_started(&mut self, _plan: &StagePlan, _stages: usize) {}
-    /// A converged step; an error stops the run.
-    fn step(&mut self, _view: &StepView) -> Result<(), BoxError> {
-        Ok(())
-    }
-    /// A stage finished; its report is the last of `report.stages`.
-    fn stage_finished(&mut self, _report: &RunReport) -> Result<(), BoxError> {
-        Ok(())
-    }
-    fn finished(&mut self, _report: &RunReport) -> Result<(), BoxError> {
-        Ok(())
-    }
-    /// The run failed; `report` holds every converged step, and the failed stage's error.
-    fn failed(&mut self, _report: &RunReport, _error: &AppError) {}
-    /// An arc-length stage located a critical point (`state` there; `mode` the critical mode
-    /// of a bifurcation as nodal vectors), reported before the step that follows it.
-    fn critical(
-        &mut self,
-        _record: &CriticalRecord,
-        _model: &Model,
-        _state: &State,
-        _mode: Option<&[[f64; 3]]>,
-    ) -> Result<(), BoxError> {
-        Ok(())
-    }
-}
 
 /// After a pressure-controlled stage failed below its target: follow the path by arc length from
 /// the last converged `state` towards `target` and return the first pressure maximum located on
@@ -234,93 +169,6 @@ fn critical_record(
         mode,
     });
     Ok(())
-}
-
-/// A run's outcome: the report (always, with every converged step) and the error if it failed.
-pub struct RunOutcome {
-    pub report: RunReport,
-    pub error: Option<AppError>,
-}
-
-impl RunOutcome {
-    pub fn into_result(self) -> Result<RunReport> {
-        match self.error {
-            None => Ok(self.report),
-            Some(e) => Err(e),
-        }
-    }
-}
-
-/// The contact edges a tracked mesh had at a checkpoint's step: its own stage's last record
-/// with them, else the finished stages' (`None`: never fitted, the uniform mesh).
-fn checkpoint_edges(ck: &Checkpoint) -> Option<Vec<f64>> {
-    ck.steps
-        .iter()
-        .rev()
-        .chain(
-            ck.report
-                .stages
-                .iter()
-                .rev()
-                .flat_map(|s| s.steps.iter().rev()),
-        )
-        .find_map(|r| r.edge_tracking.as_ref())
-        .map(|t| t.edges.clone())
-        .filter(|e| !e.is_empty())
-}
-
-/// Build the mesh a case asks for.
-pub fn build_mesh(case: &Case) -> Result<Mesh> {
-    build_mesh_with_fit(case, None).map(|(m, _)| m)
-}
-
-/// [`build_mesh`], with where its node line was fitted to the contact edge (`[mesh]
-/// fit_contact_edge`, [`crate::edge_fit`]); `interrupt` stops its locating solve as it stops
-/// the run ([`RunOptions::interrupt`]).
-pub fn build_mesh_with_fit(
-    case: &Case,
-    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
-) -> Result<(Mesh, Option<crate::edge_fit::Fit>)> {
-    let g = &case.geometry;
-    let ll = g.length / g.radius;
-    match (&case.mesh.file, case.mesh.around, case.mesh.along) {
-        (Some(file), ..) => {
-            let path = case.base_dir.join(file);
-            tubemem_mesh::io::read_json(&path, g.radius)
-                .and_then(|m| {
-                    // the mesh's own faults first (plugs, unused nodes, orientation), then
-                    // whether it is the case's tube at all
-                    m.check()?;
-                    m.check_tube(0.5 * ll, g.caps == Caps::Hemisphere)?;
-                    Ok((m, None))
-                })
-                .map_err(|source| AppError::MeshFile {
-                    file: file.clone(),
-                    source,
-                })
-        }
-        (None, Some(around), Some(along)) => {
-            let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
-            let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
-            let fit = crate::edge_fit::contact_edges(case, interrupt)?;
-            let map = match &fit {
-                Some(f) => Some(HoopMap::fitted(around, &f.edges).map_err(AppError::Mesh)?),
-                None => None,
-            };
-            match g.caps {
-                Caps::Hemisphere => {
-                    capped_tube_fitted_of(kind, 1.0, ll, around, along, cap_rows, sym, map.as_ref())
-                }
-                Caps::RigidPlug => plugged_tube_of(kind, 1.0, ll, around, along, sym),
-            }
-            .map(|m| (m, fit))
-            .map_err(AppError::Mesh)
-        }
-        _ => Err(crate::case::CaseError::Invalid(
-            "[mesh] needs `around` and `along`, or `file`".into(),
-        )
-        .into()),
-    }
 }
 
 /// The closed form at one step (see [`StepClosedForm`]).
@@ -481,109 +329,6 @@ fn stage_closed_form(
         _ => (None, None),
     };
     Ok((both, section, errors))
-}
-
-/// The estimated peak memory of a model with `equations` equations: 8 MiB + 240 B·n·log2 n.
-/// Fitted to the measured peak RSS of pressure-controlled runs (release, this 2-core machine):
-/// 19.7, 56.9, 167 and 414 MiB at 4,520, 16,280, 47,904 and 104,448 equations (the fit is
-/// within 10 % there); at 978,432 equations it gives 4.7 GiB against the 3.6 GiB measured, so
-/// it errs on the safe side as the factor's fill grows more slowly than n log n.
-pub fn memory_estimate(equations: usize) -> u64 {
-    let n = equations.max(2) as f64;
-    (8.0 * (1u64 << 20) as f64 + 240.0 * n * n.log2()) as u64
-}
-
-/// The equations of the case's generated tube, counted before it is built: the full tube has
-/// about around·along cylinder cells plus 2·(around²/16 + around·cap_rows) in the two
-/// cube-sphere caps, a node per cell (four for the 9-node element), three unknowns each,
-/// divided by the symmetry multiplicity (within 3 % of the built shipped cases).
-pub fn equations_estimate(case: &Case) -> Option<usize> {
-    let (around, along) = (case.mesh.around? as f64, case.mesh.along? as f64);
-    // each cap: a top face of (around/4)² cells and four side faces of around/4 × cap_rows
-    let rows = case.mesh.cap_rows.map_or(around / 8.0, |r| r as f64);
-    let cells = around * along + 2.0 * (around * around / 16.0 + around * rows);
-    // a 9-node element has about four nodes per cell (the lattice of twice the resolution)
-    let per_cell = match case.mesh.element {
-        tubemem_mesh::ElementKind::Quad4 => 1.0,
-        tubemem_mesh::ElementKind::Quad9 => 4.0,
-    };
-    let equations = 3.0 * per_cell * cells / case.mesh.symmetry.multiplicity();
-    // saturating: a key of 2⁶³ − 1 elements is an estimate of usize::MAX, not an overflow
-    Some(if equations < usize::MAX as f64 {
-        equations as usize
-    } else {
-        usize::MAX
-    })
-}
-
-/// The memory this machine has available (`MemAvailable` of /proc/meminfo), if it says.
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-fn check_memory(equations: usize, force: bool) -> Result<()> {
-    if force {
-        return Ok(());
-    }
-    let estimate = memory_estimate(equations);
-    match available_memory() {
-        Some(available) if estimate > available => Err(AppError::TooLarge {
-            equations,
-            estimate_bytes: estimate,
-            available_bytes: available,
-        }),
-        _ => Ok(()),
-    }
-}
-
-/// What a stage is set up with at its start. A checkpoint stores it, so that a restart
-/// continues the stage exactly as the interrupted run would have.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct StageContext {
-    pub stage: usize,
-    /// the load parameter at the start and the end of the stage
-    pub from: f64,
-    pub to: f64,
-    /// Boyle's constant of a squeeze (0 otherwise)
-    pub pv: f64,
-    /// the contact penalty of a squeeze (0 otherwise)
-    pub penalty: f64,
-    /// the mid-span λs at the stage start (λs* of a squeeze)
-    pub start_lambda_s: f64,
-}
-
-/// A run's state after a converged step, to restart from ([`crate::output::RunWriter`] writes
-/// them, [`crate::output::RunWriter::resume`] reads the newest back).
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Checkpoint {
-    pub case_hash: String,
-    pub context: StageContext,
-    pub progress: tubemem_fem::stepping::StepState,
-    /// the finished stages
-    pub report: RunReport,
-    /// the current stage's steps so far
-    pub steps: Vec<StepRecord>,
-    /// the critical points the current stage (arc length) has located so far
-    #[serde(default)]
-    pub critical_points: Vec<CriticalRecord>,
-    /// steps.csv rows and VTU frames written up to this step, and the PVD entries
-    pub rows: usize,
-    pub frames: usize,
-    pub pvd: Vec<(f64, String)>,
-    /// the state (stored in binary beside the header)
-    #[serde(skip)]
-    pub x: Vec<[f64; 3]>,
-    #[serde(skip)]
-    pub p: f64,
-    /// the state's contact multipliers (an augmented squeeze; empty otherwise)
-    #[serde(skip)]
-    pub multipliers: Vec<f64>,
-    /// the converged state before it in the stage, if any (in binary after the state)
-    #[serde(skip)]
-    pub previous: Option<(Vec<[f64; 3]>, f64)>,
 }
 
 /// How a run is driven from outside.
@@ -872,22 +617,6 @@ pub fn fe_moving_planes(planes: &[crate::case::PlaneSpec], penalty: f64) -> Movi
     }
 }
 
-/// Whether some confine stage of `case` has planes that are not symmetric about x = 0
-/// (`[0]`) or y = 0 (`[1]`): such planes push the tube sideways, which the rigid-mode pins on
-/// the axis x = y = 0 (the caps' poles) must not resist (`Model::soften_rigid_pins`).
-pub fn sideways_planes(case: &Case) -> [bool; 2] {
-    let mut out = [false, false];
-    for stage in &case.stages {
-        for (axis, flag) in out.iter_mut().enumerate() {
-            *flag |= !stage
-                .plane
-                .iter()
-                .all(|p| p.mirrored_in(&stage.plane, axis));
-        }
-    }
-    out
-}
-
 /// The FE contact of a confine stage at load parameter `t`: each wall n·x ≤ d as the kernel's
 /// plane with gap −n·x + d ≥ 0 (unit normal, in the cross-section plane).
 pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Contact {
@@ -907,6 +636,27 @@ pub fn fe_planes(planes: &[crate::case::PlaneSpec], t: f64, penalty: f64) -> Con
         enforcement: tubemem_fem::contact::Enforcement::Penalty,
         points: Default::default(),
     }
+}
+
+/// Build the mesh a case asks for.
+pub fn build_mesh(case: &Case) -> Result<tubemem_mesh::Mesh> {
+    build_mesh_with_fit(case, None).map(|(m, _)| m)
+}
+
+/// [`build_mesh`], with where its node line was fitted to the contact edge (`[mesh]
+/// fit_contact_edge`, [`crate::edge_fit`]: a locating run of the case on a coarse mesh, which
+/// `interrupt` stops as it stops the run, [`RunOptions::interrupt`]).
+pub fn build_mesh_with_fit(
+    case: &Case,
+    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> Result<(tubemem_mesh::Mesh, Option<ContactEdgeFit>)> {
+    let options = RunOptions {
+        interrupt: interrupt.cloned(),
+        ..Default::default()
+    };
+    crate::model_setup::mesh_of(case, &mut |coarse| {
+        run_with(coarse, "contact-edge locator", &options, &mut [])
+    })
 }
 
 /// Run a validated case; `label` names it in the report. Observers see every converged step as
@@ -1044,20 +794,10 @@ fn run_inner(
         warnings: vec![],
     });
     if let Some(ck) = &options.resume {
-        if ck.case_hash != case.hash() {
+        if let Some(message) = ck.mismatch(case.hash(), Some(state.x.len())) {
             return Err(AppError::Folder {
                 path: std::path::PathBuf::from(label),
-                message: format!(
-                    "the case has changed since the run started (hash {} then, {} now): resume with the same case file, or start afresh with --overwrite",
-                    ck.case_hash,
-                    case.hash()
-                ),
-            });
-        }
-        if ck.x.len() != state.x.len() {
-            return Err(AppError::Folder {
-                path: std::path::PathBuf::from(label),
-                message: "the checkpoint's state does not fit the case's mesh".into(),
+                message,
             });
         }
         *report = ck.report.clone();

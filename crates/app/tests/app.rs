@@ -988,7 +988,7 @@ fn an_edge_fit_it_cannot_make_is_a_clear_error() {
 /// caps' poles), the channel's and the plates' are symmetric about both planes.
 #[test]
 fn sideways_planes_are_found_from_the_case() {
-    use tubemem_app::run::sideways_planes;
+    use tubemem_app::model_setup::sideways_planes;
     let groove = Case::parse(include_str!("../../../cases/vgroove_abb30_ls1.3.toml")).unwrap();
     let channel = Case::parse(include_str!("../../../cases/channel_abb30_ls1.3.toml")).unwrap();
     let plates = Case::parse(include_str!("../../../cases/squeeze_abb30_ls1.3.toml")).unwrap();
@@ -1029,7 +1029,8 @@ fn contradictory_contact_keys_are_refused_not_changed() {
 /// class 2).
 #[test]
 fn the_memory_guard_counts_every_node_before_building() {
-    use tubemem_app::run::{build_mesh, equations_estimate};
+    use tubemem_app::model_setup::equations_estimate;
+    use tubemem_app::run::build_mesh;
     for text in [
         include_str!("../../../cases/squeeze_abb30_ls1.3.toml"),
         include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml"),

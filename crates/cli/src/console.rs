@@ -6,8 +6,8 @@ use crate::say;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use tubemem_app::case::StagePlan;
+use tubemem_app::observer::{BoxError, Observer, StepView};
 use tubemem_app::report::{rel, ClosedFormState, LocalSection, RunReport, StageOutcome};
-use tubemem_app::run::{BoxError, Observer, StepView};
 use tubemem_fem::model::{Model, State};
 
 /// Prints a run's progress and results.

@@ -12,8 +12,9 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use tubemem_app::case::Case;
+use tubemem_app::observer::Observer;
 use tubemem_app::output::{FolderMode, RunWriter};
-use tubemem_app::run::{Observer, RunOptions};
+use tubemem_app::run::RunOptions;
 use tubemem_cli::console::Console;
 use tubemem_cli::gps_cmd;
 

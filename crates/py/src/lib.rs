@@ -389,7 +389,7 @@ fn resultants(l1: f64, l2: f64, material: Option<&Bound<'_, PyAny>>) -> PyResult
 /// A run's outcome: its typed report (the summary dict and the step arrays are made from it,
 /// not read back from disk), or `TubememError` with the whole cause chain.
 fn run_outcome(
-    outcome: tubemem_app::run::RunOutcome,
+    outcome: tubemem_app::report::RunOutcome,
     out: &std::path::Path,
 ) -> PyResult<tubemem_app::report::RunReport> {
     match outcome.error {
@@ -437,8 +437,11 @@ struct StepNote {
 /// The observer that forwards every converged step to the interpreter's thread.
 struct Notify(std::sync::mpsc::Sender<StepNote>);
 
-impl tubemem_app::run::Observer for Notify {
-    fn step(&mut self, v: &tubemem_app::run::StepView) -> Result<(), tubemem_app::run::BoxError> {
+impl tubemem_app::observer::Observer for Notify {
+    fn step(
+        &mut self,
+        v: &tubemem_app::observer::StepView,
+    ) -> Result<(), tubemem_app::observer::BoxError> {
         let r = v.record;
         // a closed channel means the interpreter side has gone: nothing to tell
         let _ = self.0.send(StepNote {

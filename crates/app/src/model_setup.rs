@@ -1,0 +1,130 @@
+//! The mesh and the model a case asks for, and the memory guard that runs before anything
+//! large is built.
+
+use crate::case::{Caps, Case};
+use crate::{AppError, Result};
+use tubemem_mesh::hoop::HoopMap;
+use tubemem_mesh::tube::{capped_tube_fitted_of, plugged_tube_of};
+use tubemem_mesh::Mesh;
+
+/// The mesh a case asks for, with where its node lines were fitted to the contact edges
+/// (`[mesh] fit_contact_edge`); `solve` runs [`crate::edge_fit`]'s locating case (the caller's
+/// run, which uses this function to build its own mesh). Most callers want
+/// [`crate::run::build_mesh`].
+pub fn mesh_of(
+    case: &Case,
+    solve: &mut dyn FnMut(&Case) -> crate::report::RunOutcome,
+) -> Result<(Mesh, Option<crate::report::ContactEdgeFit>)> {
+    let g = &case.geometry;
+    let ll = g.length / g.radius;
+    match (&case.mesh.file, case.mesh.around, case.mesh.along) {
+        (Some(file), ..) => {
+            let path = case.base_dir.join(file);
+            tubemem_mesh::io::read_json(&path, g.radius)
+                .and_then(|m| {
+                    // the mesh's own faults first (plugs, unused nodes, orientation), then
+                    // whether it is the case's tube at all
+                    m.check()?;
+                    m.check_tube(0.5 * ll, g.caps == Caps::Hemisphere)?;
+                    Ok((m, None))
+                })
+                .map_err(|source| AppError::MeshFile {
+                    file: file.clone(),
+                    source,
+                })
+        }
+        (None, Some(around), Some(along)) => {
+            let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
+            let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
+            let fit = crate::edge_fit::contact_edges(case, solve)?;
+            let map = match &fit {
+                Some(f) => Some(HoopMap::fitted(around, &f.edges).map_err(AppError::Mesh)?),
+                None => None,
+            };
+            match g.caps {
+                Caps::Hemisphere => {
+                    capped_tube_fitted_of(kind, 1.0, ll, around, along, cap_rows, sym, map.as_ref())
+                }
+                Caps::RigidPlug => plugged_tube_of(kind, 1.0, ll, around, along, sym),
+            }
+            .map(|m| (m, fit))
+            .map_err(AppError::Mesh)
+        }
+        _ => Err(crate::case::CaseError::Invalid(
+            "[mesh] needs `around` and `along`, or `file`".into(),
+        )
+        .into()),
+    }
+}
+
+/// The estimated peak memory of a model with `equations` equations: 8 MiB + 240 B·n·log2 n.
+/// Fitted to the measured peak RSS of pressure-controlled runs (release, this 2-core machine):
+/// 19.7, 56.9, 167 and 414 MiB at 4,520, 16,280, 47,904 and 104,448 equations (the fit is
+/// within 10 % there); at 978,432 equations it gives 4.7 GiB against the 3.6 GiB measured, so
+/// it errs on the safe side as the factor's fill grows more slowly than n log n.
+pub fn memory_estimate(equations: usize) -> u64 {
+    let n = equations.max(2) as f64;
+    (8.0 * (1u64 << 20) as f64 + 240.0 * n * n.log2()) as u64
+}
+
+/// The equations of the case's generated tube, counted before it is built: the full tube has
+/// about around·along cylinder cells plus 2·(around²/16 + around·cap_rows) in the two
+/// cube-sphere caps, a node per cell (four for the 9-node element), three unknowns each,
+/// divided by the symmetry multiplicity (within 3 % of the built shipped cases).
+pub fn equations_estimate(case: &Case) -> Option<usize> {
+    let (around, along) = (case.mesh.around? as f64, case.mesh.along? as f64);
+    // each cap: a top face of (around/4)² cells and four side faces of around/4 × cap_rows
+    let rows = case.mesh.cap_rows.map_or(around / 8.0, |r| r as f64);
+    let cells = around * along + 2.0 * (around * around / 16.0 + around * rows);
+    // a 9-node element has about four nodes per cell (the lattice of twice the resolution)
+    let per_cell = match case.mesh.element {
+        tubemem_mesh::ElementKind::Quad4 => 1.0,
+        tubemem_mesh::ElementKind::Quad9 => 4.0,
+    };
+    let equations = 3.0 * per_cell * cells / case.mesh.symmetry.multiplicity();
+    // saturating: a key of 2⁶³ − 1 elements is an estimate of usize::MAX, not an overflow
+    Some(if equations < usize::MAX as f64 {
+        equations as usize
+    } else {
+        usize::MAX
+    })
+}
+
+/// The memory this machine has available (`MemAvailable` of /proc/meminfo), if it says.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+pub(crate) fn check_memory(equations: usize, force: bool) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    let estimate = memory_estimate(equations);
+    match available_memory() {
+        Some(available) if estimate > available => Err(AppError::TooLarge {
+            equations,
+            estimate_bytes: estimate,
+            available_bytes: available,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Whether some confine stage of `case` has planes that are not symmetric about x = 0
+/// (`[0]`) or y = 0 (`[1]`): such planes push the tube sideways, which the rigid-mode pins on
+/// the axis x = y = 0 (the caps' poles) must not resist (`Model::soften_rigid_pins`).
+pub fn sideways_planes(case: &Case) -> [bool; 2] {
+    let mut out = [false, false];
+    for stage in &case.stages {
+        for (axis, flag) in out.iter_mut().enumerate() {
+            *flag |= !stage
+                .plane
+                .iter()
+                .all(|p| p.mirrored_in(&stage.plane, axis));
+        }
+    }
+    out
+}
