@@ -34,6 +34,7 @@ pub mod output;
 pub mod output_file;
 pub mod report;
 pub mod run;
+pub mod stage;
 pub mod verify;
 
 use std::path::PathBuf;
@@ -116,7 +117,7 @@ pub enum AppError {
     Figure { path: PathBuf, message: String },
     #[error("overlay {}: {message}", path.display())]
     Overlay { path: PathBuf, message: String },
-    #[error("stage {stage}, step {step}: the plates penetrate the membrane by {penetration:.3e} R, {:.1} % of the plate half-gap ρ = {rho:.4} (more than {:.0} %): the penalty κ = {penalty:.3e} cannot hold them; raise `penalty` or lower `penetration_tolerance`", 100.0 * penetration / rho, 100.0 * crate::run::MAX_PENETRATION_FRACTION)]
+    #[error("stage {stage}, step {step}: the plates penetrate the membrane by {penetration:.3e} R, {:.1} % of the plate half-gap ρ = {rho:.4} (more than {:.0} %): the penalty κ = {penalty:.3e} cannot hold them; raise `penalty` or lower `penetration_tolerance`", 100.0 * penetration / rho, 100.0 * crate::stage::MAX_PENETRATION_FRACTION)]
     ContactUnresolved {
         stage: usize,
         step: usize,

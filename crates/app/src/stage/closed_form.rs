@@ -1,0 +1,120 @@
+//! The closed form a stage is compared with, at each step and at its end: GPS inflation or
+//! flattening from the FE's own mid-span values, PS at the stage's end, and for a squeeze the
+//! section at the FE's pressure.
+
+use crate::report::*;
+use crate::{AppError, Result};
+use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
+use tubemem_material::MembraneLaw;
+
+/// The closed form at one step (see [`StepClosedForm`]).
+pub fn step_closed_form(
+    law: &dyn MembraneLaw,
+    ms: &tubemem_fem::post::MidSpan,
+    squeeze: Option<(&tubemem_fem::post::ContactValues, f64)>,
+) -> StepClosedForm {
+    match squeeze {
+        None => StepClosedForm {
+            gps_inflation: inflate(law, Hypothesis::Gps, ms.lambda_s).ok(),
+            gps_flattening: None,
+            local: None,
+            gps_confine: None,
+            local_confine: None,
+        },
+        Some((c, ls0)) => {
+            let g = flatten(law, Hypothesis::Gps, ls0, c.rho).ok();
+            let local = g.map(|g| {
+                section_at_pressure(law, c.rho, ms.w, [g.lambda_s, g.lambda_z])
+                    .map_err(|e| e.to_string())
+            });
+            StepClosedForm {
+                gps_inflation: None,
+                gps_flattening: g,
+                local,
+                gps_confine: None,
+                local_confine: None,
+            }
+        }
+    }
+}
+
+/// The closed-form comparison of a stage's final state: GPS and PS, and for a squeeze the
+/// section at the FE's pressure. GPS and the section are the last step's (solved once, for its
+/// steps.csv row); only PS is solved here.
+#[allow(clippy::type_complexity)]
+pub fn stage_closed_form(
+    law: &dyn MembraneLaw,
+    ms: &tubemem_fem::post::MidSpan,
+    contact: Option<&ContactRecord>,
+    last: Option<&StepClosedForm>,
+) -> Result<(
+    [(ClosedFormState, RelativeErrors); 2],
+    Option<LocalSection>,
+    Option<RelativeErrors>,
+)> {
+    let local = last.and_then(|l| l.local.as_ref());
+    let one = |hyp: Hypothesis| -> Result<(ClosedFormState, RelativeErrors)> {
+        Ok(match contact {
+            None => {
+                let known = last
+                    .and_then(|l| l.gps_inflation)
+                    .filter(|_| hyp == Hypothesis::Gps);
+                let s = match known {
+                    Some(s) => s,
+                    None => inflate(law, hyp, ms.lambda_s).map_err(|e| {
+                        AppError::gps(format!("{} inflation at the FE's λs", hyp.label()), e)
+                    })?,
+                };
+                (
+                    ClosedFormState::Inflation(s),
+                    RelativeErrors {
+                        w: Some(rel(ms.w, s.w)),
+                        lambda_z: Some(rel(ms.lambda_z, s.lambda_z)),
+                        n_s: Some(rel(ms.n_s, s.n_s)),
+                        n_z: Some(rel(ms.n_z, s.n_z)),
+                        ..Default::default()
+                    },
+                )
+            }
+            Some(c) => {
+                let known = last
+                    .and_then(|l| l.gps_flattening)
+                    .filter(|_| hyp == Hypothesis::Gps);
+                let s = match known {
+                    Some(s) => s,
+                    None => flatten(law, hyp, c.initial_stretch, c.values.rho).map_err(|e| {
+                        AppError::gps(format!("{} flattening at the FE's ρ", hyp.label()), e)
+                    })?,
+                };
+                (
+                    ClosedFormState::Flattening(s),
+                    RelativeErrors {
+                        w: Some(rel(ms.w, s.w)),
+                        lambda_s: Some(rel(ms.lambda_s, s.lambda_s)),
+                        lambda_z: Some(rel(ms.lambda_z, s.lambda_z)),
+                        chi: Some(rel(c.values.chi, s.chi)),
+                        force: Some(rel(c.values.force, s.force)),
+                        ..Default::default()
+                    },
+                )
+            }
+        })
+    };
+    let both = [one(Hypothesis::Gps)?, one(Hypothesis::Ps)?];
+    let (section, errors) = match (contact, local) {
+        (Some(c), Some(Ok(l))) => (
+            Some(LocalSection::Solved(*l)),
+            Some(RelativeErrors {
+                w: None,
+                lambda_s: Some(rel(ms.lambda_s, l.lambda_s)),
+                lambda_z: Some(rel(ms.lambda_z, l.lambda_z)),
+                chi: Some(rel(c.values.chi, l.chi)),
+                force: Some(rel(c.values.force, l.force)),
+                ..Default::default()
+            }),
+        ),
+        (Some(_), Some(Err(e))) => (Some(LocalSection::Failed { error: e.clone() }), None),
+        _ => (None, None),
+    };
+    Ok((both, section, errors))
+}

@@ -1,0 +1,245 @@
+//! Stage kinds: what an `[[stage]]` of each kind loads, controls, monitors and compares with.
+//!
+//! [`crate::run`] drives every stage the same way (set-up, steps or arc length, records,
+//! summary); what differs between kinds lives here, one type per kind behind [`StageKind`]:
+//!
+//! | kind | type | load parameter | closed form |
+//! |---|---|---|---|
+//! | inflate | [`inflate::Inflate`] (pressure, stretch or volume control) | ϖ, λs at a node, or V | GPS/PS inflation |
+//! | squeeze | [`squeeze::Squeeze`] | plate half-gap h (gas closed) | GPS/PS flattening, section at the FE's ϖ |
+//! | confine | [`confine::Confine`] | t ∈ [0, 1] along the planes' paths (gas closed) | GPS/PS confinement by the same walls |
+//!
+//! **Adding a stage kind**: a `Target` variant in [`crate::case`] (its TOML key, its validation
+//! and its `describe`), a type here implementing [`StageKind`] (its range, load, arc-length
+//! monitor and loading, and the closed form it is compared with, step by step and at the
+//! stage's end), and its arm in [`kind_of`]. **Adding a control** of an inflation (a new
+//! controlled quantity): a [`inflate::Control`] variant and its arms in `inflate.rs`.
+
+pub mod closed_form;
+pub mod confine;
+pub mod critical;
+pub mod inflate;
+pub mod profile;
+pub mod setup;
+pub mod squeeze;
+
+use crate::case::{PenaltySpec, PlaneSpec, StagePlan, Target};
+use crate::observer::BoxError;
+use crate::report::{
+    ClosedFormState, ContactRecord, FinalContact, LocalSection, RelativeErrors, StepClosedForm,
+    StepRecord, WallSummary,
+};
+use crate::Result;
+use tubemem_fem::contact::{ContactPoints, Enforcement};
+use tubemem_fem::continuation::ArcLoading;
+use tubemem_fem::model::{Load, Model, State};
+use tubemem_fem::post::{MidSpan, WallValues};
+use tubemem_fem::stepping::StepInfo;
+use tubemem_gps::limits::Limits;
+use tubemem_material::MembraneLaw;
+
+/// The largest penetration of the plates, as a fraction of the plate half-gap ρ, that a squeeze
+/// step accepts: 5 %. Beyond it the contact is not resolved (the shipped squeezes penetrate
+/// 0.2 % of ρ at the default tolerance), and the results would be the penalty's, not the
+/// membrane's.
+pub const MAX_PENETRATION_FRACTION: f64 = 0.05;
+
+/// What a stage's load needs besides the kind: fixed at the stage's set-up.
+#[derive(Clone, Copy, Debug)]
+pub struct LoadParts {
+    /// the node whose hoop stretch a stretch control holds
+    pub node: usize,
+    /// ϖV of the closed gas (squeeze and confine), 0 otherwise
+    pub pv: f64,
+    /// the planes' penalty κ (squeeze and confine)
+    pub penalty: f64,
+    pub enforcement: Enforcement,
+    pub points: ContactPoints,
+}
+
+/// What the load range of a stage is computed from, at its start.
+pub struct RangeInput<'a> {
+    pub model: &'a Model,
+    pub state: &'a State,
+    pub node: usize,
+    /// the reference volume of the whole tube
+    pub v0: f64,
+    /// the mid-span values at the stage's start
+    pub start: &'a MidSpan,
+    /// the previous stage's final contact, if it was a squeeze
+    pub previous_squeeze: Option<FinalContact>,
+    /// the stage's `penalty` or `penetration_tolerance`
+    pub penalty: Option<PenaltySpec>,
+}
+
+/// The closed-form comparison of a stage's final state.
+pub struct StageComparison {
+    pub gps: ClosedFormState,
+    pub ps: ClosedFormState,
+    pub gps_errors: RelativeErrors,
+    pub ps_errors: RelativeErrors,
+    pub local_section: Option<LocalSection>,
+    pub local_errors: Option<RelativeErrors>,
+    pub walls: Vec<WallSummary>,
+}
+
+/// One kind of stage. Every method but the range, the load and the arc-length parts has the
+/// inflation's answer as its default.
+pub trait StageKind {
+    /// "inflate", "squeeze" or "confine": the summary's `kind`
+    fn name(&self) -> &'static str;
+
+    /// Whether the gas is closed in (ϖV fixed at the stage's start): the load parameter is
+    /// the planes' then, not a pressure or a volume.
+    fn closed_gas(&self) -> bool {
+        false
+    }
+
+    /// A pressure-controlled target ϖ, if this is one.
+    fn target_pressure(&self) -> Option<f64> {
+        None
+    }
+
+    /// Warnings about the target before the stage runs (a target outside the closed form's
+    /// validity, or on the falling branch of its curve).
+    fn warnings(
+        &self,
+        _plan: &StagePlan,
+        _law: &dyn MembraneLaw,
+        _limits: Option<&Limits>,
+    ) -> Vec<String> {
+        vec![]
+    }
+
+    /// The controlled quantity other than ϖ (a node's hoop coordinate, the total volume), if
+    /// the stage's steps are measured in one.
+    fn controlled_value(&self, _model: &Model, _state: &State, _node: usize) -> Option<f64> {
+        None
+    }
+
+    /// The closed form's estimate of the target's pressure, for the pre-stress.
+    fn pressure_estimate(&self, _law: &dyn MembraneLaw) -> Option<f64> {
+        None
+    }
+
+    /// Where the first step of a controlled stage from `from` in `steps` steps lands
+    /// (infinite: the stage has no controlled quantity).
+    fn first_step(&self, _from: f64, _steps: usize, _v0: f64) -> f64 {
+        f64::INFINITY
+    }
+
+    /// The load parameter's range (from, to) and the planes' penalty (0 without planes), or
+    /// why the stage cannot start.
+    fn range(&self, input: &RangeInput) -> std::result::Result<(f64, f64, f64), String>;
+
+    /// The load at each value of the load parameter.
+    fn load(&self, parts: &LoadParts) -> Box<dyn Fn(f64) -> Load>;
+
+    /// The value an arc-length stage is monitored by (and reaches its target in).
+    fn arc_monitor(&self, model: &Model, node: usize) -> Box<dyn Fn(&State) -> f64>;
+
+    /// How an arc-length stage is loaded.
+    fn arc_loading(&self, _parts: &LoadParts) -> ArcLoading {
+        ArcLoading::Pressure(None)
+    }
+
+    /// The mid-span contact with the plates at a converged step, if the stage has plates.
+    fn step_contact(
+        &self,
+        _model: &Model,
+        _state: &State,
+        _info: &StepInfo<'_>,
+        _start_lambda_s: f64,
+    ) -> Option<ContactRecord> {
+        None
+    }
+
+    /// The closed form of one step and the walls' values (confine), or an error that stops
+    /// the stage (an unresolved contact).
+    #[allow(clippy::too_many_arguments)]
+    fn step_closed_form(
+        &self,
+        model: &Model,
+        state: &State,
+        info: &StepInfo<'_>,
+        law: &dyn MembraneLaw,
+        ms: &MidSpan,
+        contact: Option<&ContactRecord>,
+        start_lambda_s: f64,
+        stage: usize,
+    ) -> std::result::Result<(StepClosedForm, Vec<WallValues>), BoxError> {
+        let _ = (model, state, info, stage);
+        Ok((
+            closed_form::step_closed_form(law, ms, contact.map(|c| (&c.values, start_lambda_s))),
+            vec![],
+        ))
+    }
+
+    /// The closed-form comparison of the stage's final state `ms` (with its plates' contact,
+    /// and the last step's record).
+    fn stage_comparison(
+        &self,
+        law: &dyn MembraneLaw,
+        ms: &MidSpan,
+        contact: Option<&ContactRecord>,
+        last: Option<&StepRecord>,
+        _start_lambda_s: f64,
+    ) -> Result<StageComparison> {
+        let ([(gps, gps_errors), (ps, ps_errors)], local_section, local_errors) =
+            closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form))?;
+        Ok(StageComparison {
+            gps,
+            ps,
+            gps_errors,
+            ps_errors,
+            local_section,
+            local_errors,
+            walls: vec![],
+        })
+    }
+
+    /// Said when the final tube is not uniform and the kind knows why (an inflation past the
+    /// pressure maximum); starts with "; ".
+    fn unstable_note(&self, _ms: &MidSpan, _limits: Option<&Limits>) -> String {
+        String::new()
+    }
+
+    /// The planes of a confine stage.
+    fn planes(&self) -> Option<&[PlaneSpec]> {
+        None
+    }
+}
+
+/// The kind of a planned stage (`planes`: the stage's `[[stage.plane]]`s).
+pub fn kind_of(plan: &StagePlan, planes: &[PlaneSpec]) -> Box<dyn StageKind> {
+    match plan.target {
+        Target::Pressure(p) => Box::new(inflate::Inflate {
+            control: inflate::Control::Pressure(p),
+        }),
+        Target::Stretch(s) => Box::new(inflate::Inflate {
+            control: inflate::Control::Stretch(s),
+        }),
+        Target::VolumeRatio(r) => Box::new(inflate::Inflate {
+            control: inflate::Control::VolumeRatio(r),
+        }),
+        Target::Rho(rho) => Box::new(squeeze::Squeeze { rho }),
+        Target::Confine(_) => Box::new(confine::Confine {
+            planes: planes.to_vec(),
+        }),
+    }
+}
+
+/// The penalty κ of a stage with planes: given, or from its tolerance with the pressure and the
+/// area stretch J at its start.
+fn penalty_of(spec: Option<PenaltySpec>, state: &State, start: &MidSpan) -> f64 {
+    use tubemem_fem::contact::penalty_for;
+    match spec {
+        Some(PenaltySpec::Value(k)) => k,
+        Some(PenaltySpec::Tolerance(t)) => penalty_for(state.p, start.lambda_s * start.lambda_z, t),
+        None => penalty_for(
+            state.p,
+            start.lambda_s * start.lambda_z,
+            crate::case::DEFAULT_PENETRATION_TOLERANCE,
+        ),
+    }
+}

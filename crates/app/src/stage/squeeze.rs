@@ -1,0 +1,92 @@
+//! The squeeze: the gas closed in, the tube pressed between frictionless plates y = ±h.
+
+use super::{penalty_of, LoadParts, RangeInput, StageKind};
+use crate::report::ContactRecord;
+use tubemem_fem::contact::{Contact, MovingPlanes};
+use tubemem_fem::continuation::ArcLoading;
+use tubemem_fem::model::{Load, Loading, Model, State};
+use tubemem_fem::post::midspan_contact;
+use tubemem_fem::stepping::StepInfo;
+
+/// A squeeze to the plate half-gap ρ (in R).
+#[derive(Clone, Copy, Debug)]
+pub struct Squeeze {
+    pub rho: f64,
+}
+
+impl StageKind for Squeeze {
+    fn name(&self) -> &'static str {
+        "squeeze"
+    }
+
+    fn closed_gas(&self) -> bool {
+        true
+    }
+
+    fn range(&self, input: &RangeInput) -> Result<(f64, f64, f64), String> {
+        let state = input.state;
+        if state.p.is_nan() || state.p <= 0.0 {
+            return Err(format!(
+                "the tube holds no gas pressure to squeeze (ϖ = {})",
+                state.p
+            ));
+        }
+        let h0 = state.x.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+        if self.rho >= h0 {
+            return Err(format!(
+                "`target_rho` = {} must be below the current half-height {h0:.6} of the tube",
+                self.rho
+            ));
+        }
+        let penalty = match (input.penalty, input.previous_squeeze) {
+            (Some(crate::case::PenaltySpec::Value(k)), _) => k,
+            // a squeeze that continues a squeeze keeps its plates' penalty
+            (_, Some(prev)) => prev.penalty,
+            (spec, None) => penalty_of(spec, state, input.start),
+        };
+        Ok((h0, self.rho, penalty))
+    }
+
+    fn load(&self, parts: &LoadParts) -> Box<dyn Fn(f64) -> Load> {
+        let p = *parts;
+        Box::new(move |h| {
+            Load::with_contact(
+                Loading::Gas { pv: p.pv },
+                Contact::plates(h, p.penalty)
+                    .with_enforcement(p.enforcement)
+                    .with_points(p.points),
+            )
+        })
+    }
+
+    fn arc_monitor(&self, _model: &Model, _node: usize) -> Box<dyn Fn(&State) -> f64> {
+        // closed gas: the plates' half-gap h
+        Box::new(|s: &State| s.planes)
+    }
+
+    fn arc_loading(&self, parts: &LoadParts) -> ArcLoading {
+        ArcLoading::ClosedGas {
+            pv: parts.pv,
+            planes: MovingPlanes::plates(parts.penalty)
+                .with_enforcement(parts.enforcement)
+                .with_points(parts.points),
+        }
+    }
+
+    fn step_contact(
+        &self,
+        model: &Model,
+        state: &State,
+        info: &StepInfo<'_>,
+        start_lambda_s: f64,
+    ) -> Option<ContactRecord> {
+        info.load.contact.as_ref().and_then(|c| {
+            midspan_contact(model, state, c).map(|values| ContactRecord {
+                values,
+                displacement: start_lambda_s - values.rho,
+                initial_stretch: start_lambda_s,
+                penalty: c.penalty,
+            })
+        })
+    }
+}
