@@ -33,6 +33,36 @@ impl Failure {
 const MAX_IT: usize = 60;
 const MAX_HALVINGS: usize = 40;
 
+/// The backtracking line search both solvers share: from t = 1, halved up to [`MAX_HALVINGS`]
+/// times, the first trial x + t·step with every unknown positive, accepted by the law, with a
+/// finite merit below `merit0` (or a negligible step, `small(t)`). Returns t, the trial and its
+/// evaluation, or `None`; a law's rejection is kept in `last_err`.
+fn line_search<const N: usize, J>(
+    f: impl Fn([f64; N]) -> Result<([f64; N], J), MaterialError>,
+    x: [f64; N],
+    step: [f64; N],
+    merit0: f64,
+    merit: impl Fn(&[f64; N]) -> f64,
+    small: impl Fn(f64) -> bool,
+    last_err: &mut Option<MaterialError>,
+) -> Option<(f64, [f64; N], [f64; N], J)> {
+    let mut t = 1.0;
+    for _ in 0..MAX_HALVINGS {
+        let xt: [f64; N] = std::array::from_fn(|k| x[k] + t * step[k]);
+        if xt.iter().all(|v| *v > 0.0) {
+            match f(xt) {
+                Ok((ft, jt)) if merit(&ft).is_finite() && (merit(&ft) < merit0 || small(t)) => {
+                    return Some((t, xt, ft, jt));
+                }
+                Ok(_) => {}
+                Err(e) => *last_err = Some(e),
+            }
+        }
+        t *= 0.5;
+    }
+    None
+}
+
 /// Solve f(x) = 0 (f returns value and derivative), x > 0, from `x0`.
 /// Converged when the Newton step is below 1e-14 (1 + |x|) and |f| ≤ `ftol`.
 pub(crate) fn scalar(
@@ -62,36 +92,23 @@ pub(crate) fn scalar(
         if step == 0.0 || !step.is_finite() {
             break;
         }
-        let mut t = 1.0;
-        let mut accepted = false;
-        for _ in 0..MAX_HALVINGS {
-            let xt = x + t * step;
-            if xt > 0.0 {
-                match f(xt) {
-                    Ok((ft, dft))
-                        if ft.is_finite()
-                            && (ft.abs() < fx.abs()
-                                || t * step.abs() < 1e-12 * (1.0 + x.abs())) =>
-                    {
-                        x = xt;
-                        fx = ft;
-                        dfx = dft;
-                        accepted = true;
-                        break;
-                    }
-                    Ok(_) => {}
-                    Err(e) => last_err = Some(e),
-                }
-            }
-            t *= 0.5;
-        }
-        if !accepted {
+        let small = |t: f64| t * step.abs() < 1e-12 * (1.0 + x.abs());
+        let Some((t, [xt], [ft], dft)) = line_search(
+            |[v]| f(v).map(|(fv, dv)| ([fv], dv)),
+            [x],
+            [step],
+            fx.abs(),
+            |[v]: &[f64; 1]| v.abs(),
+            small,
+            &mut last_err,
+        ) else {
             return Err(Failure {
                 residual: fx.abs(),
                 iterations: it,
                 material: last_err,
             });
-        }
+        };
+        (x, fx, dfx) = (xt, ft, dft);
         if (t * step).abs() <= 1e-14 * (1.0 + x.abs()) && fx.abs() <= ftol {
             return Ok(x);
         }
@@ -139,32 +156,16 @@ pub(crate) fn system2(
             (t * step[0]).abs() <= 1e-13 * (1.0 + x_start[0].abs())
                 && (t * step[1]).abs() <= 1e-13 * (1.0 + x_start[1].abs())
         };
-        let mut t = 1.0;
-        let mut accepted = false;
-        for _ in 0..MAX_HALVINGS {
-            let xt = [x[0] + t * step[0], x[1] + t * step[1]];
-            if xt[0] > 0.0 && xt[1] > 0.0 {
-                match f(xt) {
-                    Ok((ft, jt)) if norm(ft).is_finite() && (norm(ft) < norm(fx) || small(t)) => {
-                        x = xt;
-                        fx = ft;
-                        jx = jt;
-                        accepted = true;
-                        break;
-                    }
-                    Ok(_) => {}
-                    Err(e) => last_err = Some(e),
-                }
-            }
-            t *= 0.5;
-        }
-        if !accepted {
+        let Some((t, xt, ft, jt)) =
+            line_search(&f, x, step, norm(fx), |v| norm(*v), small, &mut last_err)
+        else {
             return Err(Failure {
                 residual: norm(fx),
                 iterations: it,
                 material: last_err,
             });
-        }
+        };
+        (x, fx, jx) = (xt, ft, jt);
         if small(t) && norm(fx) <= ftol {
             return Ok(x);
         }
