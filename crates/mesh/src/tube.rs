@@ -54,14 +54,15 @@ fn cell_points(c: &Cell, order: usize) -> Vec<[usize; 3]> {
     pts
 }
 
-/// The lattice points and cells of the whole cube surface (for the sphere); the lattice has
-/// `m` steps a face edge, the cells `order` steps a side.
-fn cube_surface(m: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
+/// The lattice points and cells of the surface of the box [0, m]² × [0, rows]: its side faces
+/// and its top face k = `rows`, and with `closed` its bottom face k = 0 too. The lattice has
+/// `m` steps a face edge and `rows` up the sides; the cells have `order` steps a side.
+fn box_surface(m: usize, rows: usize, order: usize, closed: bool) -> (Vec<[usize; 3]>, Vec<Cell>) {
     let mut points = vec![];
     for i in 0..=m {
         for j in 0..=m {
-            for k in 0..=m {
-                if i == 0 || i == m || j == 0 || j == m || k == 0 || k == m {
+            for k in 0..=rows {
+                if k == rows || (closed && k == 0) || i == 0 || i == m || j == 0 || j == m {
                     points.push([i, j, k]);
                 }
             }
@@ -69,7 +70,8 @@ fn cube_surface(m: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
     }
     let (ex, ey, ez) = ([1, 0, 0], [0, 1, 0], [0, 0, 1]);
     let mut cells = vec![];
-    for k in [0, m] {
+    let faces: &[usize] = if closed { &[0, rows] } else { &[rows] };
+    for &k in faces {
         for i in (0..m).step_by(order) {
             for j in (0..m).step_by(order) {
                 cells.push(([i, j, k], ex, ey));
@@ -78,19 +80,25 @@ fn cube_surface(m: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
     }
     for i in [0, m] {
         for j in (0..m).step_by(order) {
-            for k in (0..m).step_by(order) {
+            for k in (0..rows).step_by(order) {
                 cells.push(([i, j, k], ey, ez));
             }
         }
     }
     for j in [0, m] {
         for i in (0..m).step_by(order) {
-            for k in (0..m).step_by(order) {
+            for k in (0..rows).step_by(order) {
                 cells.push(([i, j, k], ex, ez));
             }
         }
     }
     (points, cells)
+}
+
+/// The lattice points and cells of the whole cube surface (for the sphere); the lattice has
+/// `m` steps a face edge, the cells `order` steps a side.
+fn cube_surface(m: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
+    box_surface(m, m, order, true)
 }
 
 /// Cube coordinate of row `k` of `rows` on a side face of the half cube: 0 at the equator,
@@ -108,38 +116,7 @@ fn latitude(k: usize, rows: usize) -> f64 {
 /// The upper half of the cube surface for a cap: lattice points (i, j, k) with k the row on the
 /// side faces (0 = equator, `rows` = the top face), and its cells (`order` steps a side).
 fn half_cube(m: usize, rows: usize, order: usize) -> (Vec<[usize; 3]>, Vec<Cell>) {
-    let mut points = vec![];
-    for i in 0..=m {
-        for j in 0..=m {
-            for k in 0..=rows {
-                if (k == rows) || i == 0 || i == m || j == 0 || j == m {
-                    points.push([i, j, k]);
-                }
-            }
-        }
-    }
-    let (ex, ey, ez) = ([1, 0, 0], [0, 1, 0], [0, 0, 1]);
-    let mut cells = vec![];
-    for i in (0..m).step_by(order) {
-        for j in (0..m).step_by(order) {
-            cells.push(([i, j, rows], ex, ey));
-        }
-    }
-    for i in [0, m] {
-        for j in (0..m).step_by(order) {
-            for k in (0..rows).step_by(order) {
-                cells.push(([i, j, k], ey, ez));
-            }
-        }
-    }
-    for j in [0, m] {
-        for i in (0..m).step_by(order) {
-            for k in (0..rows).step_by(order) {
-                cells.push(([i, j, k], ex, ez));
-            }
-        }
-    }
-    (points, cells)
+    box_surface(m, rows, order, false)
 }
 
 /// Split element node lists (4 or 9 each) into corner quads and mid/centre nodes.
