@@ -98,7 +98,7 @@ pub fn run(a: VerifyArgs) -> u8 {
                 s.results,
                 Some(s.verdict),
             ),
-            Err(e) => return setup(e),
+            Err(e) => return setup(tubemem_app::error_chain(&e)),
         }
     } else {
         if a.suites.is_empty() {

@@ -1573,7 +1573,7 @@ fn verify<'py>(
         (Some(c), None) => {
             let s = py
                 .detach(|| v::study::run_study(&c, &out, quick, &opts, &quiet))
-                .map_err(PyValueError::new_err)?;
+                .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
             (
                 vec![format!("study of {}", c.display())],
                 s.results,

@@ -367,14 +367,60 @@ pub fn run_check(c: &Check, out: &Path, opts: &VerifyOptions) -> CheckResult {
     r
 }
 
+/// Why a study, a member run or a case variation could not be made. (A check that runs and
+/// fails is not an error: it is a [`CheckResult`] with its status.)
+#[derive(Debug, thiserror::Error)]
+pub enum VerifyError {
+    /// the case file could not be read
+    #[error("{}", path.display())]
+    Read {
+        path: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// the case (a file, or a member's varied text) is not a valid case
+    #[error("{what}")]
+    Case {
+        what: String,
+        #[source]
+        source: crate::case::CaseError,
+    },
+    /// a case text to vary is not TOML
+    #[error("the case text to vary is not TOML")]
+    Toml(#[source] toml::de::Error),
+    /// a varied case could not be written back as TOML
+    #[error("the varied case could not be written as TOML")]
+    TomlWrite(#[source] toml::ser::Error),
+    /// a member run (or its folder) failed
+    #[error("{label}")]
+    Run {
+        label: String,
+        #[source]
+        source: Box<crate::AppError>,
+    },
+    /// the checks could not be run (their output folder)
+    #[error("the study's checks")]
+    Checks(#[source] Box<crate::AppError>),
+    /// a study the case cannot have
+    #[error("{0}")]
+    Study(&'static str),
+}
+
+/// A kind's error message: the whole chain.
+impl From<VerifyError> for String {
+    fn from(e: VerifyError) -> String {
+        crate::error_chain(&e)
+    }
+}
+
 /// Outcome of a kind's evaluation: `Ok(None)` judged by the measures, `Ok(Some(reason))`
 /// skipped, `Err(message)` an error.
 type KindResult = Result<Option<String>, String>;
 
 /// A case text with edits applied to its TOML tables. Member runs write VTU at stage ends only
 /// and no checkpoints, unless the case says otherwise.
-pub fn vary(text: &str, edit: impl FnOnce(&mut toml::Table)) -> Result<String, String> {
-    let mut t: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+pub fn vary(text: &str, edit: impl FnOnce(&mut toml::Table)) -> Result<String, VerifyError> {
+    let mut t: toml::Table = toml::from_str(text).map_err(VerifyError::Toml)?;
     edit(&mut t);
     let output = t
         .entry("output")
@@ -390,7 +436,7 @@ pub fn vary(text: &str, edit: impl FnOnce(&mut toml::Table)) -> Result<String, S
         s.entry("checkpoint_every")
             .or_insert(toml::Value::Integer(0));
     }
-    toml::to_string(&t).map_err(|e| e.to_string())
+    toml::to_string(&t).map_err(VerifyError::TomlWrite)
 }
 
 /// Run a case text into `dir` (replacing what is there); the report, or the error's chain.
@@ -399,11 +445,18 @@ pub fn run_member(
     base_dir: &Path,
     dir: &Path,
     label: &str,
-) -> Result<RunReport, String> {
-    let mut case = Case::parse(text).map_err(|e| crate::error_chain(&e))?;
+) -> Result<RunReport, VerifyError> {
+    let mut case = Case::parse(text).map_err(|source| VerifyError::Case {
+        what: label.to_string(),
+        source,
+    })?;
     case.base_dir = base_dir.to_path_buf();
+    let run_error = |source| VerifyError::Run {
+        label: label.to_string(),
+        source: Box::new(source),
+    };
     let mut writer = RunWriter::create(dir, FolderMode::Overwrite, case.hash(), &[])
-        .map_err(|e| e.chain())?
+        .map_err(run_error)?
         .checkpoint_every(case.solver.checkpoint_every)
         .frames_of(case.output);
     let options = crate::run::RunOptions {
@@ -412,13 +465,18 @@ pub fn run_member(
     };
     crate::run::run_with(&case, label, &options, &mut [&mut writer])
         .into_result()
-        .map_err(|e| format!("{label}: {}", e.chain()))
+        .map_err(run_error)
 }
 
 fn member(c: &Check, text: &str, dir: &Path, r: &mut CheckResult) -> Result<RunReport, String> {
     r.runs.push(dir.display().to_string());
     let text = vary(text, |_| {})?;
-    run_member(&text, &c.base_dir, dir, &format!("check {}", c.spec.name))
+    Ok(run_member(
+        &text,
+        &c.base_dir,
+        dir,
+        &format!("check {}", c.spec.name),
+    )?)
 }
 
 /// (FE, closed form) of `q` at one step, if the step has both.

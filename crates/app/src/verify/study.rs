@@ -26,6 +26,7 @@
 
 use super::stats::EndLaw;
 use super::suite::{CaseRef, Check, CheckKind, CheckSpec, Expect, Tol};
+use super::VerifyError;
 use super::{run_checks, CheckResult, Event, Status, VerifyOptions};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -129,15 +130,19 @@ pub fn run_study(
     quick: bool,
     opts: &VerifyOptions,
     progress: &(dyn Fn(Event) + Sync),
-) -> Result<Study, String> {
-    let text =
-        std::fs::read_to_string(case_path).map_err(|e| format!("{}: {e}", case_path.display()))?;
-    let case = crate::case::Case::parse(&text)
-        .map_err(|e| format!("{}: {}", case_path.display(), crate::error_chain(&e)))?;
+) -> Result<Study, VerifyError> {
+    let text = std::fs::read_to_string(case_path).map_err(|source| VerifyError::Read {
+        path: case_path.to_path_buf(),
+        source,
+    })?;
+    let case = crate::case::Case::parse(&text).map_err(|source| VerifyError::Case {
+        what: case_path.display().to_string(),
+        source,
+    })?;
     if case.mesh.file.is_some() {
-        return Err(
-            "the study refines a generated mesh: give `around` and `along`, not a mesh file".into(),
-        );
+        return Err(VerifyError::Study(
+            "the study refines a generated mesh: give `around` and `along`, not a mesh file",
+        ));
     }
     // the gas closed in (a squeeze or a confine stage last): the end effect falls as 1/L
     let last_kind = case.stages.last().map(|s| s.kind);
@@ -262,8 +267,9 @@ pub fn run_study(
             name,
         }),
     };
-    let round = |checks: Vec<Check>, results: &mut Vec<CheckResult>| -> Result<(), String> {
-        let done = run_checks(&checks, out, opts, &counted).map_err(|e| e.chain())?;
+    let round = |checks: Vec<Check>, results: &mut Vec<CheckResult>| -> Result<(), VerifyError> {
+        let done = run_checks(&checks, out, opts, &counted)
+            .map_err(|e| VerifyError::Checks(Box::new(e)))?;
         offset.fetch_add(done.len(), std::sync::atomic::Ordering::SeqCst);
         results.extend(done);
         Ok(())
