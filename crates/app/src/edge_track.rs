@@ -162,3 +162,25 @@ impl tubemem_fem::stepping::Refit for Tracker<'_> {
         *self.edges.borrow_mut() = snapshot.to_vec();
     }
 }
+
+impl TubeSpec {
+    /// The tube a case's tracker refits (`[mesh] track_contact_edge` on a generated tube), if
+    /// any.
+    pub fn of(case: &crate::case::Case) -> Option<TubeSpec> {
+        match (
+            case.mesh.track_contact_edge,
+            case.mesh.around,
+            case.mesh.along,
+        ) {
+            (true, Some(around), Some(along)) => Some(TubeSpec {
+                kind: case.mesh.element,
+                length: case.geometry.length / case.geometry.radius,
+                around,
+                along,
+                cap_rows: case.mesh.cap_rows.unwrap_or(around / 8),
+                symmetry: case.mesh.symmetry,
+            }),
+            _ => None,
+        }
+    }
+}

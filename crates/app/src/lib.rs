@@ -11,8 +11,13 @@
 //!
 //! * [`case`]: the case file and its validation into a plan of [`case::StagePlan`]s (stage targets resolved
 //!   once).
-//! * [`run`]: the FE run: [`run::run`] returns a [`report::RunReport`] and calls
-//!   [`observer::Observer`]s at every converged step and stage end.
+//! * [`model_setup`]: the mesh a case asks for and the memory guard.
+//! * [`stage`]: one type per stage kind (inflate, squeeze, confine) behind
+//!   [`stage::StageKind`], and what every kind shares (set-up, critical points, closed forms).
+//! * [`run`]: the FE run, a loop over the plan's stages: [`run::run`] returns a
+//!   [`report::RunReport`] and calls [`observer::Observer`]s at every converged step and stage
+//!   end.
+//! * [`checkpoint`]: the restart point, its binary format and its validation in one place.
 //! * [`output`]: the writer that turns the report into files while the run goes on.
 //! * [`curves`], [`figures`], [`main_job`]: closed-form curves, the paper's figures, and the
 //!   main job on the embedded default case.

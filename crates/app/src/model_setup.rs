@@ -128,3 +128,32 @@ pub fn sideways_planes(case: &Case) -> [bool; 2] {
     }
     out
 }
+
+/// The model of `mesh` with the case's law (with its tension-field relaxation if the case asks),
+/// its rigid-mode pins (springs where planes move the tube sideways), the solver's settings and
+/// the run's interrupt flag.
+pub fn model_of(
+    case: &Case,
+    mesh: Mesh,
+    interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> Result<tubemem_fem::model::Model> {
+    let law = case.material.build_with(case.solver.wrinkling)?;
+    let mut model = tubemem_fem::model::Model::new(mesh, law).map_err(AppError::Model)?;
+    // planes that move the tube sideways: the rigid-mode pins on the axis would hold the caps'
+    // poles against them, so springs hold those modes instead
+    let soft = sideways_planes(case);
+    if soft.iter().any(|s| *s) {
+        model
+            .soften_rigid_pins(soft, tubemem_fem::dofs::SOFT_PIN_STIFFNESS)
+            .map_err(AppError::Model)?;
+    }
+    model.set_interrupt(interrupt);
+    model.set_settings(tubemem_fem::NewtonSettings {
+        rtol: case.solver.rtol,
+        max_iterations: case.solver.max_iterations,
+        ..tubemem_fem::NewtonSettings::default()
+    });
+    model.set_factor_threads(case.solver.factor_threads);
+    model.set_iteration_log(case.output.iterations);
+    Ok(model)
+}

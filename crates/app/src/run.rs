@@ -3,22 +3,21 @@
 
 use crate::case::Case;
 use crate::checkpoint::{checkpoint_edges, Checkpoint};
-use crate::model_setup::{check_memory, equations_estimate, sideways_planes};
+use crate::model_setup::{check_memory, equations_estimate, model_of};
 use crate::observer::{BoxError, Observer, StepView};
 use crate::report::*;
-use crate::stage::critical::{
-    critical_record, pressure_maximum_below, PendingCritical, BRANCH_SWITCH_FRACTION,
-};
-use crate::stage::profile::{boundary_layer, wrinkle_report};
+use crate::stage::critical::{critical_record, PendingCritical, BRANCH_SWITCH_FRACTION};
+use crate::stage::failure::{stage_error, FailureInput};
+use crate::stage::record::{step_record, RecordInput};
 use crate::stage::setup::{setup_stage, SetupInput};
-use crate::stage::{LoadParts, MAX_PENETRATION_FRACTION};
+use crate::stage::summary::stage_report;
+use crate::stage::LoadParts;
 use crate::{AppError, Result};
-use tubemem_fem::contact::{Contact, Enforcement};
+use tubemem_fem::contact::Enforcement;
 use tubemem_fem::continuation::{run_arc_stage, ArcLoading, Critical, CriticalKind};
 use tubemem_fem::model::{nearest_node, Model, State};
-use tubemem_fem::post::{midspan, ring_profile};
-use tubemem_fem::stepping::{run_stage_refitted, Stage, StageError, StepInfo, StepSettings};
-use tubemem_fem::NewtonSettings;
+
+use tubemem_fem::stepping::{run_stage_refitted, Stage, StepInfo, StepSettings};
 use tubemem_gps::Hypothesis;
 
 /// How a run is driven from outside.
@@ -121,98 +120,31 @@ fn run_inner(
     if case.mesh.file.is_some() {
         check_memory(3 * mesh.nodes.len(), options.force)?;
     }
-    let symmetry = mesh.symmetry;
-    let law = case.material.build_with(case.solver.wrinkling)?;
     let closed_form_law = case.material.build()?;
     // the closed form's limit points, for the warnings, the critical points' references and the
     // stage-end notes (one scan per run)
     let gps_limits =
         tubemem_gps::limits::limit_points(closed_form_law.as_ref(), Hypothesis::Gps).ok();
-    let mut model = Model::new(mesh, law).map_err(AppError::Model)?;
-    // planes that move the tube sideways: the rigid-mode pins on the axis would hold the caps'
-    // poles against them, so springs hold those modes instead
-    let soft = sideways_planes(case);
-    if soft.iter().any(|s| *s) {
-        model
-            .soften_rigid_pins(soft, tubemem_fem::dofs::SOFT_PIN_STIFFNESS)
-            .map_err(AppError::Model)?;
-    }
-    model.set_interrupt(options.interrupt.clone());
-    model.set_settings(NewtonSettings {
-        rtol: case.solver.rtol,
-        max_iterations: case.solver.max_iterations,
-        ..NewtonSettings::default()
-    });
-    model.set_factor_threads(case.solver.factor_threads);
-    model.set_iteration_log(case.output.iterations);
+    let mut model = model_of(case, mesh, options.interrupt.clone())?;
     let mut state = model.reference_state();
     // `[mesh] track_contact_edge`: the tube the tracker refits, and the edges it is fitted to
     let tracking = case.mesh.track_contact_edge;
-    let tube = match (tracking, case.mesh.around, case.mesh.along) {
-        (true, Some(around), Some(along)) => Some(crate::edge_track::TubeSpec {
-            kind: case.mesh.element,
-            length: g.length / g.radius,
-            around,
-            along,
-            cap_rows: case.mesh.cap_rows.unwrap_or(around / 8),
-            symmetry: case.mesh.symmetry,
-        }),
-        _ => None,
-    };
+    let tube = crate::edge_track::TubeSpec::of(case);
     let tracked_edges: crate::edge_track::Edges = Default::default();
     let v0 = model.multiplicity() * model.mesh().volume();
     let node = nearest_node(model.mesh(), [1.0, 0.0, 0.0]);
-    let report = slot.insert(RunReport {
-        case: label.to_string(),
-        mesh: MeshInfo {
-            nodes: model.mesh().nodes.len(),
-            elements: model.mesh().quads.len(),
-            equations: model.n_eq(),
-            symmetry: format!("{symmetry:?}").to_lowercase(),
-            element: model.mesh().element().name().into(),
-            factor_nnz: model.factor_nnz(),
-            factor_flops: model.factor_flops(),
-            contact_edge_fit,
-        },
-        material: model.law().name(),
-        material_spec: case.material,
-        geometry: GeometryInfo {
-            radius: g.radius,
-            length: g.length,
-            thickness: g.thickness,
-            caps: format!("{:?}", g.caps).to_lowercase(),
-        },
-        units: UNITS.into(),
-        case_hash: case.hash().to_string(),
-        scales: case.scales(),
-        stages: vec![],
-        warnings: vec![],
-    });
+    let report = slot.insert(initial_report(case, label, &model, contact_edge_fit));
     if let Some(ck) = &options.resume {
-        if let Some(message) = ck.mismatch(case.hash(), Some(state.x.len())) {
-            return Err(AppError::Folder {
-                path: std::path::PathBuf::from(label),
-                message,
-            });
-        }
-        *report = ck.report.clone();
-        state.x.clone_from(&ck.x);
-        state.p = ck.p;
-        state.multipliers.clone_from(&ck.multipliers);
-        // a tracked mesh: fitted where the checkpoint's step had it
-        if let (Some(tube), Some(edges)) = (tube, checkpoint_edges(ck)) {
-            let nodes = tube.nodes(&edges).map_err(AppError::Mesh)?;
-            let n = nodes.len();
-            model
-                .move_reference(
-                    nodes,
-                    &tubemem_mesh::hoop::Transfer::identity(n),
-                    None,
-                    &mut [],
-                )
-                .map_err(AppError::Model)?;
-            *tracked_edges.borrow_mut() = edges;
-        }
+        restore(
+            ck,
+            case,
+            label,
+            tube,
+            &mut model,
+            &mut state,
+            report,
+            &tracked_edges,
+        )?;
     }
     for o in observers.iter_mut() {
         o.started(report, &model, &state)
@@ -316,6 +248,16 @@ fn run_inner(
             .rev()
             .find(|c| matches!(c.kind, CriticalKind::LimitMax | CriticalKind::LimitMin))
             .map(|c| c.midspan.w);
+        let record_input = RecordInput {
+            kind: kind.as_ref(),
+            plan,
+            law: closed_form_law.as_ref(),
+            start_lambda_s,
+            half_length: half,
+            every_profile,
+            started_uniform,
+            tracked_edges: (tracking && closed_gas).then_some(&tracked_edges),
+        };
         let mut on_step = |m: &Model, st: &State, info: &StepInfo| {
             let mut critical_here = None;
             for p in pending.borrow_mut().drain(..) {
@@ -326,88 +268,7 @@ fn run_inner(
                 criticals.push(p.record);
             }
             {
-                let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
-                let contact = kind.step_contact(m, st, info, start_lambda_s);
-
-                let mut vals = vec![
-                    ms.w,
-                    ms.lambda_s,
-                    ms.lambda_z,
-                    ms.n_s,
-                    ms.n_z,
-                    ms.n_sz,
-                    ms.volume,
-                ];
-                if let Some(c) = &contact {
-                    let c = &c.values;
-                    vals.extend([c.chi, c.force, c.contact_pressure, c.penetration]);
-                }
-                if let Some(c) = &contact {
-                    let (pen, rho) = (c.values.penetration, c.values.rho);
-                    if pen.is_nan() || pen > MAX_PENETRATION_FRACTION * rho {
-                        return Err(Box::new(AppError::ContactUnresolved {
-                            stage: i,
-                            step: info.step,
-                            penetration: pen,
-                            rho,
-                            penalty: c.penalty,
-                        }) as BoxError);
-                    }
-                }
-                if vals.iter().any(|v| !v.is_finite()) {
-                    return Err(Box::new(AppError::NonFinite {
-                        stage: i,
-                        step: info.step,
-                        values: vals,
-                    }) as BoxError);
-                }
-                let (closed_form, walls) = kind.step_closed_form(
-                    m,
-                    st,
-                    info,
-                    closed_form_law.as_ref(),
-                    &ms,
-                    contact.as_ref(),
-                    start_lambda_s,
-                    i,
-                )?;
-                let profile = if every_profile {
-                    ring_profile(m, st, info.load.contact.as_ref())
-                        .map_err(|e| Box::new(e) as BoxError)?
-                } else {
-                    vec![]
-                };
-                let step_nonuniformity = nonuniformity(&profile, half);
-                let step_fronts = bulge_fronts(&profile);
-                let record = StepRecord {
-                    stage: i,
-                    step: info.step,
-                    load: info.value,
-                    midspan: ms,
-                    newton_iterations: info.newton.iterations,
-                    negative_pivots: info.newton.inertia.negative_pivots,
-                    residuals: info.newton.history.clone(),
-                    contact,
-                    walls,
-                    closed_form,
-                    profile,
-                    arc: plan.arc_length.then_some(ArcValues {
-                        arc_length: info.progress.lambda,
-                        dw_ds: info.dw_ds,
-                    }),
-                    critical: critical_here,
-                    nonuniformity: step_nonuniformity,
-                    gps_applicable: step_nonuniformity
-                        .map(|u| u <= NONUNIFORM && started_uniform.is_none()),
-                    negative_pivots_volume: info.negative_conjugate,
-                    fronts: step_fronts,
-                    augmentation: matches!(plan.enforcement, Some(Enforcement::Augmented { .. }))
-                        .then_some(info.newton.augmentation),
-                    edge_tracking: (tracking && closed_gas).then(|| crate::report::EdgeTracking {
-                        edges: tracked_edges.borrow().clone(),
-                        refits: info.refits,
-                    }),
-                };
+                let record = step_record(&record_input, m, st, info, critical_here)?;
                 steps.push(record);
                 let view = StepView {
                     report: finished,
@@ -489,64 +350,19 @@ fn run_inner(
             )
         };
         if let Err(e) = result {
-            let error = match e {
-                StageError::Solve(tubemem_fem::FemError::Interrupted) => AppError::Interrupted {
-                    stage: i,
-                    steps: steps.len(),
+            let error = stage_error(
+                e,
+                &FailureInput {
+                    kind: kind.as_ref(),
+                    plan,
+                    stages,
+                    law: closed_form_law.as_ref(),
+                    steps: &steps,
+                    previous: report.stages.last(),
                 },
-                StageError::Solve(source) => {
-                    // the last converged state of the stage, or of the run before it
-                    let last_negative = steps.last().map(|r| r.negative_pivots).or_else(|| {
-                        report
-                            .stages
-                            .last()
-                            .filter(|s| !s.plan.arc_length)
-                            .and_then(|s| s.steps.last())
-                            .map(|r| r.negative_pivots)
-                    });
-                    let unstable = last_negative.filter(|&n| n > 0 && !plan.arc_length);
-                    match kind.target_pressure().filter(|_| !plan.arc_length) {
-                        // a pressure target the path cannot reach: say where its maximum is
-                        Some(target) if state.p < target => {
-                            match pressure_maximum_below(
-                                &mut model,
-                                &state,
-                                target,
-                                closed_form_law.as_ref(),
-                            ) {
-                                Some((w_max, lambda_s)) => AppError::BeyondLimit {
-                                    stage: i,
-                                    stages,
-                                    target,
-                                    w_max,
-                                    lambda_s,
-                                    source: Box::new(source),
-                                },
-                                None => AppError::Stage {
-                                    stage: i,
-                                    stages,
-                                    unstable,
-                                    source,
-                                },
-                            }
-                        }
-                        _ => AppError::Stage {
-                            stage: i,
-                            stages,
-                            unstable,
-                            source,
-                        },
-                    }
-                }
-                StageError::Observer { step, source, .. } => match source.downcast::<AppError>() {
-                    Ok(app) => *app,
-                    Err(source) => AppError::Observer {
-                        stage: i,
-                        step,
-                        source,
-                    },
-                },
-            };
+                &mut model,
+                &state,
+            );
             let last_converged = steps.last().map(|s| s.midspan);
             report.stages.push(StageReport {
                 plan: *plan,
@@ -561,97 +377,15 @@ fn run_inner(
             });
             return Err(error);
         }
-        let (ms, contact, its, neg) = match steps.last() {
-            Some(l) => (l.midspan, l.contact, l.newton_iterations, l.negative_pivots),
-            None => (
-                midspan(&model, &state).map_err(|source| AppError::Post { stage: i, source })?,
-                None,
-                0,
-                0,
-            ),
-        };
-        // the stage end's profile: the last step's, or computed for it (with its plates)
-        let rings = match steps.last() {
-            Some(l) if !l.profile.is_empty() => l.profile.clone(),
-            _ => {
-                let plates = contact.map(|c| {
-                    Contact::plates(c.values.rho, c.penalty)
-                        .with_enforcement(enforcement)
-                        .with_points(points)
-                });
-                ring_profile(&model, &state, plates.as_ref())
-                    .map_err(|source| AppError::Post { stage: i, source })?
-            }
-        };
-        let layer = boundary_layer(&rings, half, ms.lambda_s, 1e-3);
-        let stage_nonuniformity = nonuniformity(&rings, half);
-        let unstable_note = kind.unstable_note(&ms, gps_limits.as_ref());
-        let wrinkling = wrinkle_report(&model, &state, i)?;
-        let comparison = kind.stage_comparison(
-            closed_form_law.as_ref(),
-            &ms,
-            contact.as_ref(),
-            steps.last(),
-            start_lambda_s,
-        )?;
-        let summary = StageSummary {
-            index: i,
-            kind: kind.name().into(),
-            control: plan.control().map(String::from),
-            target: plan.target,
-            final_state: StageFinal {
-                midspan: ms,
-                newton_iterations: its,
-                stage_steps: steps.len(),
-                stage_newton_iterations: steps.iter().map(|s| s.newton_iterations).sum(),
-                negative_pivots: neg,
-                contact: contact.map(|c| FinalContact {
-                    rho: c.values.rho,
-                    chi: c.values.chi,
-                    chi_geometric: c.values.chi_geometric,
-                    force: c.values.force,
-                    displacement: c.displacement,
-                    contact_pressure: c.values.contact_pressure,
-                    penetration: c.values.penetration,
-                    total_plate_force: c.values.total_force,
-                    penalty: c.penalty,
-                    initial_stretch: c.initial_stretch,
-                }),
-            },
-            cap_boundary_layer: layer,
-            wrinkling,
-            profile: format!("profiles/stage{i}_final.csv"),
-            gps: comparison.gps,
-            ps: comparison.ps,
-            relative_error_vs_gps: comparison.gps_errors,
-            relative_error_vs_ps: comparison.ps_errors,
-            gps_at_fe_pressure: comparison.local_section,
-            relative_error_vs_gps_at_fe_pressure: comparison.local_errors,
-            walls: comparison.walls,
-            planes: kind.planes().map(<[_]>::to_vec).unwrap_or_default(),
-            critical_points: criticals,
-            nonuniformity: stage_nonuniformity,
-            gps_applicable: stage_nonuniformity.is_none_or(|u| u <= NONUNIFORM)
-                && started_uniform.is_none(),
-            gps_not_applicable: match (stage_nonuniformity.filter(|u| *u > NONUNIFORM), started_uniform) {
-                (Some(u), _) => Some(format!(
-                    "the tube is not uniform: λs varies by {:.1} % over the central half of the cylinder (more than {} %){}",
-                    100.0 * u,
-                    100.0 * NONUNIFORM,
-                    unstable_note
-                )),
-                (None, Some(k)) => Some(format!(
-                    "the stage starts from the end of stage {k}, where the tube was not uniform, and the closed form starts from a uniform tube"
-                )),
-                (None, None) => None,
-            },
-        };
-        report.stages.push(StageReport {
-            plan: *plan,
+        let finished = stage_report(
+            &record_input,
+            gps_limits.as_ref(),
+            &model,
+            &state,
             steps,
-            outcome: StageOutcome::Finished(Box::new(summary)),
-            profile: rings,
-        });
+            criticals,
+        )?;
+        report.stages.push(finished);
         for o in observers.iter_mut() {
             o.stage_finished(report)
                 .map_err(|source| AppError::Output {
@@ -665,6 +399,82 @@ fn run_inner(
             what: "the run's results".into(),
             source,
         })?;
+    }
+    Ok(())
+}
+
+/// The report of a run before its first stage: the case, the mesh, the law and the geometry.
+fn initial_report(
+    case: &Case,
+    label: &str,
+    model: &Model,
+    contact_edge_fit: Option<ContactEdgeFit>,
+) -> RunReport {
+    let g = &case.geometry;
+    RunReport {
+        case: label.to_string(),
+        mesh: MeshInfo {
+            nodes: model.mesh().nodes.len(),
+            elements: model.mesh().quads.len(),
+            equations: model.n_eq(),
+            symmetry: format!("{:?}", model.mesh().symmetry).to_lowercase(),
+            element: model.mesh().element().name().into(),
+            factor_nnz: model.factor_nnz(),
+            factor_flops: model.factor_flops(),
+            contact_edge_fit,
+        },
+        material: model.law().name(),
+        material_spec: case.material,
+        geometry: GeometryInfo {
+            radius: g.radius,
+            length: g.length,
+            thickness: g.thickness,
+            caps: format!("{:?}", g.caps).to_lowercase(),
+        },
+        units: UNITS.into(),
+        case_hash: case.hash().to_string(),
+        scales: case.scales(),
+        stages: vec![],
+        warnings: vec![],
+    }
+}
+
+/// Continue from the checkpoint `ck`: its report, its state and, for a tracked mesh, the node
+/// lines where its step had them. A checkpoint of another case or mesh is refused.
+#[allow(clippy::too_many_arguments)]
+fn restore(
+    ck: &Checkpoint,
+    case: &Case,
+    label: &str,
+    tube: Option<crate::edge_track::TubeSpec>,
+    model: &mut Model,
+    state: &mut State,
+    report: &mut RunReport,
+    tracked_edges: &crate::edge_track::Edges,
+) -> Result<()> {
+    if let Some(message) = ck.mismatch(case.hash(), Some(state.x.len())) {
+        return Err(AppError::Folder {
+            path: std::path::PathBuf::from(label),
+            message,
+        });
+    }
+    *report = ck.report.clone();
+    state.x.clone_from(&ck.x);
+    state.p = ck.p;
+    state.multipliers.clone_from(&ck.multipliers);
+    // a tracked mesh: fitted where the checkpoint's step had it
+    if let (Some(tube), Some(edges)) = (tube, checkpoint_edges(ck)) {
+        let nodes = tube.nodes(&edges).map_err(AppError::Mesh)?;
+        let n = nodes.len();
+        model
+            .move_reference(
+                nodes,
+                &tubemem_mesh::hoop::Transfer::identity(n),
+                None,
+                &mut [],
+            )
+            .map_err(AppError::Model)?;
+        *tracked_edges.borrow_mut() = edges;
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! each moved from its `offset` to its `target` as the load parameter t goes from 0 to 1.
 
 use super::{
-    closed_form, penalty_of, LoadParts, RangeInput, StageComparison, StageKind,
+    closed_form, closed_gas_load, penalty_of, LoadParts, RangeInput, StageComparison, StageKind,
     MAX_PENETRATION_FRACTION,
 };
 use crate::case::PlaneSpec;
@@ -13,7 +13,7 @@ use crate::report::{
 use crate::{AppError, Result};
 use tubemem_fem::contact::{Contact, MovingPlanes};
 use tubemem_fem::continuation::ArcLoading;
-use tubemem_fem::model::{Load, Loading, Model, State};
+use tubemem_fem::model::{Load, Model, State};
 use tubemem_fem::post::{MidSpan, WallValues};
 use tubemem_fem::stepping::StepInfo;
 use tubemem_gps::confine::{confine, confine_at_pressure, ConfineState, WallContact};
@@ -79,15 +79,8 @@ impl StageKind for Confine {
     }
 
     fn load(&self, parts: &LoadParts) -> Box<dyn Fn(f64) -> Load> {
-        let (planes, p) = (self.planes.clone(), *parts);
-        Box::new(move |t| {
-            Load::with_contact(
-                Loading::Gas { pv: p.pv },
-                fe_planes(&planes, t, p.penalty)
-                    .with_enforcement(p.enforcement)
-                    .with_points(p.points),
-            )
-        })
+        let planes = self.planes.clone();
+        closed_gas_load(parts, move |t, penalty| fe_planes(&planes, t, penalty))
     }
 
     fn arc_monitor(&self, _model: &Model, _node: usize) -> Box<dyn Fn(&State) -> f64> {

@@ -18,10 +18,13 @@
 pub mod closed_form;
 pub mod confine;
 pub mod critical;
+pub mod failure;
 pub mod inflate;
 pub mod profile;
+pub mod record;
 pub mod setup;
 pub mod squeeze;
+pub mod summary;
 
 use crate::case::{PenaltySpec, PlaneSpec, StagePlan, Target};
 use crate::observer::BoxError;
@@ -227,6 +230,23 @@ pub fn kind_of(plan: &StagePlan, planes: &[PlaneSpec]) -> Box<dyn StageKind> {
             planes: planes.to_vec(),
         }),
     }
+}
+
+/// The load of a closed-gas stage: the gas ϖV fixed, and the planes `planes(value, κ)` at each
+/// value of the load parameter, with the stage's enforcement and contact points.
+fn closed_gas_load(
+    parts: &LoadParts,
+    planes: impl Fn(f64, f64) -> tubemem_fem::contact::Contact + 'static,
+) -> Box<dyn Fn(f64) -> Load> {
+    let p = *parts;
+    Box::new(move |v| {
+        Load::with_contact(
+            tubemem_fem::model::Loading::Gas { pv: p.pv },
+            planes(v, p.penalty)
+                .with_enforcement(p.enforcement)
+                .with_points(p.points),
+        )
+    })
 }
 
 /// The penalty κ of a stage with planes: given, or from its tolerance with the pressure and the

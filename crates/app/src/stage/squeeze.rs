@@ -1,10 +1,10 @@
 //! The squeeze: the gas closed in, the tube pressed between frictionless plates y = ±h.
 
-use super::{penalty_of, LoadParts, RangeInput, StageKind};
+use super::{closed_gas_load, penalty_of, LoadParts, RangeInput, StageKind};
 use crate::report::ContactRecord;
 use tubemem_fem::contact::{Contact, MovingPlanes};
 use tubemem_fem::continuation::ArcLoading;
-use tubemem_fem::model::{Load, Loading, Model, State};
+use tubemem_fem::model::{Load, Model, State};
 use tubemem_fem::post::midspan_contact;
 use tubemem_fem::stepping::StepInfo;
 
@@ -48,15 +48,7 @@ impl StageKind for Squeeze {
     }
 
     fn load(&self, parts: &LoadParts) -> Box<dyn Fn(f64) -> Load> {
-        let p = *parts;
-        Box::new(move |h| {
-            Load::with_contact(
-                Loading::Gas { pv: p.pv },
-                Contact::plates(h, p.penalty)
-                    .with_enforcement(p.enforcement)
-                    .with_points(p.points),
-            )
-        })
+        closed_gas_load(parts, Contact::plates)
     }
 
     fn arc_monitor(&self, _model: &Model, _node: usize) -> Box<dyn Fn(&State) -> f64> {
