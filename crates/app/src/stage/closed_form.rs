@@ -41,17 +41,12 @@ pub fn step_closed_form(
 /// The closed-form comparison of a stage's final state: GPS and PS, and for a squeeze the
 /// section at the FE's pressure. GPS and the section are the last step's (solved once, for its
 /// steps.csv row); only PS is solved here.
-#[allow(clippy::type_complexity)]
 pub fn stage_closed_form(
     law: &dyn MembraneLaw,
     ms: &tubemem_fem::post::MidSpan,
     contact: Option<&ContactRecord>,
     last: Option<&StepClosedForm>,
-) -> Result<(
-    [(ClosedFormState, RelativeErrors); 2],
-    Option<LocalSection>,
-    Option<RelativeErrors>,
-)> {
+) -> Result<super::StageComparison> {
     let local = last.and_then(|l| l.local.as_ref());
     let one = |hyp: Hypothesis| -> Result<(ClosedFormState, RelativeErrors)> {
         Ok(match contact {
@@ -100,7 +95,7 @@ pub fn stage_closed_form(
             }
         })
     };
-    let both = [one(Hypothesis::Gps)?, one(Hypothesis::Ps)?];
+    let ((gps, gps_errors), (ps, ps_errors)) = (one(Hypothesis::Gps)?, one(Hypothesis::Ps)?);
     let (section, errors) = match (contact, local) {
         (Some(c), Some(Ok(l))) => (
             Some(LocalSection::Solved(*l)),
@@ -116,5 +111,13 @@ pub fn stage_closed_form(
         (Some(_), Some(Err(e))) => (Some(LocalSection::Failed { error: e.clone() }), None),
         _ => (None, None),
     };
-    Ok((both, section, errors))
+    Ok(super::StageComparison {
+        gps,
+        ps,
+        gps_errors,
+        ps_errors,
+        local_section: section,
+        local_errors: errors,
+        walls: vec![],
+    })
 }

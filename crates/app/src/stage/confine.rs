@@ -157,17 +157,8 @@ impl StageKind for Confine {
         last: Option<&StepRecord>,
         start_lambda_s: f64,
     ) -> Result<StageComparison> {
-        let ([(gps, gps_errors), (ps, ps_errors)], local_section, local_errors) =
+        let mut out =
             closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form))?;
-        let mut out = StageComparison {
-            gps,
-            ps,
-            gps_errors,
-            ps_errors,
-            local_section,
-            local_errors,
-            walls: vec![],
-        };
         let Some(last) = last else {
             return Ok(out);
         };

@@ -162,16 +162,15 @@ pub trait StageKind {
     #[allow(clippy::too_many_arguments)]
     fn step_closed_form(
         &self,
-        model: &Model,
-        state: &State,
-        info: &StepInfo<'_>,
+        _model: &Model,
+        _state: &State,
+        _info: &StepInfo<'_>,
         law: &dyn MembraneLaw,
         ms: &MidSpan,
         contact: Option<&ContactRecord>,
         start_lambda_s: f64,
-        stage: usize,
+        _stage: usize,
     ) -> std::result::Result<(StepClosedForm, Vec<WallValues>), BoxError> {
-        let _ = (model, state, info, stage);
         Ok((
             closed_form::step_closed_form(law, ms, contact.map(|c| (&c.values, start_lambda_s))),
             vec![],
@@ -188,17 +187,7 @@ pub trait StageKind {
         last: Option<&StepRecord>,
         _start_lambda_s: f64,
     ) -> Result<StageComparison> {
-        let ([(gps, gps_errors), (ps, ps_errors)], local_section, local_errors) =
-            closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form))?;
-        Ok(StageComparison {
-            gps,
-            ps,
-            gps_errors,
-            ps_errors,
-            local_section,
-            local_errors,
-            walls: vec![],
-        })
+        closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form))
     }
 
     /// Said when the final tube is not uniform and the kind knows why (an inflation past the
