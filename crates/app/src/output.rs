@@ -519,7 +519,11 @@ impl RunWriter {
             .iter()
             .filter_map(|k| read_checkpoint(&dir.join("checkpoints").join(format!("ckpt-{k}.bin"))))
             .max_by_key(|c| c.rows)
-            .ok_or_else(|| folder("no whole checkpoint in checkpoints/".into()))?;
+            .ok_or_else(|| {
+                // killed while its first checkpoint was being written: checkpoints/ exists,
+                // but holds no whole checkpoint
+                folder("it holds no whole checkpoint to resume from (the run was killed before its first checkpoint was complete): start it afresh with --overwrite".into())
+            })?;
         if let Some(message) = ck.mismatch(case_hash, None) {
             return Err(folder(message));
         }
