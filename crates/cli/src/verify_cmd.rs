@@ -75,7 +75,7 @@ pub fn run(a: VerifyArgs) -> u8 {
                 err,
                 "[{done}/{total}] {:<7} {:<12} {} ({:.1} s): {}",
                 r.status.label(),
-                r.kind.label(),
+                r.kind,
                 r.name,
                 r.seconds,
                 r.message

@@ -118,7 +118,7 @@ pub fn junit(r: &Results) -> String {
             let _ = write!(
                 x,
                 "    <testcase classname=\"tubemem.verify.{}\" name=\"{}\" time=\"{:.3}\"",
-                c.kind.label(),
+                c.kind,
                 esc_xml(&c.name),
                 c.seconds
             );
@@ -126,7 +126,7 @@ pub fn junit(r: &Results) -> String {
                 format!(
                     ">\n      <{tag} message=\"{}\" type=\"{}\">{}</{tag}>\n    </testcase>\n",
                     esc_xml(&c.message),
-                    c.kind.label(),
+                    c.kind,
                     esc_xml(&c.message)
                 )
             };
@@ -161,20 +161,14 @@ pub fn markdown(r: &Results) -> String {
             m,
             "| {} | {} | {} | {} | {:.1} s |",
             esc_md(&c.name),
-            c.kind.label(),
+            c.kind,
             c.status.label(),
             esc_md(&c.message),
             c.seconds
         );
     }
     for c in r.checks {
-        let _ = writeln!(
-            m,
-            "\n## {} ({}, {})\n",
-            c.name,
-            c.kind.label(),
-            c.status.label()
-        );
+        let _ = writeln!(m, "\n## {} ({}, {})\n", c.name, c.kind, c.status.label());
         if c.measures.is_empty() {
             let _ = writeln!(m, "{}", esc_md(&c.message));
             continue;
@@ -247,7 +241,7 @@ pub fn html(r: &Results) -> String {
             h,
             "<tr><td><a href=\"#{0}\">{0}</a></td><td>{1}</td><td><span class=\"st\" style=\"background:{2}\">{3}</span></td><td>{4}</td><td>{5:.1} s</td></tr>",
             esc_html(&c.name),
-            c.kind.label(),
+            c.kind,
             status_color(c.status),
             c.status.label(),
             esc_html(&c.message),
@@ -262,7 +256,7 @@ pub fn html(r: &Results) -> String {
             esc_html(&c.name),
             status_color(c.status),
             c.status.label(),
-            c.kind.label(),
+            c.kind,
             esc_html(&c.message)
         );
         if !c.measures.is_empty() {

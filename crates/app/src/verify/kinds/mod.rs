@@ -1,0 +1,88 @@
+//! The kinds of check, one file each, behind one trait.
+//!
+//! A kind runs its check's case (or a family of variations of it) and judges what the typed
+//! [`RunReport`]s say. It pushes [`Measure`](super::Measure)s onto the [`CheckResult`] (each
+//! with its tolerance and the tolerance's source), the member run folders, and optionally a
+//! figure; [`run_check_with`](super::run_check_with) turns the measures into the status and
+//! the one-line message. To add a kind: implement [`VerifyKind`] in a file here, add a
+//! [`CheckKind`] variant (the name a suite file gives it) and its line in [`kind_of`].
+//! `crates/app/tests/verify_kind.rs` is a worked example: a toy kind run through the trait.
+
+use super::suite::{Check, CheckKind};
+use super::{run_member, vary, CheckResult, VerifyOptions};
+use crate::figures::{rasterize, render_svg, Figure};
+use crate::report::RunReport;
+use plotters::style::RGBColor;
+use std::path::{Path, PathBuf};
+
+mod closed_form;
+mod convergence;
+mod end_effect;
+mod gold;
+mod invariance;
+mod reference;
+
+pub use reference::REFERENCES_HOWTO;
+
+/// One kind of check.
+pub trait VerifyKind: Sync {
+    /// The kind's name, as a suite file and the reports give it.
+    fn label(&self) -> &'static str;
+    /// Run check `c` under its folder `dir` and add what it measured to `r`.
+    fn evaluate(
+        &self,
+        c: &Check,
+        dir: &Path,
+        opts: &VerifyOptions,
+        r: &mut CheckResult,
+    ) -> KindResult;
+}
+
+/// The kind a suite file's `kind = "..."` names.
+pub fn kind_of(kind: CheckKind) -> &'static dyn VerifyKind {
+    match kind {
+        CheckKind::ClosedForm => &closed_form::ClosedForm,
+        CheckKind::Reference => &reference::Reference,
+        CheckKind::Convergence => &convergence::Convergence,
+        CheckKind::EndEffect => &end_effect::EndEffect,
+        CheckKind::Invariance => &invariance::Invariance,
+        CheckKind::Gold => &gold::Gold,
+    }
+}
+
+/// Outcome of a kind's evaluation: `Ok(None)` judged by the measures, `Ok(Some(reason))`
+/// skipped, `Err(message)` an error.
+pub type KindResult = Result<Option<String>, String>;
+
+fn member(c: &Check, text: &str, dir: &Path, r: &mut CheckResult) -> Result<RunReport, String> {
+    r.runs.push(dir.display().to_string());
+    let text = vary(text, |_| {})?;
+    Ok(run_member(
+        &text,
+        &c.base_dir,
+        dir,
+        &format!("check {}", c.spec.name),
+    )?)
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    a / b - 1.0
+}
+
+const COLORS: [RGBColor; 6] = [
+    RGBColor(31, 90, 180),
+    RGBColor(200, 50, 40),
+    RGBColor(20, 140, 60),
+    RGBColor(150, 60, 170),
+    RGBColor(230, 130, 0),
+    RGBColor(90, 90, 90),
+];
+
+/// Draw a small figure to PNG bytes (for the HTML report).
+fn plot(fig: &Figure, r: &mut CheckResult) {
+    r.figure = Some(crate::figures::audit(fig));
+    let p = PathBuf::from(format!("{}.png", r.name));
+    if let Ok(svg) = render_svg(fig, &p) {
+        r.png = rasterize(&svg, 70.0, &p).ok();
+    }
+}
