@@ -524,6 +524,13 @@ pub enum Target {
 }
 
 impl StagePlan {
+    /// How the stage's planes are enforced: the case's `enforcement`, penalty when it names
+    /// none.
+    pub fn contact_enforcement(&self) -> tubemem_fem::contact::Enforcement {
+        self.enforcement
+            .unwrap_or(tubemem_fem::contact::Enforcement::Penalty)
+    }
+
     /// The stage's `control` as the case file names it: "pressure", "volume" or "arc-length"
     /// (None: a squeeze or confine stage stepped by load, which names no control).
     pub fn control(&self) -> Option<&'static str> {

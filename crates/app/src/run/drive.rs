@@ -13,7 +13,6 @@ use crate::stage::summary::stage_report;
 use crate::stage::{LoadParts, StageKind};
 use crate::Result;
 use std::cell::RefCell;
-use tubemem_fem::contact::Enforcement;
 use tubemem_fem::continuation::{run_arc_stage, ArcLoading, Critical, CriticalKind};
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::stepping::{run_stage_refitted, Stage, StageError, StepInfo, StepSettings};
@@ -43,7 +42,7 @@ pub(super) fn drive_stage(
         node: r.node,
         pv: context.pv,
         penalty: context.penalty,
-        enforcement: plan.enforcement.unwrap_or(Enforcement::Penalty),
+        enforcement: plan.contact_enforcement(),
         points: plan.contact_points,
     };
     let stage = Stage {

@@ -6,7 +6,7 @@ use super::profile::{boundary_layer, wrinkle_report};
 use super::record::RecordInput;
 use crate::report::*;
 use crate::{AppError, Result};
-use tubemem_fem::contact::{Contact, Enforcement};
+use tubemem_fem::contact::Contact;
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::post::{midspan, ring_profile};
 use tubemem_gps::limits::Limits;
@@ -37,7 +37,7 @@ pub fn stage_report(
         _ => {
             let plates = contact.map(|c| {
                 Contact::plates(c.values.rho, c.penalty)
-                    .with_enforcement(r.plan.enforcement.unwrap_or(Enforcement::Penalty))
+                    .with_enforcement(r.plan.contact_enforcement())
                     .with_points(r.plan.contact_points)
             });
             ring_profile(model, state, plates.as_ref())

@@ -1,0 +1,86 @@
+//! `tubemem.verify`: verification suites, or the study of one case.
+
+use crate::convert::to_py;
+use crate::errors::TubememError;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// Run verification suites (TOML files, as `tubemem verify`) or, with `case=`, the study of one
+/// case (closed form, three-mesh convergence with GCI, end effect, invariance core, references),
+/// into `out`; writes results.json, report.md, report.html and junit.xml there and returns the
+/// results as a dict (results.json's content: `verdict`, `passed`, `failed`, `checks` with each
+/// check's `status`, `message`, `measures` and `details`). Bad suites raise ValueError; failing
+/// checks do not raise (read `failed` and each check's `status`). The `reference` checks run
+/// the scikit-fem references in `python` (default: this interpreter, where
+/// `pip install ./python_ref` puts them) or from the `python_ref` folder given (default
+/// `TUBEMEM_PYTHON_REF`, else a checkout's above the case or the working folder).
+#[pyfunction]
+#[pyo3(signature = (suites=None, out=PathBuf::from("tubemem-verify"), case=None, quick=false, jobs=0, filter=None, update_gold=false, python=None, python_ref=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn verify<'py>(
+    py: Python<'py>,
+    suites: Option<Vec<PathBuf>>,
+    out: PathBuf,
+    case: Option<PathBuf>,
+    quick: bool,
+    jobs: usize,
+    filter: Option<String>,
+    update_gold: bool,
+    python: Option<PathBuf>,
+    python_ref: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use tubemem_app::verify::{self as v, report::Results, VerifyOptions};
+    let python = match python {
+        Some(p) => Some(p),
+        None => Some(
+            py.import("sys")?
+                .getattr("executable")?
+                .extract::<PathBuf>()?,
+        )
+        .filter(|p| !p.as_os_str().is_empty()),
+    };
+    let opts = VerifyOptions {
+        jobs,
+        filter,
+        update_gold,
+        python,
+        python_ref,
+    };
+    let t0 = std::time::Instant::now();
+    let quiet = |_: v::Event| {};
+    let (names, results, verdict) = match (case, suites) {
+        (Some(c), None) => {
+            let s = py
+                .detach(|| v::study::run_study(&c, &out, quick, &opts, &quiet))
+                .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
+            (
+                vec![format!("study of {}", c.display())],
+                s.results,
+                Some(s.verdict),
+            )
+        }
+        (None, Some(list)) if !list.is_empty() => {
+            let mut checks = vec![];
+            let mut names = vec![];
+            for s in &list {
+                let (n, c) =
+                    v::suite::read_suite(s).map_err(|e| PyValueError::new_err(e.to_string()))?;
+                names.push(n);
+                checks.extend(c);
+            }
+            let r = py
+                .detach(|| v::run_checks(&checks, &out, &opts, &quiet))
+                .map_err(|e| TubememError::new_err(e.chain()))?;
+            (names, r, None)
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "give suites=[...] (suite files) or case=... (a case file), not both",
+            ))
+        }
+    };
+    let results = Results::new(names, t0.elapsed().as_secs_f64(), &results, verdict);
+    v::report::write_all(&out, &results).map_err(|e| TubememError::new_err(e.chain()))?;
+    to_py(py, &results)
+}
