@@ -123,6 +123,168 @@ fn named<'a>(results: &'a [CheckResult], name: &str) -> Option<&'a CheckResult> 
     results.iter().find(|r| r.name == name)
 }
 
+/// The study's member checks and the families they run, built from the case.
+struct StudyPlan {
+    conv: CheckSpec,
+    end: CheckSpec,
+    inv: CheckSpec,
+    reference: CheckSpec,
+    /// the quantities judged against GPS: ϖ, and for a squeeze the force and the contact width
+    judged: Vec<String>,
+    /// the mesh family's counts around, and the user's mesh's place in it
+    family: Vec<usize>,
+    user: usize,
+    /// the end-effect family's lengths L/R, and the case's
+    lengths: Vec<f64>,
+    l: f64,
+}
+
+impl StudyPlan {
+    fn of(case: &crate::case::Case, path: &str, quick: bool) -> Self {
+        // the gas closed in (a squeeze or a confine stage last): the end effect falls as 1/L
+        let last_kind = case.stages.last().map(|s| s.kind);
+        let squeeze = last_kind == Some(crate::case::Kind::Squeeze);
+        let closed_gas = squeeze || last_kind == Some(crate::case::Kind::Confine);
+        let l = case.geometry.length / case.geometry.radius;
+        let judged: Vec<String> = if squeeze {
+            vec!["w".into(), "force".into(), "chi".into()]
+        } else {
+            vec!["w".into()]
+        };
+        let mut conv = spec("convergence", CheckKind::Convergence, path);
+        conv.refinement = Some(2.0);
+        conv.meshes = Some(3);
+        // the family refines upward from the user's mesh, which every valid case admits
+        // (halving 24 around gives 12, which the generator refuses); --quick starts one level
+        // coarser where the halved mesh is valid (around/2 a multiple of 8, along/2 even), for
+        // a quarter the cost
+        let around = case.mesh.around.unwrap_or(8);
+        let along = case.mesh.along.unwrap_or(2);
+        let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
+        let halves = around.is_multiple_of(2)
+            && along.is_multiple_of(2)
+            && cap_rows.is_multiple_of(2)
+            && tubemem_mesh::tube::check_counts(around / 2, along / 2, (cap_rows / 2).max(1))
+                .is_ok();
+        let start = if quick && halves { -1 } else { 0 };
+        conv.start = Some(start);
+        let family: Vec<usize> = (0..3)
+            .map(|k| (around as f64 * 2f64.powi(start + k)).round() as usize)
+            .collect();
+        conv.expected_order = Some(match case.mesh.element {
+            tubemem_mesh::ElementKind::Quad4 => Expect {
+                value: 2.0,
+                within: 0.5,
+                source: "bilinear facets: the polygon error 1/cos(π/n) − 1 ≈ π²/(2n²) is O(n⁻²)"
+                    .into(),
+            },
+            tubemem_mesh::ElementKind::Quad9 => Expect {
+                value: 4.0,
+                within: 0.5,
+                source: "biquadratic isoparametric geometry: the volume, the Rivlin sphere's limit pressure and the tube's mid-span ϖ converge at order 4 (crates/fem/src/tests_quad9.rs, scripts/convergence-tables.py)".into(),
+            },
+        });
+        // ϖ is held to the element's order; the force and χ of the contact converge with the
+        // contact edge's position between nodes, and may oscillate: their order (or half
+        // range) is reported, and their allowance uses Roache's factor for an unverified order
+        conv.quantities = Some(judged.clone());
+        conv.order_quantities = Some(vec!["w".into()]);
+        // the extrapolated value against GPS is judged by the closed-form check below, which
+        // allows for the end effect and the mesh together
+        conv.compare_reference = Some(false);
+        let mut end = spec("end-effect", CheckKind::EndEffect, path);
+        // the gas-closed law c + A/(L/R) holds once the tube is longer than its two boundary
+        // layers: on the user's Mooney–Rivlin squeeze (L/R = 15, layers of 5.5 R) the member
+        // at L/2 put c at −1.2e-2 for the force, where L/R = 15…240 give −5.6e-3 (c + A/L and
+        // c + A/L + B/L² agree to 3e-5 over 30…240): so that law is fitted from L up; the
+        // exponential decay of an inflation is fitted across L
+        let lengths = match (closed_gas, quick) {
+            (true, false) => vec![l, 2.0 * l, 4.0 * l],
+            (true, true) => vec![l, 1.5 * l, 2.0 * l],
+            (false, false) => vec![0.5 * l, l, 2.0 * l],
+            (false, true) => vec![0.5 * l, 0.75 * l, l],
+        };
+        end.lengths = Some(lengths.clone());
+        end.quantities = Some(judged.clone());
+        end.law = Some(if closed_gas {
+            EndLaw::Inverse
+        } else {
+            EndLaw::Exponential
+        });
+        end.epsilon = Some(1e-3);
+        // reported, not gated: how much of the tube is translation invariant is a property of
+        // the tube's length, not of whether GPS describes its mid-span (issue #24 item 12)
+        let mut inv = spec("invariance", CheckKind::Invariance, path);
+        inv.epsilon = Some(1e-3);
+        let mut reference = spec("reference", CheckKind::Reference, path);
+        reference.tolerance.insert(
+            "profile".into(),
+            Tol {
+                value: 5e-3,
+                source: "the FE end-cap profile against the axisymmetric one: 1.07e-4 at 64 around, 5.7e-4 at 16 around (README), with room for coarser meshes".into(),
+            },
+        );
+        StudyPlan {
+            conv,
+            end,
+            inv,
+            reference,
+            judged,
+            family,
+            user: (-start) as usize,
+            lengths,
+            l,
+        }
+    }
+
+    /// Each judged quantity's allowance, from the checks among `results` that passed only.
+    fn allowances(&self, results: &[CheckResult]) -> Vec<Allowance> {
+        let passed = |n: &str| named(results, n).filter(|r| r.status == Status::Pass);
+        let conv_rows = passed("convergence")
+            .and_then(|r| r.details.get("quantities"))
+            .and_then(|t| t.as_array())
+            .cloned()
+            .unwrap_or_default();
+        let end_fits = passed("end-effect")
+            .and_then(|r| r.details.get("fits"))
+            .cloned();
+        let user = self.user;
+        let mut allowances: Vec<Allowance> = vec![];
+        for q in &self.judged {
+            let row = conv_rows.iter().find(|r| r["quantity"] == q.as_str());
+            let mesh = row.and_then(|row| {
+                let values = row["values"].as_array()?;
+                let user_value = values.get(user)?.as_f64()?;
+                if q == "w" {
+                    let ext = row["extrapolated"].as_f64()?;
+                    return Some(MeshPart::Richardson {
+                        error: user_value / ext - 1.0,
+                        order: row["order"].as_f64()?,
+                        gci: row["gci_fine"].as_f64()?,
+                    });
+                }
+                let next = values.get(user + 1)?.as_f64()?;
+                let change = user_value / next - 1.0;
+                Some(MeshPart::Unverified {
+                    change,
+                    band: UNVERIFIED_SAFETY * change.abs(),
+                })
+            });
+            let ends = end_fits
+                .as_ref()
+                .and_then(|f| f.get(q.as_str()))
+                .and_then(|f| serde_json::from_value::<super::stats::EndFit>(f["fit"].clone()).ok())
+                .map(|f| (f.end_effect(self.l), f.length_for(1e-3)));
+            allowances.push(Allowance {
+                quantity: q.clone(),
+                mesh,
+                ends,
+            });
+        }
+        allowances
+    }
+}
+
 /// Build and run the study of `case_path` into `out`.
 pub fn run_study(
     case_path: &Path,
@@ -144,11 +306,6 @@ pub fn run_study(
             "the study refines a generated mesh: give `around` and `along`, not a mesh file",
         ));
     }
-    // the gas closed in (a squeeze or a confine stage last): the end effect falls as 1/L
-    let last_kind = case.stages.last().map(|s| s.kind);
-    let squeeze = last_kind == Some(crate::case::Kind::Squeeze);
-    let closed_gas = squeeze || last_kind == Some(crate::case::Kind::Confine);
-    let l = case.geometry.length / case.geometry.radius;
     let base_dir = case_path
         .parent()
         .map(Path::to_path_buf)
@@ -164,84 +321,7 @@ pub fn run_study(
         base_dir: base_dir.clone(),
         gold_dir: base_dir.clone(),
     };
-    let path = case_path.display().to_string();
-    // the quantities judged against GPS: ϖ, and for a squeeze the force and the contact width
-    let judged: Vec<String> = if squeeze {
-        vec!["w".into(), "force".into(), "chi".into()]
-    } else {
-        vec!["w".into()]
-    };
-    let mut conv = spec("convergence", CheckKind::Convergence, &path);
-    conv.refinement = Some(2.0);
-    conv.meshes = Some(3);
-    // the family refines upward from the user's mesh, which every valid case admits (halving
-    // 24 around gives 12, which the generator refuses); --quick starts one level coarser where
-    // the halved mesh is valid (around/2 a multiple of 8, along/2 even), for a quarter the cost
-    let around = case.mesh.around.unwrap_or(8);
-    let along = case.mesh.along.unwrap_or(2);
-    let cap_rows = case.mesh.cap_rows.unwrap_or(around / 8);
-    let halves = around % 2 == 0
-        && along % 2 == 0
-        && cap_rows % 2 == 0
-        && tubemem_mesh::tube::check_counts(around / 2, along / 2, (cap_rows / 2).max(1)).is_ok();
-    let start = if quick && halves { -1 } else { 0 };
-    conv.start = Some(start);
-    let family: Vec<usize> = (0..3)
-        .map(|k| (around as f64 * 2f64.powi(start + k)).round() as usize)
-        .collect();
-    conv.expected_order = Some(match case.mesh.element {
-        tubemem_mesh::ElementKind::Quad4 => Expect {
-            value: 2.0,
-            within: 0.5,
-            source: "bilinear facets: the polygon error 1/cos(π/n) − 1 ≈ π²/(2n²) is O(n⁻²)"
-                .into(),
-        },
-        tubemem_mesh::ElementKind::Quad9 => Expect {
-            value: 4.0,
-            within: 0.5,
-            source: "biquadratic isoparametric geometry: the volume, the Rivlin sphere's limit pressure and the tube's mid-span ϖ converge at order 4 (crates/fem/src/tests_quad9.rs, scripts/convergence-tables.py)".into(),
-        },
-    });
-    // ϖ is held to the element's order; the force and χ of the contact converge with the
-    // contact edge's position between nodes, and may oscillate: their order (or half range)
-    // is reported, and their allowance uses Roache's factor for an unverified order
-    conv.quantities = Some(judged.clone());
-    conv.order_quantities = Some(vec!["w".into()]);
-    // the extrapolated value against GPS is judged by the closed-form check below, which
-    // allows for the end effect and the mesh together
-    conv.compare_reference = Some(false);
-    let mut end = spec("end-effect", CheckKind::EndEffect, &path);
-    // the gas-closed law c + A/(L/R) holds once the tube is longer than its two boundary
-    // layers: on the user's Mooney–Rivlin squeeze (L/R = 15, layers of 5.5 R) the member at
-    // L/2 put c at −1.2e-2 for the force, where L/R = 15…240 give −5.6e-3 (c + A/L and
-    // c + A/L + B/L² agree to 3e-5 over 30…240): so that law is fitted from L up; the
-    // exponential decay of an inflation is fitted across L
-    let lengths = match (closed_gas, quick) {
-        (true, false) => vec![l, 2.0 * l, 4.0 * l],
-        (true, true) => vec![l, 1.5 * l, 2.0 * l],
-        (false, false) => vec![0.5 * l, l, 2.0 * l],
-        (false, true) => vec![0.5 * l, 0.75 * l, l],
-    };
-    end.lengths = Some(lengths.clone());
-    end.quantities = Some(judged.clone());
-    end.law = Some(if closed_gas {
-        EndLaw::Inverse
-    } else {
-        EndLaw::Exponential
-    });
-    end.epsilon = Some(1e-3);
-    // reported, not gated: how much of the tube is translation invariant is a property of the
-    // tube's length, not of whether GPS describes its mid-span (issue #24 item 12)
-    let mut inv = spec("invariance", CheckKind::Invariance, &path);
-    inv.epsilon = Some(1e-3);
-    let mut reference = spec("reference", CheckKind::Reference, &path);
-    reference.tolerance.insert(
-        "profile".into(),
-        Tol {
-            value: 5e-3,
-            source: "the FE end-cap profile against the axisymmetric one: 1.07e-4 at 64 around, 5.7e-4 at 16 around (README), with room for coarser meshes".into(),
-        },
-    );
+    let plan = StudyPlan::of(&case, &case_path.display().to_string(), quick);
     // one progress count over the whole study (the checks run in two rounds)
     let selected = |n: &str| opts.filter.as_deref().is_none_or(|f| n.contains(f));
     let total = [
@@ -276,64 +356,24 @@ pub fn run_study(
     };
     let mut results = vec![];
     round(
-        vec![mk(end), mk(inv), mk(reference), mk(conv)],
+        vec![
+            mk(plan.end.clone()),
+            mk(plan.inv.clone()),
+            mk(plan.reference.clone()),
+            mk(plan.conv.clone()),
+        ],
         &mut results,
     )?;
-    // each judged quantity's allowance, from the checks that passed only
-    let passed = |n: &str| named(&results, n).filter(|r| r.status == Status::Pass);
-    let conv_rows = passed("convergence")
-        .and_then(|r| r.details.get("quantities"))
-        .and_then(|t| t.as_array())
-        .cloned()
-        .unwrap_or_default();
-    let end_fits = passed("end-effect")
-        .and_then(|r| r.details.get("fits"))
-        .cloned();
-    let user = (-start) as usize;
-    let mut allowances: Vec<Allowance> = vec![];
-    for q in &judged {
-        let row = conv_rows.iter().find(|r| r["quantity"] == q.as_str());
-        let mesh = row.and_then(|row| {
-            let values = row["values"].as_array()?;
-            let user_value = values.get(user)?.as_f64()?;
-            if q == "w" {
-                let ext = row["extrapolated"].as_f64()?;
-                return Some(MeshPart::Richardson {
-                    error: user_value / ext - 1.0,
-                    order: row["order"].as_f64()?,
-                    gci: row["gci_fine"].as_f64()?,
-                });
-            }
-            let next = values.get(user + 1)?.as_f64()?;
-            let change = user_value / next - 1.0;
-            Some(MeshPart::Unverified {
-                change,
-                band: UNVERIFIED_SAFETY * change.abs(),
-            })
-        });
-        let ends = end_fits
-            .as_ref()
-            .and_then(|f| f.get(q.as_str()))
-            .and_then(|f| serde_json::from_value::<super::stats::EndFit>(f["fit"].clone()).ok())
-            .map(|f| (f.end_effect(l), f.length_for(1e-3)));
-        allowances.push(Allowance {
-            quantity: q.clone(),
-            mesh,
-            ends,
-        });
-    }
-    let why_not = |a: &Allowance| -> String {
-        match (&a.mesh, &a.ends) {
-            (None, None) => "the convergence and end-effect checks gave no estimate".into(),
-            (None, _) => "the convergence check gave no mesh estimate".into(),
-            _ => "the end-effect check gave no estimate".into(),
-        }
-    };
-    let mut cf = spec("closed-form", CheckKind::ClosedForm, &path);
+    let allowances = plan.allowances(&results);
+    let mut cf = spec(
+        "closed-form",
+        CheckKind::ClosedForm,
+        &case_path.display().to_string(),
+    );
     // at the last step, where the mesh and end-effect estimates are made (the first steps of a
     // squeeze, on a narrow flat, have other and larger relative errors)
     for a in &allowances {
-        if let Some((value, source)) = a.tolerance(l, &family, &lengths) {
+        if let Some((value, source)) = a.tolerance(plan.l, &plan.family, &plan.lengths) {
             cf.tolerance
                 .insert(format!("final_{}", a.quantity), Tol { value, source });
         }
@@ -341,49 +381,131 @@ pub fn run_study(
     if !cf.tolerance.is_empty() {
         round(vec![mk(cf)], &mut results)?;
     }
-    let have_end = named(&results, "end-effect").is_some();
-    let have_conv = named(&results, "convergence").is_some();
-    let cf_r = named(&results, "closed-form");
-    let measure = |q: &str| {
-        cf_r.and_then(|r| {
-            r.measures
-                .iter()
-                .find(|m| m.quantity == format!("final_{q}"))
-        })
-        .cloned()
-    };
-    let core = named(&results, "invariance")
-        .and_then(|r| r.measures.first())
-        .map(|m| m.measured);
-    let failed: Vec<&str> = results
-        .iter()
-        .filter(|r| matches!(r.status, Status::Fail | Status::Error) && r.name != "closed-form")
-        .map(|r| r.name.as_str())
-        .collect();
-    fn label(q: &str) -> &str {
-        match q {
-            "w" => "ϖ",
-            "force" => "the squeeze force",
-            "chi" => "the contact width χ",
-            other => other,
-        }
+    let verdict = Verdict {
+        plan: &plan,
+        results: &results,
+        allowances: &allowances,
     }
-    let mut verdict = String::new();
-    // what `--filter` left out of the comparison with GPS
-    if let Some(f) = opts.filter.as_deref().filter(|_| !(have_end && have_conv)) {
+    .text(&case, opts.filter.as_deref(), quick);
+    Ok(Study { results, verdict })
+}
+
+/// How a judged quantity is named in the verdict.
+fn label(q: &str) -> &str {
+    match q {
+        "w" => "ϖ",
+        "force" => "the squeeze force",
+        "chi" => "the contact width χ",
+        other => other,
+    }
+}
+
+/// What the study's verdict is written from.
+struct Verdict<'a> {
+    plan: &'a StudyPlan,
+    results: &'a [CheckResult],
+    allowances: &'a [Allowance],
+}
+
+impl Verdict<'_> {
+    /// The verdict: whether GPS describes the tube's mid-span and to what accuracy, the checks
+    /// that did not pass, a target past the pressure maximum, the invariant core, the length
+    /// an end effect below 1e-3 needs, and the families.
+    fn text(&self, case: &crate::case::Case, filter: Option<&str>, quick: bool) -> String {
+        let results = self.results;
+        let have_end = named(results, "end-effect").is_some();
+        let have_conv = named(results, "convergence").is_some();
+        let mut verdict = String::new();
+        // what `--filter` left out of the comparison with GPS
+        if let Some(f) = filter.filter(|_| !(have_end && have_conv)) {
+            verdict.push_str(&format!(
+                "the comparison with GPS was not made: it needs the end-effect and convergence checks, and --filter {f:?} left {} out; ",
+                match (have_end, have_conv) {
+                    (false, false) => "both",
+                    (false, true) => "end-effect",
+                    _ => "convergence",
+                }
+            ));
+        } else {
+            verdict.push_str(&self.gps_sentence());
+        }
+        let failed: Vec<&str> = results
+            .iter()
+            .filter(|r| matches!(r.status, Status::Fail | Status::Error) && r.name != "closed-form")
+            .map(|r| r.name.as_str())
+            .collect();
+        if !failed.is_empty() {
+            verdict.push_str(&format!(
+                "Did not pass (their estimates are not used): {}. ",
+                failed.join(", ")
+            ));
+        }
+        if named(results, "closed-form").is_some() {
+            verdict.push_str(&past_maximum(case));
+        }
+        if let Some(c) = named(results, "invariance")
+            .and_then(|r| r.measures.first())
+            .map(|m| m.measured)
+        {
+            verdict.push_str(&format!(
+                "Along the tube, the middle {:.0} % is translation invariant (ε = 1e-3), the rest the caps' boundary layers. ",
+                100.0 * c
+            ));
+        }
+        let needed: Vec<String> = self
+            .allowances
+            .iter()
+            .filter_map(|a| {
+                let (_, n) = a.ends?;
+                n.is_finite()
+                    .then(|| format!("{} L/R ≥ {n:.1}", label(&a.quantity)))
+            })
+            .collect();
+        let (family, lengths, l) = (&self.plan.family, &self.plan.lengths, self.plan.l);
+        if !needed.is_empty() {
+            verdict.push_str(&format!(
+                "An end effect below ε = 1e-3 needs {} (this tube: {l}). ",
+                needed.join(", ")
+            ));
+        }
         verdict.push_str(&format!(
-            "the comparison with GPS was not made: it needs the end-effect and convergence checks, and --filter {f:?} left {} out; ",
-            match (have_end, have_conv) {
-                (false, false) => "both",
-                (false, true) => "end-effect",
-                _ => "convergence",
+            "Meshes {family:?} around, lengths L/R = {}{}.",
+            lengths
+                .iter()
+                .map(|x| format!("{x}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if quick {
+                " (--quick: the cheaper family above; its estimates, and so its allowances, are cruder than the full study's, which refines upward from the case's mesh to 4 times as fine and, for a gas-closed stage, fits lengths up to 4L)"
+            } else {
+                ""
             }
         ));
-    } else {
+        verdict
+    }
+
+    /// Whether GPS describes the mid-span: each judged quantity held, broken or not judged.
+    fn gps_sentence(&self) -> String {
+        let cf_r = named(self.results, "closed-form");
+        let measure = |q: &str| {
+            cf_r.and_then(|r| {
+                r.measures
+                    .iter()
+                    .find(|m| m.quantity == format!("final_{q}"))
+            })
+            .cloned()
+        };
+        let why_not = |a: &Allowance| -> String {
+            match (&a.mesh, &a.ends) {
+                (None, None) => "the convergence and end-effect checks gave no estimate".into(),
+                (None, _) => "the convergence check gave no mesh estimate".into(),
+                _ => "the end-effect check gave no estimate".into(),
+            }
+        };
         let mut held = vec![];
         let mut broken = vec![];
         let mut unjudged = vec![];
-        for a in &allowances {
+        for a in self.allowances {
             match measure(&a.quantity) {
                 // no step to compare: the last step is not a uniform tube (a bulge)
                 Some(m) if m.measured.is_nan() => broken.push(format!(
@@ -406,6 +528,7 @@ pub fn run_study(
                 None => unjudged.push(format!("{} ({})", label(&a.quantity), why_not(a))),
             }
         }
+        let mut verdict = String::new();
         if broken.is_empty() && !held.is_empty() {
             verdict.push_str(&format!(
                 "At mid-span GPS describes this tube, to within its mesh and end effects: {}",
@@ -426,67 +549,36 @@ pub fn run_study(
             verdict.push_str(&format!("; not judged: {}", unjudged.join(", ")));
         }
         verdict.push_str(". ");
+        verdict
     }
-    if !failed.is_empty() {
-        verdict.push_str(&format!(
-            "Did not pass (their estimates are not used): {}. ",
-            failed.join(", ")
-        ));
+}
+
+/// Past the GPS pressure maximum the uniform state is unstable: what the verdict says of a
+/// target there (empty otherwise).
+fn past_maximum(case: &crate::case::Case) -> String {
+    let Some(ls) = case.stages.last().and_then(|s| s.target_stretch) else {
+        return String::new();
+    };
+    let Ok(law) = case.material.build() else {
+        return String::new();
+    };
+    let Ok(lim) = tubemem_gps::limits::limit_points(law.as_ref(), tubemem_gps::Hypothesis::Gps)
+    else {
+        return String::new();
+    };
+    let Some(mx) = lim.max.filter(|mx| ls > mx.lambda_s) else {
+        return String::new();
+    };
+    match lim.min.filter(|mn| ls >= mn.lambda_s) {
+        // beyond both limit points the uniform state is stable again, but the path to it went
+        // through a bulge, whose fronts may still be near the caps
+        Some(mn) => format!(
+            "The target λs* = {ls} lies beyond both GPS limit points (maximum ϖ = {:.4} at λs = {:.3}, minimum {:.4} at {:.3}): a uniform tube is stable there again, but the path to it passes a bulge that propagates to the caps, and the tube may still be transitioning near them. ",
+            mx.w, mx.lambda_s, mn.w, mn.lambda_s
+        ),
+        None => format!(
+            "The target λs* = {ls} lies past the GPS pressure maximum (ϖ = {:.4} at λs = {:.3}), where the uniform state is unstable and a bulge forms. ",
+            mx.w, mx.lambda_s
+        ),
     }
-    // past the GPS pressure maximum the uniform state is unstable: say so
-    let last_ls = cf_r.and_then(|_| case.stages.last().and_then(|s| s.target_stretch));
-    if let (Ok(law), Some(ls)) = (case.material.build(), last_ls) {
-        if let Ok(lim) =
-            tubemem_gps::limits::limit_points(law.as_ref(), tubemem_gps::Hypothesis::Gps)
-        {
-            if let Some(mx) = lim.max.filter(|mx| ls > mx.lambda_s) {
-                match lim.min.filter(|mn| ls >= mn.lambda_s) {
-                    // beyond both limit points the uniform state is stable again, but the path
-                    // to it went through a bulge, whose fronts may still be near the caps
-                    Some(mn) => verdict.push_str(&format!(
-                        "The target λs* = {ls} lies beyond both GPS limit points (maximum ϖ = {:.4} at λs = {:.3}, minimum {:.4} at {:.3}): a uniform tube is stable there again, but the path to it passes a bulge that propagates to the caps, and the tube may still be transitioning near them. ",
-                        mx.w, mx.lambda_s, mn.w, mn.lambda_s
-                    )),
-                    None => verdict.push_str(&format!(
-                        "The target λs* = {ls} lies past the GPS pressure maximum (ϖ = {:.4} at λs = {:.3}), where the uniform state is unstable and a bulge forms. ",
-                        mx.w, mx.lambda_s
-                    )),
-                }
-            }
-        }
-    }
-    if let Some(c) = core {
-        verdict.push_str(&format!(
-            "Along the tube, the middle {:.0} % is translation invariant (ε = 1e-3), the rest the caps' boundary layers. ",
-            100.0 * c
-        ));
-    }
-    let needed: Vec<String> = allowances
-        .iter()
-        .filter_map(|a| {
-            let (_, n) = a.ends?;
-            n.is_finite()
-                .then(|| format!("{} L/R ≥ {n:.1}", label(&a.quantity)))
-        })
-        .collect();
-    if !needed.is_empty() {
-        verdict.push_str(&format!(
-            "An end effect below ε = 1e-3 needs {} (this tube: {l}). ",
-            needed.join(", ")
-        ));
-    }
-    verdict.push_str(&format!(
-        "Meshes {family:?} around, lengths L/R = {}{}.",
-        lengths
-            .iter()
-            .map(|x| format!("{x}"))
-            .collect::<Vec<_>>()
-            .join(", "),
-        if quick {
-            " (--quick: the cheaper family above; its estimates, and so its allowances, are cruder than the full study's, which refines upward from the case's mesh to 4 times as fine and, for a gas-closed stage, fits lengths up to 4L)"
-        } else {
-            ""
-        }
-    ));
-    Ok(Study { results, verdict })
 }
