@@ -670,6 +670,8 @@ impl StageSpec {
         })
     }
 
+    /// The stage's target, after every check of the keys that combine into it. Its length: one
+    /// arm per stage kind and control, each checking its own keys and naming them in its error.
     fn target(&self, i: usize) -> Result<Target, CaseError> {
         if self.branch.is_some() && self.control != Some(ControlKind::ArcLength) {
             invalid!(
@@ -978,6 +980,8 @@ impl Case {
         self.plan.truncate(n);
     }
 
+    /// Its length: a flat list of independent checks of the whole case, each returning its
+    /// own error with the key it names; there is no shared logic to factor out.
     fn validate(&self) -> Result<Vec<StagePlan>, CaseError> {
         let g = &self.geometry;
         if self.units.is_some() && g.thickness.is_none() {

@@ -61,6 +61,9 @@ pub enum ShellChoice {
 }
 
 /// The Abaqus/CalculiX input deck of `case` (`label` names it in the heading).
+///
+/// Its length: the deck is written in order, section after section (heading, nodes, elements,
+/// sets, symmetry conditions, material, one step per stage), each a few lines.
 pub fn abaqus_deck(
     case: &Case,
     label: &str,

@@ -1120,6 +1120,9 @@ impl RunWriter {
         }
     }
 
+    /// Everything of one converged step, in the order the files are journaled: the iteration
+    /// log, steps.csv's row, walls.csv, fronts.csv, the profile, the VTU frame and the PVD
+    /// entry, and the checkpoint. Its length is that list of files.
     fn write_step(&mut self, view: &StepView) -> Result<(), BoxError> {
         let iterations = view.model.take_iteration_log();
         if self.vtu.iterations && !iterations.is_empty() {

@@ -381,6 +381,12 @@ pub type FollowResult<P, O> =
 /// Follow the path of `path` from the equilibrium `start` until `target` is reached (located to
 /// `target_rtol`). `on_event` gets every converged step and every located critical point, in
 /// path order. Returns the located critical points.
+///
+/// Its length (the longest function of the crate) is one pass of the arc-length algorithm
+/// kept in one place: predictor, corrector, step control, the sign changes of the tangent
+/// stiffness and of the load's derivative, the bisection that locates a critical point, the
+/// branch switch, and the stop at the target; each branch reads and updates the same path
+/// state, and splitting it would pass that state through a dozen functions.
 pub fn follow<P: Path, O>(
     path: &mut P,
     start: P::State,

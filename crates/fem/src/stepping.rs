@@ -252,6 +252,10 @@ pub fn run_stage_from<E>(
 /// [`run_stage_from`] with the reference mesh following the solution by `refit` (see
 /// [`Refit`]). A step whose re-solve on the moved mesh fails is cut back like any other, from
 /// the last converged state carried to the moved mesh.
+///
+/// Its length is the adaptive load-stepping loop in one place: step size, the mesh refit, the
+/// Newton solve, the cut-back of a failed step from the last converged state, and the growth
+/// of the next; each branch updates the same step state.
 pub fn run_stage_refitted<E>(
     model: &mut Model,
     state: &mut State,

@@ -326,6 +326,10 @@ impl Mesh {
 
     /// Check connectivity, shape and orientation. A symmetry-reduced mesh may be open only along
     /// its symmetry planes.
+    ///
+    /// Its length: a sequence of independent checks (indices, counts, degenerate and inverted
+    /// elements, edge manifoldness, open edges only on symmetry planes, 9-node placement), each
+    /// with its own error naming the element or node.
     pub fn check(&self) -> Result<(), MeshError> {
         let n = self.nodes.len();
         if n == 0 || self.quads.is_empty() {

@@ -3,9 +3,9 @@
 
 //!
 //! The run is a loop over the case's stages ([`run_with`]): build the model
-//! ([`runner::Runner`]), restore a checkpoint if resuming, then for each stage its kind
+//! (`runner::Runner`), restore a checkpoint if resuming, then for each stage its kind
 //! ([`crate::stage::kind_of`]), its start (set up or restored) and its driving
-//! ([`drive::drive_stage`]: load steps or arc length, a record per converged step), with the
+//! (`drive::drive_stage`: load steps or arc length, a record per converged step), with the
 //! observers told at each point.
 
 mod drive;

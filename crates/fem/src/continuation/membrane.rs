@@ -198,6 +198,10 @@ impl Path for MembranePath<'_> {
 /// monitored quantity, its Newton report's inertia the negative pivots of the pressure-control
 /// stiffness K), every located critical point to `on_critical`; `state` is the last converged
 /// step whatever happens. [`StepState::lambda`] carries the arc length and `dl` the next Δs.
+///
+/// Its length: the membrane's path is set up (loading, monitor, target, resume), followed by
+/// [`super::follow`], and its events turned into the stage's steps and critical points, with
+/// the target's overshoot located back, in one place so that a resumed stage repeats it.
 #[allow(clippy::too_many_arguments)]
 pub fn run_arc_stage<E>(
     model: &mut crate::model::Model,

@@ -182,6 +182,9 @@ impl newton::Problem for MembraneProblem<'_> {
     type Step = (Vec<f64>, f64);
     type Error = FemError;
 
+    /// Its length: the residual and the bordered tangent of every loading (pressure, volume,
+    /// stretch, closed gas, moving planes, with or without augmented multipliers) are assembled
+    /// and factorized here once per Newton iteration, one arm per loading.
     fn linearize(&mut self, state: &mut State) -> Result<Linearization<Self::Step>, FemError> {
         if self.model.interrupted() {
             return Err(FemError::Interrupted);

@@ -30,6 +30,9 @@ impl VerifyKind for ClosedForm {
     }
 }
 
+/// Every tolerated quantity against its closed form at every step, with the worst step kept
+/// and one curve per quantity drawn. Its length is the list of quantity kinds (per step, the
+/// last step only, the Maxwell plateau), each compared its own way.
 fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let report = member(c, &c.case_text, &dir.join("run"), r)?;
     let law = report.material_spec.build().map_err(|e| e.to_string())?;

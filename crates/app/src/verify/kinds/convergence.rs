@@ -38,6 +38,9 @@ fn scale_mesh(t: &mut toml::Table, factor: f64) {
     }
 }
 
+/// The mesh family run, then per quantity the observed order, Richardson extrapolation and
+/// GCI (or the half range of an oscillating family), the expected order and the reference
+/// held, and the convergence plot. Its length is that sequence, on one family's table.
 fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let ratio = c.spec.refinement.unwrap_or(2.0);
     let n = c.spec.meshes.unwrap_or(3);

@@ -27,6 +27,9 @@ impl VerifyKind for EndEffect {
     }
 }
 
+/// The length family run, then per quantity the end-effect law fitted, its residual, rate and
+/// amplitude held, the length for ε, and the plot. Its length is that sequence, on one
+/// family's table.
 fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
     let lengths = c.spec.lengths.clone().unwrap_or_default();
     let law = c.spec.law.unwrap_or(stats::EndLaw::Exponential);
