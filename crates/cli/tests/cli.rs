@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
-use common::{assert_same_run, reference_run, run_in, tmp, tubemem};
+use common::{
+    assert_same_run, edit, reference_run, refused, run_in, run_ok, spawn_run, tmp, tubemem,
+    write_case, Steps, SMALL_CASE,
+};
 
 fn json(args: &[&str]) -> Value {
     let out = tubemem(args);
@@ -425,52 +428,12 @@ fn figures_writes_pngs_and_csvs() {
     }
 }
 
-/// The small tube shared with the Python tests.
-const SMALL_CASE: &str = include_str!("../../../cases/small_abb30_ls1.2.toml");
-
-/// A steps.csv read by header name: each row a map from column to field.
-struct Steps {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
-}
-
-impl Steps {
-    fn read(path: &std::path::Path) -> Self {
-        let text = std::fs::read_to_string(path).unwrap();
-        let mut lines = text.lines();
-        let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-        let rows = lines
-            .map(|l| l.split(',').map(String::from).collect::<Vec<_>>())
-            .collect();
-        Self { header, rows }
-    }
-    fn field<'a>(&self, row: &'a [String], col: &str) -> &'a str {
-        let k = self
-            .header
-            .iter()
-            .position(|h| h == col)
-            .unwrap_or_else(|| panic!("steps.csv has no column `{col}`"));
-        &row[k]
-    }
-    fn num(&self, row: &[String], col: &str) -> f64 {
-        self.field(row, col)
-            .parse()
-            .unwrap_or_else(|_| panic!("`{col}` is not a number"))
-    }
-}
-
 /// Run `case` into `run/` beside it, then `tubemem figures --out figs --overlay run EXTRA…`;
 /// (run folder, figures folder).
 fn overlay_figures(case: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
     let d = case.parent().unwrap();
     let (run, figs) = (d.join("run"), d.join("figs"));
-    let o = tubemem(&[
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(case, &run, &[]);
     let mut args = vec![
         "figures",
         "--out",
@@ -484,13 +447,6 @@ fn overlay_figures(case: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
     (run, figs)
 }
 
-fn write_case(name: &str, text: &str) -> PathBuf {
-    let d = tmp(name);
-    let p = d.join("case.toml");
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
 /// A small FE run: the outputs exist, agree with each other and with GPS at the mid-span to
 /// the polygon (apothem) factor 1/cos(π/16) − 1 = 1.96e-2 in ϖ, and to 1e-4 in λz (a short
 /// tube, L/R = 8: the cap effect at mid-span is below 1e-5 there, measured 4e-7).
@@ -498,13 +454,7 @@ fn write_case(name: &str, text: &str) -> PathBuf {
 fn run_writes_steps_summary_profiles_and_vtu() {
     let case = write_case("run-ok", SMALL_CASE);
     let out = case.parent().unwrap().join("out");
-    let o = tubemem(&[
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &out, &[]);
     let steps = Steps::read(&out.join("steps.csv"));
     // the mid-span columns, the contact columns (empty for inflation rows), then the closed
     // form at each step (GPS inflation at the same λs for inflation rows); new columns are
@@ -579,34 +529,32 @@ fn malformed_case_files_name_the_key_and_line() {
         + 1;
     let around_needle = format!("line {around_line}");
     let cases = [
+        (edit(SMALL_CASE, "kuhn = 30", "kuhn = 30\nkuhm = 2"), "kuhm"),
         (
-            SMALL_CASE.replace("kuhn = 30", "kuhn = 30\nkuhm = 2"),
-            "kuhm",
-        ),
-        (
-            SMALL_CASE.replace("around = 16", "around = \"many\""),
+            edit(SMALL_CASE, "around = 16", "around = \"many\""),
             around_needle.as_str(),
         ),
         (
-            SMALL_CASE.replace("target_stretch = 1.2", "target_pressure = 0.5"),
+            edit(SMALL_CASE, "target_stretch = 1.2", "target_pressure = 0.5"),
             "target_stretch",
         ),
-        (SMALL_CASE.replace("around = 16", "around = 12"), "around"),
-        (SMALL_CASE.replace("kuhn = 30", "kuhn = 0.5"), "kuhn"),
+        (edit(SMALL_CASE, "around = 16", "around = 12"), "around"),
+        (edit(SMALL_CASE, "kuhn = 30", "kuhn = 0.5"), "kuhn"),
         (
-            SMALL_CASE.replace("target_stretch = 1.2", "target_stretch = 0.9"),
+            edit(SMALL_CASE, "target_stretch = 1.2", "target_stretch = 0.9"),
             "target_stretch",
         ),
+        (edit(SMALL_CASE, "length = 8.0", "length = -8.0"), "length"),
         (
-            SMALL_CASE.replace("length = 8.0", "length = -8.0"),
-            "length",
-        ),
-        (
-            SMALL_CASE.replace("kind = \"inflate\"", "kind = \"inflat\""),
+            edit(SMALL_CASE, "kind = \"inflate\"", "kind = \"inflat\""),
             "inflat",
         ),
         (
-            SMALL_CASE.replace("around = 16", "file = \"mesh.json\"\naround = 16"),
+            edit(
+                SMALL_CASE,
+                "around = 16",
+                "file = \"mesh.json\"\naround = 16",
+            ),
             "drop `around`",
         ),
         (
@@ -617,19 +565,7 @@ fn malformed_case_files_name_the_key_and_line() {
             "missing.json",
         ),
     ];
-    for (i, (text, needle)) in cases.iter().enumerate() {
-        let case = write_case(&format!("bad{i}"), text);
-        let out = case.parent().unwrap().join("out");
-        assert_clean_failure(
-            &[
-                "run",
-                case.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ],
-            needle,
-        );
-    }
+    refused(&tmp("malformed"), &cases);
     assert_clean_failure(&["run", "/nonexistent/case.toml"], "cannot read case file");
 }
 
@@ -645,12 +581,7 @@ fn a_failing_run_keeps_every_converged_step() {
         .replace("target_stretch = 1.2", "target_stretch = 3.0");
     let case = write_case("run-fail", &text);
     let out = case.parent().unwrap().join("out");
-    let o = tubemem(&[
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_in(&case, &out, &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(!err.contains("panicked"), "{err}");
@@ -704,13 +635,7 @@ fn squeeze_stage_writes_contact_outputs() {
         format!("{SMALL_CASE}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.0\nsteps = 6\n");
     let case = write_case("squeeze", &text);
     let out = case.parent().unwrap().join("out");
-    let o = tubemem(&[
-        "run",
-        case.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &out, &[]);
     let steps = Steps::read(&out.join("steps.csv"));
     let last = steps.rows.last().unwrap();
     assert_eq!(steps.field(last, "stage"), "2");
@@ -1078,14 +1003,12 @@ fn output_folders_cannot_be_mixed() {
             "{err}"
         );
     }
-    let o = run_in(&long, &out, &[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&long, &out, &[]);
     let long_rows = Steps::read(&out.join("steps.csv")).rows.len();
     // the folder now holds a finished run: refused without --overwrite
     let o = run_in(&short, &out, &[]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("--overwrite"));
-    let o = run_in(&short, &out, &["--overwrite"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&short, &out, &["--overwrite"]);
     let steps = Steps::read(&out.join("steps.csv"));
     assert!(
         steps.rows.len() < long_rows,
@@ -1262,17 +1185,7 @@ fn killed_in_its_squeeze(name: &str, text: &str) -> (PathBuf, PathBuf, PathBuf) 
 /// Start `tubemem run CASE --out OUT` and kill it (SIGKILL) once its steps.csv satisfies `done`
 /// (or after 60 s); a run that finished meanwhile has nothing to kill.
 fn run_and_kill(case: &Path, out: &Path, done: impl Fn(&str) -> bool) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_run(case, out);
     let t0 = std::time::Instant::now();
     loop {
         let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap_or_default();
@@ -1308,8 +1221,7 @@ fn a_killed_run_resumes_bit_identical() {
     .unwrap();
     let o = run_in(&changed, &killed, &["--resume"]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("the case has changed"));
-    let o = run_in(&case, &killed, &["--resume"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &killed, &["--resume"]);
     assert_same_run(
         &reference,
         &killed,
@@ -1353,8 +1265,7 @@ fn a_killed_tracked_run_resumes_bit_identical() {
         "resume-tracked",
         include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml"),
     );
-    let o = run_in(&case, &killed, &["--resume"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &killed, &["--resume"]);
     let steps = std::fs::read_to_string(killed.join("steps.csv")).unwrap();
     assert!(steps.lines().next().unwrap().ends_with(",mesh_refits"));
     assert_same_run(
@@ -1385,8 +1296,7 @@ fn a_killed_fitted_run_resumes_bit_identical() {
     run_and_kill(&case, &killed, |steps| {
         steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
     });
-    let o = run_in(&case, &killed, &["--resume"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &killed, &["--resume"]);
     assert_same_run(&reference, &killed, &["steps.csv", "summary.json"], false);
     let s: Value =
         serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())
@@ -1421,8 +1331,7 @@ fn a_killed_arc_length_run_resumes_with_its_critical_points() {
     run_and_kill(&case, &killed, |steps| {
         steps.lines().count().saturating_sub(1) >= 10
     });
-    let o = run_in(&case, &killed, &["--resume"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &killed, &["--resume"]);
     let read = |dir: &std::path::Path| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
     };
@@ -1475,8 +1384,7 @@ fn a_killed_closed_gas_arc_length_run_resumes_at_its_plates() {
     )
     .unwrap();
     let (reference, killed) = (d.join("ref"), d.join("killed"));
-    let o = run_in(&case, &reference, &[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &reference, &[]);
     // killed after the third squeeze step
     run_and_kill(&case, &killed, |steps| {
         steps.lines().filter(|l| l.starts_with("2,")).count() >= 3
@@ -1496,8 +1404,7 @@ fn a_killed_closed_gas_arc_length_run_resumes_at_its_plates() {
     // killed inside the squeeze, not after it
     let before = squeeze_rows(&killed).len();
     assert!(before >= 3 && before < squeeze_rows(&reference).len());
-    let o = run_in(&case, &killed, &["--resume"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &killed, &["--resume"]);
     let read = |dir: &std::path::Path| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
     };
@@ -1549,8 +1456,7 @@ fn a_whole_tube_holds_its_neutral_bulge_translation_and_reaches_the_target() {
     )
     .unwrap();
     let out = d.join("out");
-    let o = run_in(&case, &out, &[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &out, &[]);
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     let stage = &summary["stages"][0];
@@ -1596,8 +1502,7 @@ fn a_whole_tube_holds_its_neutral_bulge_translation_and_reaches_the_target() {
     run_and_kill(&case, &killed, |steps| {
         steps.lines().filter(|l| l.starts_with("1,")).count() >= 55
     });
-    let o = run_in(&case, &killed, &["--resume"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&case, &killed, &["--resume"]);
     let resumed: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())
             .unwrap();
@@ -1707,17 +1612,7 @@ fn two_runs_cannot_share_a_folder() {
     )
     .unwrap();
     let out = d.join("out");
-    let first = Command::new(env!("CARGO_BIN_EXE_tubemem"))
-        .args([
-            "run",
-            case.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let first = spawn_run(&case, &out);
     let t0 = std::time::Instant::now();
     while !out.join("run.json").exists() && t0.elapsed().as_secs() < 30 {
         std::thread::sleep(std::time::Duration::from_millis(5));
@@ -2086,36 +1981,26 @@ fn huge_values_are_echoed_in_scientific_notation() {
     let small = include_str!("../../../cases/small_abb30_ls1.2.toml");
     let squeeze =
         format!("{small}\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1e308\nsteps = 2\n");
-    for (k, (text, needle)) in [
+    let cases = [
         (
-            small.replace("target_stretch = 1.2", "target_stretch = -1e308"),
+            edit(small, "target_stretch = 1.2", "target_stretch = -1e308"),
             "`target_stretch` = -1e308 is out of range",
         ),
         (
-            small.replace("target_stretch = 1.2", "target_stretch = 1e308"),
+            edit(small, "target_stretch = 1.2", "target_stretch = 1e308"),
             "`target_stretch` = 1e308 is out of range (pressure ≥ 0, stretch in [1, 1e6]",
         ),
         (
-            small.replace("around = 16", "around = 1e308"),
+            edit(small, "around = 16", "around = 1e308"),
             "floating point `1e308`, expected usize",
         ),
         (
-            small.replace("kuhn = 30", "kuhn = 1e308"),
+            edit(small, "kuhn = 30", "kuhn = 1e308"),
             "`kuhn` = 1e308: the Kuhn segment number must be > 1 and at most 1e6",
         ),
         (squeeze, "`target_rho` = 1e308"),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let case = d.join(format!("c{k}.toml"));
-        std::fs::write(&case, text).unwrap();
-        let o = run_in(&case, &d.join(format!("o{k}")), &[]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            !o.status.success() && err.contains(needle),
-            "{needle}: {err}"
-        );
+    ];
+    for err in refused(&d, &cases) {
         let longest = err
             .split(|c: char| !c.is_ascii_digit())
             .map(str::len)

@@ -11,6 +11,15 @@ pub(crate) struct Failure {
 }
 
 impl Failure {
+    /// The solve could not even evaluate its starting point.
+    fn at_start(e: MaterialError) -> Self {
+        Failure {
+            residual: f64::NAN,
+            iterations: 0,
+            material: Some(e),
+        }
+    }
+
     /// The typed error of a failed solve in `stage` at `at`: the material's, if that is what
     /// stopped it, otherwise no convergence with the residual and iteration count.
     pub(crate) fn into_error(self, stage: &'static str, at: &str) -> crate::GpsError {
@@ -71,11 +80,7 @@ pub(crate) fn scalar(
     ftol: f64,
 ) -> Result<f64, Failure> {
     let mut x = x0;
-    let (mut fx, mut dfx) = f(x).map_err(|e| Failure {
-        residual: f64::NAN,
-        iterations: 0,
-        material: Some(e),
-    })?;
+    let (mut fx, mut dfx) = f(x).map_err(Failure::at_start)?;
     let mut last_err = None;
     for it in 1..=MAX_IT {
         if fx == 0.0 {
@@ -132,11 +137,7 @@ pub(crate) fn system2(
 ) -> Result<[f64; 2], Failure> {
     let norm = |v: [f64; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
     let mut x = x0;
-    let (mut fx, mut jx) = f(x).map_err(|e| Failure {
-        residual: f64::NAN,
-        iterations: 0,
-        material: Some(e),
-    })?;
+    let (mut fx, mut jx) = f(x).map_err(Failure::at_start)?;
     let mut last_err = None;
     for it in 1..=MAX_IT {
         let det = jx[0][0] * jx[1][1] - jx[0][1] * jx[1][0];

@@ -389,11 +389,25 @@ pub fn capped_tube_fitted_of(
             cells.push(cell_points(c, order).iter().map(|pt| id[pt]).collect());
         }
     }
-    let (mut quads, mut mid) = split_cells(cells);
     let half = 0.5 * length;
-    orient(&nodes, &mut quads, &mut mid, |p| {
-        [0.0, 0.0, p[2].clamp(-half, half)]
-    });
+    closed_mesh(
+        nodes,
+        cells,
+        |p| [0.0, 0.0, p[2].clamp(-half, half)],
+        symmetry,
+    )
+}
+
+/// The closed surface of `nodes` and `cells` (4 or 9 nodes each), each element oriented
+/// outwards from its `center` point, reduced to `symmetry` and checked.
+fn closed_mesh(
+    nodes: Vec<[f64; 3]>,
+    cells: Vec<Vec<usize>>,
+    center: impl Fn([f64; 3]) -> [f64; 3],
+    symmetry: Symmetry,
+) -> Result<Mesh, MeshError> {
+    let (mut quads, mut mid) = split_cells(cells);
+    orient(&nodes, &mut quads, &mut mid, center);
     let mesh = reduce(
         Mesh {
             nodes,
@@ -520,25 +534,11 @@ pub fn sphere_of(
         id.insert(*pt, nodes.len());
         nodes.push([radius * d[0], radius * d[1], radius * d[2]]);
     }
-    let (mut quads, mut mid) = split_cells(
-        cells
-            .iter()
-            .map(|c| cell_points(c, order).iter().map(|pt| id[pt]).collect())
-            .collect(),
-    );
-    orient(&nodes, &mut quads, &mut mid, |_| [0.0; 3]);
-    let mesh = reduce(
-        Mesh {
-            nodes,
-            quads,
-            symmetry: Symmetry::None,
-            plugs: vec![],
-            mid,
-        },
-        symmetry,
-    );
-    mesh.check()?;
-    Ok(mesh)
+    let cells = cells
+        .iter()
+        .map(|c| cell_points(c, order).iter().map(|pt| id[pt]).collect())
+        .collect();
+    closed_mesh(nodes, cells, |_| [0.0; 3], symmetry)
 }
 
 /// Keep the elements whose centroid (of corners) lies on the positive side of each symmetry

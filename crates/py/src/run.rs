@@ -248,41 +248,23 @@ pub(crate) fn default_case() -> &'static str {
 /// state; which steps have a frame follows `[output] vtu`), readable with meshio.
 #[pyclass(name = "Run", module = "tubemem")]
 pub(crate) struct Run {
+    #[pyo3(get)]
     pub(crate) summary: Py<PyAny>,
+    #[pyo3(get)]
     pub(crate) steps: Py<Table>,
+    #[pyo3(get)]
     pub(crate) profiles: Py<Table>,
+    #[pyo3(get)]
     pub(crate) critical_points: Py<Table>,
+    #[pyo3(get)]
     pub(crate) fronts: Py<Table>,
+    #[pyo3(get)]
     pub(crate) path: PathBuf,
     pub(crate) frames: usize,
 }
 
 #[pymethods]
 impl Run {
-    #[getter]
-    fn summary(&self, py: Python<'_>) -> Py<PyAny> {
-        self.summary.clone_ref(py)
-    }
-    #[getter]
-    fn steps(&self, py: Python<'_>) -> Py<Table> {
-        self.steps.clone_ref(py)
-    }
-    #[getter]
-    fn profiles(&self, py: Python<'_>) -> Py<Table> {
-        self.profiles.clone_ref(py)
-    }
-    #[getter]
-    fn critical_points(&self, py: Python<'_>) -> Py<Table> {
-        self.critical_points.clone_ref(py)
-    }
-    #[getter]
-    fn fronts(&self, py: Python<'_>) -> Py<Table> {
-        self.fronts.clone_ref(py)
-    }
-    #[getter]
-    fn path(&self) -> PathBuf {
-        self.path.clone()
-    }
     /// The steps as a pandas DataFrame (pandas is imported on demand).
     pub(crate) fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.steps.borrow(py).to_pandas(py)

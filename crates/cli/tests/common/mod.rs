@@ -68,3 +68,113 @@ pub fn reference_run(name: &str, text: &str) -> (PathBuf, PathBuf, PathBuf) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (d, case, reference)
 }
+
+/// `tubemem run CASE --out OUT EXTRA…`, which must succeed (its stderr is the failure's
+/// message).
+pub fn run_ok(case: &Path, out: &Path, extra: &[&str]) -> Output {
+    let o = run_in(case, out, extra);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+/// `tubemem run CASE --out OUT` started in the background, its output discarded.
+pub fn spawn_run(case: &Path, out: &Path) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_tubemem"))
+        .args([
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// A scratch folder `name` with `text` as its `case.toml`; the case file's path.
+pub fn write_case(name: &str, text: &str) -> PathBuf {
+    let d = tmp(name);
+    let p = d.join("case.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// The small tube shared with the Python tests.
+pub const SMALL_CASE: &str = include_str!("../../../../cases/small_abb30_ls1.2.toml");
+
+/// A steps.csv read by header name: each row a map from column to field.
+pub struct Steps {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Steps {
+    pub fn read(path: &std::path::Path) -> Self {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(String::from).collect::<Vec<_>>())
+            .collect();
+        Self { header, rows }
+    }
+    pub fn field<'a>(&self, row: &'a [String], col: &str) -> &'a str {
+        let k = self
+            .header
+            .iter()
+            .position(|h| h == col)
+            .unwrap_or_else(|| panic!("steps.csv has no column `{col}`"));
+        &row[k]
+    }
+    pub fn num(&self, row: &[String], col: &str) -> f64 {
+        self.field(row, col)
+            .parse()
+            .unwrap_or_else(|_| panic!("`{col}` is not a number"))
+    }
+}
+
+/// `text` with `from` replaced by `to`. `from` must be in `text`: an edit that matched nothing
+/// would test the unedited case, and a test of a refusal would then pass or fail for the
+/// wrong reason.
+pub fn edit(text: &str, from: &str, to: &str) -> String {
+    assert!(text.contains(from), "`{from}` is not in the case to edit");
+    text.replace(from, to)
+}
+
+/// Case `text` written as `dir/NAME.toml` and run into `dir/NAME` with `extra` arguments:
+/// (case file, run folder, the run's output).
+pub fn run_text(dir: &Path, name: &str, text: &str, extra: &[&str]) -> (PathBuf, PathBuf, Output) {
+    let case = dir.join(format!("{name}.toml"));
+    std::fs::write(&case, text).unwrap();
+    let out = dir.join(name);
+    let o = run_in(&case, &out, extra);
+    (case, out, o)
+}
+
+/// Every case text of `cases` is refused by `tubemem run` with its needle in the message: a
+/// non-zero exit, no panic, nothing on stdout. Returns the messages, in order.
+pub fn refused(dir: &Path, cases: &[(String, &str)]) -> Vec<String> {
+    cases
+        .iter()
+        .enumerate()
+        .map(|(k, (text, needle))| {
+            let (_, _, o) = run_text(dir, &format!("refused{k}"), text, &[]);
+            let err = String::from_utf8_lossy(&o.stderr).into_owned();
+            assert!(!o.status.success(), "case {k} ran: {text}");
+            assert!(
+                !err.contains("panicked") && !err.contains("backtrace"),
+                "case {k} panicked: {err}"
+            );
+            assert!(
+                err.contains(needle),
+                "case {k}: expected `{needle}` in: {err}"
+            );
+            assert!(
+                o.stdout.is_empty(),
+                "case {k} printed a result despite failing"
+            );
+            err
+        })
+        .collect()
+}

@@ -1,7 +1,7 @@
 //! `closed-form`: the mid-span against GPS at every step (and the section under the FE's own
 //! pressure for a squeeze), per-quantity relative tolerances; PS reported.
 
-use super::{member, plot, rel, KindResult, VerifyKind, COLORS};
+use super::{member, plot, rel, KindResult, COLORS};
 use crate::figures::{Figure, Series, Stroke};
 use crate::report::StepRecord;
 use crate::verify::quantity::step_pair;
@@ -11,29 +11,17 @@ use plotters::style::RGBColor;
 use std::path::Path;
 use tubemem_gps::Hypothesis;
 
-/// The `closed-form` kind.
-pub struct ClosedForm;
-
-impl VerifyKind for ClosedForm {
-    fn label(&self) -> &'static str {
-        "closed-form"
-    }
-
-    fn evaluate(
-        &self,
-        c: &Check,
-        dir: &Path,
-        _opts: &VerifyOptions,
-        r: &mut CheckResult,
-    ) -> KindResult {
-        closed_form(c, dir, r)
-    }
-}
+kind!(
+    /// The `closed-form` kind.
+    ClosedForm,
+    "closed-form",
+    closed_form
+);
 
 /// Every tolerated quantity against its closed form at every step, with the worst step kept
 /// and one curve per quantity drawn. Its length is the list of quantity kinds (per step, the
 /// last step only, the Maxwell plateau), each compared its own way.
-fn closed_form(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
+fn closed_form(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
     let report = member(c, &c.case_text, &dir.join("run"), r)?;
     let law = report.material_spec.build().map_err(|e| e.to_string())?;
     let steps: Vec<&StepRecord> = report.steps().collect();

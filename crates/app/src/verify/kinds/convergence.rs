@@ -1,31 +1,19 @@
 //! `convergence`: a mesh family: observed order, Richardson extrapolation and GCI
 //! ([`stats::gci`](crate::verify::stats::gci)), the reference within the extrapolated value ± GCI.
 
-use super::{plot, rel, KindResult, VerifyKind, COLORS};
+use super::{plot, rel, KindResult, COLORS};
 use crate::figures::{Figure, Series, Stroke};
 use crate::verify::quantity::{final_value, step_pair};
 use crate::verify::suite::Check;
 use crate::verify::{run_member, stats, vary, CheckResult, Measure, VerifyOptions};
 use std::path::Path;
 
-/// The `convergence` kind.
-pub struct Convergence;
-
-impl VerifyKind for Convergence {
-    fn label(&self) -> &'static str {
-        "convergence"
-    }
-
-    fn evaluate(
-        &self,
-        c: &Check,
-        dir: &Path,
-        _opts: &VerifyOptions,
-        r: &mut CheckResult,
-    ) -> KindResult {
-        convergence(c, dir, r)
-    }
-}
+kind!(
+    /// The `convergence` kind.
+    Convergence,
+    "convergence",
+    convergence
+);
 
 fn scale_mesh(t: &mut toml::Table, factor: f64) {
     if let Some(m) = t.get_mut("mesh").and_then(|m| m.as_table_mut()) {
@@ -41,7 +29,7 @@ fn scale_mesh(t: &mut toml::Table, factor: f64) {
 /// The mesh family run, then per quantity the observed order, Richardson extrapolation and
 /// GCI (or the half range of an oscillating family), the expected order and the reference
 /// held, and the convergence plot. Its length is that sequence, on one family's table.
-fn convergence(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
+fn convergence(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
     let ratio = c.spec.refinement.unwrap_or(2.0);
     let n = c.spec.meshes.unwrap_or(3);
     let start = c.spec.start.unwrap_or(0);

@@ -1,36 +1,24 @@
 //! `end-effect`: a length family: the mid-span error against GPS fitted to c + A exp(−k L/R)
 //! (open inflation) or c + A/(L/R) (gas-closed squeeze) ([`stats`](crate::verify::stats)).
 
-use super::{plot, rel, KindResult, VerifyKind, COLORS};
+use super::{plot, rel, KindResult, COLORS};
 use crate::figures::{Figure, Markers, Series, Stroke};
 use crate::verify::quantity::step_pair;
 use crate::verify::suite::Check;
 use crate::verify::{run_member, stats, vary, CheckResult, Measure, VerifyOptions};
 use std::path::Path;
 
-/// The `end-effect` kind.
-pub struct EndEffect;
-
-impl VerifyKind for EndEffect {
-    fn label(&self) -> &'static str {
-        "end-effect"
-    }
-
-    fn evaluate(
-        &self,
-        c: &Check,
-        dir: &Path,
-        _opts: &VerifyOptions,
-        r: &mut CheckResult,
-    ) -> KindResult {
-        end_effect(c, dir, r)
-    }
-}
+kind!(
+    /// The `end-effect` kind.
+    EndEffect,
+    "end-effect",
+    end_effect
+);
 
 /// The length family run, then per quantity the end-effect law fitted, its residual, rate and
 /// amplitude held, the length for ε, and the plot. Its length is that sequence, on one
 /// family's table.
-fn end_effect(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
+fn end_effect(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
     let lengths = c.spec.lengths.clone().unwrap_or_default();
     let law = c.spec.law.unwrap_or(stats::EndLaw::Exponential);
     // the check's own quantity first, then any others fitted from the same runs

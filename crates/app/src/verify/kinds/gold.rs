@@ -1,30 +1,18 @@
 //! `gold`: every step and the summary against stored gold files, like MOOSE's CSVDiff.
 
-use super::{member, KindResult, VerifyKind};
+use super::{member, KindResult};
 use crate::output::STEPS_HEADER;
 use crate::report::RunReport;
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use std::path::Path;
 
-/// The `gold` kind.
-pub struct Gold;
-
-impl VerifyKind for Gold {
-    fn label(&self) -> &'static str {
-        "gold"
-    }
-
-    fn evaluate(
-        &self,
-        c: &Check,
-        dir: &Path,
-        opts: &VerifyOptions,
-        r: &mut CheckResult,
-    ) -> KindResult {
-        gold(c, dir, opts, r)
-    }
-}
+kind!(
+    /// The `gold` kind.
+    Gold,
+    "gold",
+    gold
+);
 
 /// The steps.csv text of a report (the writer's format).
 fn steps_csv(report: &RunReport) -> String {

@@ -1,31 +1,19 @@
 //! `invariance`: the middle region within which every profile quantity stays within ε of its
 //! mid-span value, at every step.
 
-use super::{member, plot, KindResult, VerifyKind, COLORS};
+use super::{member, plot, KindResult, COLORS};
 use crate::figures::{Figure, Series, Stroke};
 use crate::report::StepRecord;
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use std::path::Path;
 
-/// The `invariance` kind.
-pub struct Invariance;
-
-impl VerifyKind for Invariance {
-    fn label(&self) -> &'static str {
-        "invariance"
-    }
-
-    fn evaluate(
-        &self,
-        c: &Check,
-        dir: &Path,
-        _opts: &VerifyOptions,
-        r: &mut CheckResult,
-    ) -> KindResult {
-        invariance(c, dir, r)
-    }
-}
+kind!(
+    /// The `invariance` kind.
+    Invariance,
+    "invariance",
+    invariance
+);
 
 /// The core of one profile: (core length on the +z side, on the −z side (None for a model
 /// symmetric about z = 0), the quantity that ends the core on the +z side). The geometric
@@ -88,7 +76,7 @@ fn core(
     Some((plus, minus, why))
 }
 
-fn invariance(c: &Check, dir: &Path, r: &mut CheckResult) -> KindResult {
+fn invariance(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
     let eps = c.spec.epsilon.unwrap_or(1e-3);
     let report = member(c, &c.case_text, &dir.join("run"), r)?;
     let half = 0.5 * report.geometry.length;

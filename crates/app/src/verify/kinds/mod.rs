@@ -4,7 +4,8 @@
 //! [`RunReport`]s say. It pushes [`Measure`](super::Measure)s onto the [`CheckResult`] (each
 //! with its tolerance and the tolerance's source), the member run folders, and optionally a
 //! figure; [`run_check_with`](super::run_check_with) turns the measures into the status and
-//! the one-line message. To add a kind: implement [`VerifyKind`] in a file here, add a
+//! the one-line message. To add a kind: implement [`VerifyKind`] in a file here (the built-in
+//! kinds do it with the `kind!` macro: a unit type whose check is one function), add a
 //! [`CheckKind`] variant (the name a suite file gives it) and its line in [`kind_of`].
 //! `crates/app/tests/verify_kind.rs` is a worked example: a toy kind run through the trait.
 
@@ -14,6 +15,31 @@ use crate::figures::{rasterize, render_svg, Figure};
 use crate::report::RunReport;
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
+
+/// A kind whose check is one function `f(check, dir, options, result)`: its unit type and its
+/// [`VerifyKind`] implementation.
+macro_rules! kind {
+    ($(#[$doc:meta])* $name:ident, $label:literal, $f:path) => {
+        $(#[$doc])*
+        pub struct $name;
+
+        impl $crate::verify::kinds::VerifyKind for $name {
+            fn label(&self) -> &'static str {
+                $label
+            }
+
+            fn evaluate(
+                &self,
+                c: &$crate::verify::suite::Check,
+                dir: &std::path::Path,
+                opts: &$crate::verify::VerifyOptions,
+                r: &mut $crate::verify::CheckResult,
+            ) -> $crate::verify::kinds::KindResult {
+                $f(c, dir, opts, r)
+            }
+        }
+    };
+}
 
 mod closed_form;
 mod convergence;

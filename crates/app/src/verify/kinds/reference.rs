@@ -1,29 +1,17 @@
 //! `reference`: the FE against the scikit-fem references of `python_ref`, run as a separate
 //! Python process; skipped, with the reason, when they are not installed.
 
-use super::{member, KindResult, VerifyKind};
+use super::{member, KindResult};
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use std::path::{Path, PathBuf};
 
-/// The `reference` kind.
-pub struct Reference;
-
-impl VerifyKind for Reference {
-    fn label(&self) -> &'static str {
-        "reference"
-    }
-
-    fn evaluate(
-        &self,
-        c: &Check,
-        dir: &Path,
-        opts: &VerifyOptions,
-        r: &mut CheckResult,
-    ) -> KindResult {
-        reference(c, dir, opts, r)
-    }
-}
+kind!(
+    /// The `reference` kind.
+    Reference,
+    "reference",
+    reference
+);
 
 /// Where the `python_ref` folder is, when there is one to put on the module path: given
 /// (`--python-ref`, `TUBEMEM_PYTHON_REF`), or the checkout's, searched upwards from `from` and
