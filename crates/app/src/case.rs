@@ -408,7 +408,7 @@ fn two_components<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D:
 impl PlaneSpec {
     /// Whether the plane's mirror image across x = 0 (`axis` 0) or y = 0 (`axis` 1), with the
     /// same offset and target, is among `planes` (to 1e-12 relative).
-    pub fn mirrored_in(&self, planes: &[PlaneSpec], axis: usize) -> bool {
+    pub(crate) fn mirrored_in(&self, planes: &[PlaneSpec], axis: usize) -> bool {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
         let mut m = self.normal;
         m[axis] = -m[axis];
@@ -421,7 +421,7 @@ impl PlaneSpec {
     }
 
     /// The wall at load parameter `t` ∈ [0, 1] (the closed form's convention, unit normal).
-    pub fn wall_at(&self, t: f64) -> Result<tubemem_gps::confine::Wall, tubemem_gps::GpsError> {
+    pub(crate) fn wall_at(&self, t: f64) -> Result<tubemem_gps::confine::Wall, tubemem_gps::GpsError> {
         tubemem_gps::confine::Wall::new(
             self.normal[0],
             self.normal[1],

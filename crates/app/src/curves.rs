@@ -27,7 +27,7 @@ pub fn flattening_values(s: &FlatteningState) -> Vec<f64> {
 
 /// One CSV line of numbers (shortest round-trip form), an empty field where a value does not
 /// apply (non-finite).
-pub fn csv_line(values: &[f64]) -> String {
+pub(crate) fn csv_line(values: &[f64]) -> String {
     values
         .iter()
         .map(|v| {
@@ -43,7 +43,7 @@ pub fn csv_line(values: &[f64]) -> String {
 
 /// Rows of numbers as CSV text (shortest round-trip representation), for the file `path`. A
 /// non-finite value is refused: it would be a silent wrong answer.
-pub fn csv_text(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<String> {
+pub(crate) fn csv_text(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<String> {
     let mut out = String::with_capacity(1 << 16);
     out.push_str(header);
     out.push('\n');
@@ -61,7 +61,7 @@ pub fn csv_text(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>)
     Ok(out)
 }
 
-/// Write rows of numbers as CSV ([`csv_text`]), whole.
+/// Write rows of numbers as CSV (`csv_text`), whole.
 pub fn write_csv(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| AppError::io(dir, e))?;

@@ -30,7 +30,7 @@ fn plate_edges(a: f64) -> Vec<f64> {
 }
 
 /// The reference angle of the plates' contact edge from their symmetry line, π χ / (2 λs).
-pub fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
+pub(crate) fn edge_angle(chi: f64, lambda_s: f64) -> f64 {
     PI * chi / (2.0 * lambda_s)
 }
 
@@ -68,7 +68,7 @@ pub(crate) fn wall_section_edges(
 /// run's own [`crate::run::run_with`], with its interrupt: the run is then
 /// [`AppError::Interrupted`]); it is passed in so that this module, which a run uses to build
 /// its mesh, does not itself depend on the run.
-pub fn contact_edges(
+pub(crate) fn contact_edges(
     case: &Case,
     solve: &mut dyn FnMut(&Case) -> crate::report::RunOutcome,
 ) -> Result<Option<Fit>> {

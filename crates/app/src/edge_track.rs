@@ -88,7 +88,7 @@ pub struct Tracker<'a> {
 impl Tracker<'_> {
     /// The contact edges of the GPS section under pressure `w` at load value `value`, from the
     /// state's mid-span stretches `guess`; empty where the section does not touch.
-    pub fn edges_at(&self, value: f64, w: f64, guess: [f64; 2]) -> Result<Vec<f64>, String> {
+    pub(crate) fn edges_at(&self, value: f64, w: f64, guess: [f64; 2]) -> Result<Vec<f64>, String> {
         if !(w.is_finite() && w > 0.0) {
             return Ok(vec![]);
         }

@@ -58,21 +58,21 @@ impl Journal {
 
     /// Remember a file that a writer outside the journal is about to create (a VTU frame), so
     /// that undoing the step removes it.
-    pub fn creating(&mut self, path: &Path) {
+    pub(crate) fn creating(&mut self, path: &Path) {
         if !path.exists() {
             self.note(path);
         }
     }
 
     /// The step's files are all written: keep them.
-    pub fn commit(&mut self) {
+    pub(crate) fn commit(&mut self) {
         self.touched.clear();
     }
 
     /// Undo the step: cut every appended file back to its earlier length and remove every file
     /// it created, newest first. Best effort (neither needs free space); the first failure is
     /// returned, after the rest have been tried.
-    pub fn rollback(&mut self) -> Result<()> {
+    pub(crate) fn rollback(&mut self) -> Result<()> {
         let mut first = None;
         for (path, len) in self.touched.drain(..).rev() {
             let r = match len {

@@ -176,14 +176,6 @@ impl AppError {
             source,
         }
     }
-    /// The material error at the root of a failed stage (e.g. locking), with its element.
-    pub fn material_cause(&self) -> Option<(usize, &tubemem_material::MaterialError)> {
-        match self {
-            AppError::Stage { source, .. } => source.material_cause(),
-            AppError::BeyondLimit { source, .. } => source.material_cause(),
-            _ => None,
-        }
-    }
     /// Whether the failure is the input's (a case, mesh or folder the run cannot take) rather
     /// than a solve's: front ends map the first to their bad-input error (Python's ValueError).
     pub fn is_input_error(&self) -> bool {

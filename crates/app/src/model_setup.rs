@@ -11,7 +11,7 @@ use tubemem_mesh::Mesh;
 /// (`[mesh] fit_contact_edge`); `solve` runs [`crate::edge_fit`]'s locating case (the caller's
 /// run, which uses this function to build its own mesh). Most callers want
 /// [`crate::run::build_mesh`].
-pub fn mesh_of(
+pub(crate) fn mesh_of(
     case: &Case,
     solve: &mut dyn FnMut(&Case) -> crate::report::RunOutcome,
 ) -> Result<(Mesh, Option<crate::report::ContactEdgeFit>)> {
@@ -62,7 +62,7 @@ pub fn mesh_of(
 /// 19.7, 56.9, 167 and 414 MiB at 4,520, 16,280, 47,904 and 104,448 equations (the fit is
 /// within 10 % there); at 978,432 equations it gives 4.7 GiB against the 3.6 GiB measured, so
 /// it errs on the safe side as the factor's fill grows more slowly than n log n.
-pub fn memory_estimate(equations: usize) -> u64 {
+pub(crate) fn memory_estimate(equations: usize) -> u64 {
     let n = equations.max(2) as f64;
     (8.0 * (1u64 << 20) as f64 + 240.0 * n * n.log2()) as u64
 }
@@ -91,7 +91,7 @@ pub fn equations_estimate(case: &Case) -> Option<usize> {
 }
 
 /// The memory this machine has available (`MemAvailable` of /proc/meminfo), if it says.
-pub fn available_memory() -> Option<u64> {
+pub(crate) fn available_memory() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
@@ -132,7 +132,7 @@ pub fn sideways_planes(case: &Case) -> [bool; 2] {
 /// The model of `mesh` with the case's law (with its tension-field relaxation if the case asks),
 /// its rigid-mode pins (springs where planes move the tube sideways), the solver's settings and
 /// the run's interrupt flag.
-pub fn model_of(
+pub(crate) fn model_of(
     case: &Case,
     mesh: Mesh,
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,

@@ -38,7 +38,7 @@ mesh_refits";
 
 /// The `critical` column of steps.csv: the kind of a critical point located between the
 /// previous step and this one (empty: none).
-pub fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
+pub(crate) fn critical_code(k: tubemem_fem::continuation::CriticalKind) -> f64 {
     use tubemem_fem::continuation::CriticalKind as K;
     match k {
         K::LimitMax => 1.0,
@@ -191,7 +191,7 @@ pub const FRONTS_HEADER: &str = "row,stage,step,w,volume,front,z_ref";
 pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m";
 
 /// steps.csv's header: [`STEPS_HEADER`], and [`SI_HEADER`] with units.
-pub fn steps_header(units: bool) -> String {
+pub(crate) fn steps_header(units: bool) -> String {
     if units {
         format!("{STEPS_HEADER},{SI_HEADER}")
     } else {
@@ -219,7 +219,7 @@ fn si_row(s: &tubemem_gps::Scales, r: &StepRecord) -> String {
         .join(",")
 }
 
-pub fn format_row(r: &StepRecord) -> String {
+pub(crate) fn format_row(r: &StepRecord) -> String {
     let fields: Vec<String> = step_row(r)
         .into_iter()
         .enumerate()
@@ -999,7 +999,7 @@ fn trim_rows(path: &Path, rows: usize) -> Result<bool> {
 }
 
 /// Write a profile (one row per ring) as CSV, whole.
-pub fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
+pub(crate) fn write_profile(path: &Path, rings: &[RingValues]) -> Result<()> {
     let mut text = format!("{PROFILE_HEADER}\n");
     for r in rings {
         text.push_str(&join(&ring_row(r)));

@@ -1,5 +1,5 @@
 //! One policy for the paths a command writes: the output folders (`run --out`, `figures
-//! --out`) must be folders ([`create_folder`]), and the single files it writes beside a run
+//! --out`) must be folders (`create_folder`), and the single files it writes beside a run
 //! folder (`run --log`, `export --out`): such a file is written only where it cannot destroy an input or a file
 //! tubemem did not write. Checked before anything is written:
 //! - a folder at the path is refused ("is a folder");
@@ -101,7 +101,7 @@ pub fn write_whole(path: &Path, bytes: &[u8]) -> Result<()> {
 
 /// Create the output folder `dir` (and its parents), or refuse a path that is a file (or
 /// whose parent is one) as "not a folder" instead of the system's "File exists".
-pub fn create_folder(dir: &Path) -> Result<()> {
+pub(crate) fn create_folder(dir: &Path) -> Result<()> {
     let mut p = Some(dir);
     while let Some(q) = p.filter(|q| !q.as_os_str().is_empty()) {
         if q.exists() {
@@ -128,7 +128,7 @@ pub fn create_folder(dir: &Path) -> Result<()> {
 /// with the same 64 bytes as its new content: the same CSV header, SVG preamble or PNG
 /// header); any other is refused, with every such file named, before anything is written.
 /// The manifest is written first, so a file is never on disk unlisted. Returns the paths.
-pub fn write_owned(
+pub(crate) fn write_owned(
     dir: &Path,
     manifest: &str,
     who: &str,

@@ -32,7 +32,8 @@ pub mod render;
 pub use mode::mode_figure;
 pub use overlay::{law_label, same_law, Overlay, SqueezePoint, PAPER_LAW};
 pub use paper::write_all;
-pub use render::{rasterize, render_files, render_svg, save};
+pub use render::save;
+pub(crate) use render::{rasterize, render_files, render_svg};
 
 use crate::{AppError, Result};
 use plotters::prelude::*;
@@ -225,7 +226,7 @@ fn under_legend(u: f64, v: f64, left: bool, upper: bool, size: (f64, f64)) -> bo
 }
 
 /// The [`FigureAudit`] of the top panel of `fig` as [`render_svg`] draws it.
-pub fn audit(fig: &Figure) -> FigureAudit {
+pub(crate) fn audit(fig: &Figure) -> FigureAudit {
     let (x, y) = axes(fig);
     let all: Vec<(f64, f64)> = fig
         .series
@@ -264,7 +265,7 @@ pub fn audit(fig: &Figure) -> FigureAudit {
 
 /// The corner of the plot where the legend covers the fewest points (curve and marker points,
 /// a curve's segments sampled between its points), the upper left on a tie.
-pub fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
+pub(crate) fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
     let size = legend_size(fig);
     let unit = |p: (f64, f64)| ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
     let mut pts: Vec<(f64, f64)> = fig

@@ -106,7 +106,7 @@ pub(super) fn draw_markers<'a, 'b: 'a>(
 }
 
 /// The figure as an SVG document.
-pub fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
+pub(crate) fn render_svg(fig: &Figure, path: &Path) -> Result<String> {
     register_font(path)?;
     let err = |message: String| AppError::Figure {
         path: path.to_path_buf(),
@@ -253,7 +253,7 @@ pub(super) fn font_database() -> Arc<resvg::usvg::fontdb::Database> {
 }
 
 /// Rasterize an SVG document into PNG bytes at `dpi` (anti-aliased, resvg).
-pub fn rasterize(svg: &str, dpi: f64, path: &Path) -> Result<Vec<u8>> {
+pub(crate) fn rasterize(svg: &str, dpi: f64, path: &Path) -> Result<Vec<u8>> {
     let err = |message: String| AppError::Figure {
         path: path.to_path_buf(),
         message,
@@ -298,7 +298,7 @@ pub fn save(fig: &Figure, stem: &Path, opts: &FigureOptions) -> Result<Vec<PathB
 }
 
 /// The files [`save`] writes, rendered: (path, content).
-pub fn render_files(
+pub(crate) fn render_files(
     fig: &Figure,
     stem: &Path,
     opts: &FigureOptions,

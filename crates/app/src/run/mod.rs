@@ -39,7 +39,7 @@ pub fn build_mesh(case: &Case) -> Result<tubemem_mesh::Mesh> {
 /// [`build_mesh`], with where its node line was fitted to the contact edge (`[mesh]
 /// fit_contact_edge`, [`crate::edge_fit`]: a locating run of the case on a coarse mesh, which
 /// `interrupt` stops as it stops the run, [`RunOptions::interrupt`]).
-pub fn build_mesh_with_fit(
+pub(crate) fn build_mesh_with_fit(
     case: &Case,
     interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
 ) -> Result<(tubemem_mesh::Mesh, Option<ContactEdgeFit>)> {

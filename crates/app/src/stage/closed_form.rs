@@ -8,7 +8,7 @@ use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
 use tubemem_material::MembraneLaw;
 
 /// The closed form at one step (see [`StepClosedForm`]).
-pub fn step_closed_form(
+pub(crate) fn step_closed_form(
     law: &dyn MembraneLaw,
     ms: &tubemem_fem::post::MidSpan,
     squeeze: Option<(&tubemem_fem::post::ContactValues, f64)>,
@@ -41,7 +41,7 @@ pub fn step_closed_form(
 /// The closed-form comparison of a stage's final state: GPS and PS, and for a squeeze the
 /// section at the FE's pressure. GPS and the section are the last step's (solved once, for its
 /// steps.csv row); only PS is solved here.
-pub fn stage_closed_form(
+pub(crate) fn stage_closed_form(
     law: &dyn MembraneLaw,
     ms: &tubemem_fem::post::MidSpan,
     contact: Option<&ContactRecord>,

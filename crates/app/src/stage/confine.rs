@@ -219,7 +219,7 @@ impl StageKind for Confine {
 
 /// The planes of a confine stage as functions of its load parameter t (for arc length):
 /// [`fe_planes`] at t, the offsets linear in t.
-pub fn fe_moving_planes(planes: &[PlaneSpec], penalty: f64) -> MovingPlanes {
+pub(crate) fn fe_moving_planes(planes: &[PlaneSpec], penalty: f64) -> MovingPlanes {
     MovingPlanes {
         at_zero: fe_planes(planes, 0.0, penalty),
         rates: planes
@@ -231,7 +231,7 @@ pub fn fe_moving_planes(planes: &[PlaneSpec], penalty: f64) -> MovingPlanes {
 
 /// The FE contact of a confine stage at load parameter `t`: each wall n·x ≤ d as the kernel's
 /// plane with gap −n·x + d ≥ 0 (unit normal, in the cross-section plane).
-pub fn fe_planes(planes: &[PlaneSpec], t: f64, penalty: f64) -> Contact {
+pub(crate) fn fe_planes(planes: &[PlaneSpec], t: f64, penalty: f64) -> Contact {
     Contact {
         planes: planes
             .iter()

@@ -28,7 +28,7 @@ pub struct FailureInput<'a> {
 
 /// The run's error for the stage's failure `e`, from the last converged `state` (the model is
 /// used for the probe of a pressure maximum, and left as it was).
-pub fn stage_error(
+pub(crate) fn stage_error(
     e: StageError<BoxError>,
     f: &FailureInput,
     model: &mut Model,

@@ -8,7 +8,7 @@ use tubemem_fem::post::{cell_values, Regime};
 
 /// Distance (in R) from the cap junction (or plug) at which λs comes within `tol` of its
 /// mid-span value and stays there all the way to mid-span; `None` if it never does.
-pub fn boundary_layer(
+pub(crate) fn boundary_layer(
     rings: &[tubemem_fem::post::RingValues],
     half_length: f64,
     mid: f64,

@@ -35,7 +35,7 @@ pub struct RecordInput<'a> {
 
 /// The record of the converged step `info` (`critical`: the critical point located just
 /// before it).
-pub fn step_record(
+pub(crate) fn step_record(
     r: &RecordInput,
     m: &Model,
     st: &State,

@@ -26,7 +26,7 @@ pub struct SetupInput<'a> {
 
 /// Set up a stage of `kind` at its start. A precondition that fails is recorded in the report
 /// as the stage's failure.
-pub fn setup_stage(
+pub(crate) fn setup_stage(
     kind: &dyn StageKind,
     plan: &StagePlan,
     run: &SetupInput,

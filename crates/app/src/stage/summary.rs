@@ -13,7 +13,7 @@ use tubemem_gps::limits::Limits;
 
 /// The report of the stage that ended at `state` with `steps` and the critical points
 /// `criticals`.
-pub fn stage_report(
+pub(crate) fn stage_report(
     r: &RecordInput,
     limits: Option<&Limits>,
     model: &Model,

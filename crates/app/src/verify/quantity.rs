@@ -1,10 +1,10 @@
 //! The quantities a check compares, by name: the FE's mid-span value and its closed form at
-//! one step ([`step_pair`]), and the FE's final value ([`final_value`]).
+//! one step (`step_pair`), and the FE's final value (`final_value`).
 
 use crate::report::{RunReport, StepRecord};
 
 /// (FE, closed form) of `q` at one step, if the step has both.
-pub fn step_pair(s: &StepRecord, q: &str) -> Option<(f64, f64)> {
+pub(crate) fn step_pair(s: &StepRecord, q: &str) -> Option<(f64, f64)> {
     let m = &s.midspan;
     let cf = &s.closed_form;
     if let Some(g) = &cf.gps_confine {
@@ -75,7 +75,7 @@ pub fn step_pair(s: &StepRecord, q: &str) -> Option<(f64, f64)> {
 }
 
 /// The final mid-span value of `q` (the last step of the run).
-pub fn final_value(report: &RunReport, q: &str) -> Option<f64> {
+pub(crate) fn final_value(report: &RunReport, q: &str) -> Option<f64> {
     let s = report.steps().last()?;
     let m = &s.midspan;
     match q {
