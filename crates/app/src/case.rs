@@ -421,7 +421,10 @@ impl PlaneSpec {
     }
 
     /// The wall at load parameter `t` ∈ [0, 1] (the closed form's convention, unit normal).
-    pub(crate) fn wall_at(&self, t: f64) -> Result<tubemem_gps::confine::Wall, tubemem_gps::GpsError> {
+    pub(crate) fn wall_at(
+        &self,
+        t: f64,
+    ) -> Result<tubemem_gps::confine::Wall, tubemem_gps::GpsError> {
         tubemem_gps::confine::Wall::new(
             self.normal[0],
             self.normal[1],

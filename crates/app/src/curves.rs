@@ -43,7 +43,11 @@ pub(crate) fn csv_line(values: &[f64]) -> String {
 
 /// Rows of numbers as CSV text (shortest round-trip representation), for the file `path`. A
 /// non-finite value is refused: it would be a silent wrong answer.
-pub(crate) fn csv_text(path: &Path, header: &str, rows: impl Iterator<Item = Vec<f64>>) -> Result<String> {
+pub(crate) fn csv_text(
+    path: &Path,
+    header: &str,
+    rows: impl Iterator<Item = Vec<f64>>,
+) -> Result<String> {
     let mut out = String::with_capacity(1 << 16);
     out.push_str(header);
     out.push('\n');
