@@ -959,11 +959,7 @@ impl Case {
     /// The scales R, H, μ of `[units]` (None: the outputs stay dimensionless).
     pub fn scales(&self) -> Option<tubemem_gps::Scales> {
         self.units?;
-        let mu = match self.material {
-            MaterialSpec::Abb { shear_modulus, .. }
-            | MaterialSpec::MooneyRivlin { shear_modulus, .. }
-            | MaterialSpec::NeoHookean { shear_modulus } => shear_modulus,
-        };
+        let mu = self.material.shear_modulus();
         tubemem_gps::Scales::new(self.geometry.radius, self.geometry.thickness?, mu).ok()
     }
 

@@ -83,11 +83,11 @@ pub fn abaqus_deck(
         );
     }
     // μ the case's shear modulus (ϖ = pR/(μH)), μ(1 + α) the small-strain one
-    let (mu, c10, c01, mu_small) = match case.material {
-        MaterialSpec::NeoHookean { shear_modulus } => {
+    let (mu, c10, c01, mu_small) = match &case.material {
+        &MaterialSpec::NeoHookean { shear_modulus } => {
             (shear_modulus, 0.5 * shear_modulus, 0.0, shear_modulus)
         }
-        MaterialSpec::MooneyRivlin {
+        &MaterialSpec::MooneyRivlin {
             shear_modulus,
             alpha,
         } => (
@@ -100,6 +100,12 @@ pub fn abaqus_deck(
             return unsupported(
                 "the Anssari-Benam–Bucchi law is not a material of Abaqus or CalculiX: export a neo-Hookean or Mooney–Rivlin case (or write it as a user material, *USER MATERIAL / UMAT, yourself)".into(),
             )
+        }
+        other => {
+            return unsupported(format!(
+                "the {} law is not exported yet: export writes neo-Hookean and Mooney–Rivlin materials",
+                other.model()
+            ))
         }
     };
     let law = case

@@ -15,9 +15,14 @@ pub enum Model {
 
 #[derive(Args, Debug, Clone)]
 pub struct MaterialArgs {
-    /// Membrane law.
+    /// Membrane law (or give any law with --law).
     #[arg(long, value_enum)]
-    pub material: Model,
+    pub material: Option<Model>,
+    /// Any law, as the keys of a case file's material table, e.g.
+    /// 'model = "yeoh", c10 = 0.5, c20 = -0.01, c30 = 0.001', or a TOML file holding a
+    /// material table (a case file) or its keys.
+    #[arg(long, conflicts_with_all = ["material", "kuhn", "alpha"])]
+    pub law: Option<String>,
     /// Kuhn segment number 𝒩 (> 1) of the abb law.
     #[arg(long)]
     pub kuhn: Option<f64>,
@@ -66,9 +71,41 @@ pub fn spec_of(
     })
 }
 
+/// The law of `--law`: a TOML file with a material table or its keys, or those keys inline.
+pub fn law_of(text: &str) -> Result<MaterialSpec> {
+    let path = std::path::Path::new(text);
+    let table: toml::Table = if !text.contains('=') && path.is_file() {
+        let file = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("--law {}: {e}", path.display()))?;
+        let mut t: toml::Table =
+            toml::from_str(&file).map_err(|e| anyhow::anyhow!("--law {}: {e}", path.display()))?;
+        match t.remove("material") {
+            Some(toml::Value::Table(m)) => m,
+            _ => t,
+        }
+    } else {
+        let wrapped: toml::Table = toml::from_str(&format!("m = {{ {text} }}"))
+            .map_err(|e| anyhow::anyhow!("--law: not the keys of a [material] table ({e})"))?;
+        match wrapped.get("m") {
+            Some(toml::Value::Table(m)) => m.clone(),
+            _ => bail!("--law: not the keys of a [material] table"),
+        }
+    };
+    let spec: MaterialSpec = toml::Value::Table(table).try_into().map_err(|e| {
+        anyhow::anyhow!("--law: {}", tubemem_material::tidy_numbers(&e.to_string()))
+    })?;
+    Ok(spec)
+}
+
 impl MaterialArgs {
     pub fn spec(&self) -> Result<MaterialSpec> {
-        spec_of(self.material, self.kuhn, self.alpha, self.shear_modulus)
+        match (&self.law, self.material) {
+            (Some(law), _) => law_of(law),
+            (None, Some(m)) => spec_of(m, self.kuhn, self.alpha, self.shear_modulus),
+            (None, None) => bail!(
+                "give the membrane law: --material abb|mooney-rivlin|neo-hookean with its parameters, or --law with a [material] table's keys"
+            ),
+        }
     }
 
     pub fn build(&self) -> Result<Box<dyn MembraneLaw>> {

@@ -428,3 +428,81 @@ fn section_at_pressure_responds_to_pressure_and_rejects_bad_input() {
         Err(GpsError::InvalidInput { .. })
     ));
 }
+
+/// Saint-Venant–Kirchhoff in plane stress (the law of Kratos's `MembraneElement3D4N`): the GPS
+/// inflation in closed form. With Eα = (λα² − 1)/2, k = ν/(1 − ν) and the resultants per
+/// μ = E/(2(1 + ν)), N_s = 2 (λs/λz) [Es + k (Es + Ez)], N_z = 2 (λz/λs) [Ez + k (Es + Ez)],
+/// eq. (66)'s N_s = 2 N_z is, in x = λz², the quadratic
+///
+/// ```text
+/// (1 + k) x² + (2 k Es − (1 + k) − k λs²/2) x − λs² ((1 + k) Es − k/2) = 0
+/// ```
+/// whose positive root gives λz, and ϖ = N_s/λs = (2/λz) [Es + k (Es + Ez)]. Kratos's table:
+/// E = 2(1 + ν) (so that μ = 1), ν = 0.4999, unit thickness. Tolerance 1e-12: the closed form
+/// is exact, the solver's Newton converges to 1e-13 relative (module header).
+#[test]
+fn svk_gps_inflation_matches_its_closed_form() {
+    for (nu, ls) in [
+        (0.4999, 1.3),
+        (0.3, 1.3),
+        (0.0, 1.3),
+        (0.4999, 1.05),
+        (0.3, 2.5),
+    ] {
+        let law = tubemem_material::laws::SaintVenantKirchhoff::new(2.0 * (1.0 + nu), nu).unwrap();
+        let k = nu / (1.0 - nu);
+        let es = 0.5 * (ls * ls - 1.0);
+        let (qa, qb, qc) = (
+            1.0 + k,
+            2.0 * k * es - (1.0 + k) - 0.5 * k * ls * ls,
+            -ls * ls * ((1.0 + k) * es - 0.5 * k),
+        );
+        let x = (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
+        let lz = x.sqrt();
+        let ez = 0.5 * (x - 1.0);
+        let w = 2.0 / lz * (es + k * (es + ez));
+        let s = inflate(&law, Hypothesis::Gps, ls).unwrap();
+        assert!(
+            rel(s.lambda_z, lz) < 1e-12,
+            "ν = {nu}: λz {} vs {lz}",
+            s.lambda_z
+        );
+        assert!(rel(s.w, w) < 1e-12, "ν = {nu}: ϖ {} vs {w}", s.w);
+        if (nu, ls) == (0.4999, 1.3) {
+            println!("SVK (Kratos's law), λs = 1.3: ϖ = {w:.12}, λz = {lz:.12} (closed form); solver ϖ − closed = {:.1e}, λz − closed = {:.1e}", s.w - w, s.lambda_z - lz);
+        }
+        // plane strain: λz = 1, ϖ = 2 (1 + k) Es
+        let p = inflate(&law, Hypothesis::Ps, ls).unwrap();
+        assert!(rel(p.w, 2.0 * (1.0 + k) * es) < 1e-12);
+    }
+}
+
+/// The paper's Appendix F: for a Hooke material with Poisson's ratio ν, the initial slopes of
+/// the pressure–stretch curves are pR/(EH) = εs/(1 − ν/2) under GPS (eq. 100) and
+/// εs/(1 − ν²) under PS (eq. 102); in ϖ = pR/(μH) with E/μ = 2(1 + ν):
+/// dϖ/dλs = 2(1 + ν)/(1 − ν/2) and 2(1 + ν)/(1 − ν²) at λs = 1. The plane-stress SVK law is
+/// that material at small strain. The slope is taken from the closed form at λs = 1 + h and
+/// 1 + 2h (ϖ(1) = 0): (4ϖ(1 + h) − ϖ(1 + 2h))/(2h), whose error is O(h²) ≈ 1e-8 at h = 1e-4;
+/// tolerance 1e-6 relative. PS and GPS agree for ν = 0 and ν = ½ only.
+#[test]
+fn appendix_f_initial_slopes_of_svk_for_three_poisson_ratios() {
+    let h = 1e-4;
+    for nu in [0.0, 0.3, 0.4999] {
+        let law = tubemem_material::laws::SaintVenantKirchhoff::new(2.0 * (1.0 + nu), nu).unwrap();
+        let slope = |hyp| {
+            let w = |ls: f64| inflate(&law, hyp, ls).unwrap().w;
+            (4.0 * w(1.0 + h) - w(1.0 + 2.0 * h)) / (2.0 * h)
+        };
+        let (gps, ps) = (slope(Hypothesis::Gps), slope(Hypothesis::Ps));
+        let (eq100, eq102) = (
+            2.0 * (1.0 + nu) / (1.0 - 0.5 * nu),
+            2.0 * (1.0 + nu) / (1.0 - nu * nu),
+        );
+        println!(
+            "ν = {nu}: GPS slope {gps:.8} (eq. 100: {eq100:.8}), PS slope {ps:.8} (eq. 102: {eq102:.8}), PS/GPS − 1 = {:+.4}",
+            ps / gps - 1.0
+        );
+        assert!(rel(gps, eq100) < 1e-6, "ν = {nu}: {gps} vs eq. 100 {eq100}");
+        assert!(rel(ps, eq102) < 1e-6, "ν = {nu}: {ps} vs eq. 102 {eq102}");
+    }
+}

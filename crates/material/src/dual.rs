@@ -37,6 +37,18 @@ pub trait Real:
     fn sqrt(self) -> Self;
     fn powi(self, n: i32) -> Self;
     fn recip(self) -> Self;
+    /// self^p for a constant p (self > 0 where p is not an integer).
+    fn powf(self, p: f64) -> Self {
+        (self.ln() * p).exp()
+    }
+    /// self^e for a variable exponent: exp(e ln self), self > 0.
+    fn pow(self, e: Self) -> Self {
+        (self.ln() * e).exp()
+    }
+    /// The constant `c` as a scalar of this kind (no derivatives).
+    fn lift(self, c: f64) -> Self {
+        self * 0.0 + c
+    }
 }
 
 impl Real for f64 {
@@ -57,6 +69,15 @@ impl Real for f64 {
     }
     fn recip(self) -> Self {
         f64::recip(self)
+    }
+    fn powf(self, p: f64) -> Self {
+        f64::powf(self, p)
+    }
+    fn pow(self, e: Self) -> Self {
+        f64::powf(self, e)
+    }
+    fn lift(self, c: f64) -> Self {
+        c
     }
 }
 
@@ -207,6 +228,14 @@ impl Real for HyperDual2 {
     fn recip(self) -> Self {
         let x = self.re;
         self.chain(1.0 / x, -1.0 / (x * x), 2.0 / (x * x * x))
+    }
+    fn lift(self, c: f64) -> Self {
+        Self::constant(c)
+    }
+    fn powf(self, p: f64) -> Self {
+        let x = self.re;
+        let xp = x.powf(p);
+        self.chain(xp, p * xp / x, p * (p - 1.0) * xp / (x * x))
     }
 }
 

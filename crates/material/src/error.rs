@@ -89,6 +89,26 @@ pub enum MaterialError {
         "stretch beyond the locking limit of the {law} law: I1 = {i1:.6} but the law requires I1 < {limit:.6}"
     )]
     Locking { law: String, i1: f64, limit: f64 },
+    /// A parameter (of a law with named or indexed parameters) outside its admissible range.
+    /// (The text fields of this and the next two variants are boxed `str`s, so that the error
+    /// stays as small as the paper's laws' errors.)
+    #[error("invalid material parameter `{name}` = {}: {requirement}", Num(*value))]
+    Parameter {
+        name: Box<str>,
+        value: f64,
+        requirement: Box<str>,
+    },
+    /// An energy written as text that cannot be parsed.
+    #[error("the energy `{energy}`, column {column}: {message}")]
+    Expression {
+        energy: Box<str>,
+        column: usize,
+        message: Box<str>,
+    },
+    /// A law that is not admissible as a whole (an energy that is not finite or not convex at
+    /// the reference state, parameters that contradict each other).
+    #[error("the {law} law is not admissible: {reason}")]
+    Inadmissible { law: Box<str>, reason: Box<str> },
     /// The energy or one of its derivatives is not finite at this state.
     #[error("the {law} energy is not finite at I1 = {i1}, I2 = {i2}")]
     NonFinite { law: String, i1: f64, i2: f64 },

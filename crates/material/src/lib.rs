@@ -21,11 +21,14 @@
 //!   ([`MembraneLaw::stress_tangent`], Voigt order 11, 22, 12; both per unit μH).
 //!
 //! Built-in laws ([`laws`]): the generalized neo-Hookean law of Anssari-Benam & Bucchi (paper
-//! eqs. 19–23), Mooney–Rivlin (Appendix B) and neo-Hookean, all with analytic derivatives.
-//! A user law needs only its energy: implement [`InvariantEnergy`] (one generic function of I1,
-//! I2) and wrap it in [`AutoDiff`]; the derivatives come from a second-order dual number
-//! ([`dual::HyperDual2`]). The built-in laws are also available that way, and tests hold the two
-//! routes against each other.
+//! eqs. 19–23), Mooney–Rivlin (Appendix B), neo-Hookean, Yeoh, Gent, Gent–Gent, Arruda–Boyce,
+//! Ogden (principal stretches, through [`separable`]) and the compressible plane-stress
+//! Saint-Venant–Kirchhoff law. A user's law needs only its energy: written as text in a case
+//! file ([`laws::expression`], parsed by [`expr`]), or in Rust as an [`InvariantEnergy`] (one
+//! generic function of I1, I2) wrapped in [`AutoDiff`]; the derivatives come from a
+//! second-order dual number ([`dual::HyperDual2`]) or Taylor jets ([`taylor`]). The built-in
+//! laws are also available that way, and tests hold the two routes against each other.
+//! [`MaterialSpec`] is the typed description case files and the CLI name.
 //!
 //! ```
 //! use tubemem_material::{laws::AnssariBenamBucchi, MembraneLaw};
@@ -37,11 +40,15 @@
 
 pub mod dual;
 mod error;
+pub mod expr;
 pub mod laws;
 pub mod relaxed;
+pub mod separable;
+mod spec;
+pub mod taylor;
 
 pub use error::{tidy_numbers, MaterialError, Num};
-use serde::{Deserialize, Serialize};
+pub use spec::{MaterialSpec, Wrinkling};
 
 /// W(a, b) and its partial derivatives, a = tr C, b = det C (dimensionless, per μ).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -399,84 +406,23 @@ pub mod energies {
     }
 }
 
-/// A typed, validated material description (what case files and the CLI name).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "model", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum MaterialSpec {
-    /// Anssari-Benam & Bucchi generalized neo-Hookean (paper eqs. 19–23).
-    Abb { shear_modulus: f64, kuhn: f64 },
-    /// Mooney–Rivlin (paper eq. 83).
-    MooneyRivlin { shear_modulus: f64, alpha: f64 },
-    /// Neo-Hookean (α = 0).
-    NeoHookean { shear_modulus: f64 },
-}
-
-/// Whether compressive states are relaxed (tension-field theory) or kept as computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Wrinkling {
-    /// Pipkin's relaxed energy: no compressive resultant (the default for finite elements).
-    #[default]
-    Relaxed,
-    /// The law as it is (compressive resultants allowed).
-    None,
-}
-
-impl MaterialSpec {
-    /// Each `model` a case file names, with the parameters it requires.
-    pub const MODELS: [(&'static str, &'static [&'static str]); 3] = [
-        ("abb", &["shear_modulus", "kuhn"]),
-        ("mooney-rivlin", &["shear_modulus", "alpha"]),
-        ("neo-hookean", &["shear_modulus"]),
-    ];
-
-    /// The law with the chosen wrinkling model.
-    pub fn build_with(&self, wrinkling: Wrinkling) -> Result<Box<dyn MembraneLaw>, MaterialError> {
-        Ok(match (wrinkling, *self) {
-            (Wrinkling::None, _) => self.build()?,
-            (
-                Wrinkling::Relaxed,
-                MaterialSpec::Abb {
-                    shear_modulus,
-                    kuhn,
-                },
-            ) => Box::new(relaxed::Relaxed::new(laws::AnssariBenamBucchi::new(
-                shear_modulus,
-                kuhn,
-            )?)),
-            (
-                Wrinkling::Relaxed,
-                MaterialSpec::MooneyRivlin {
-                    shear_modulus,
-                    alpha,
-                },
-            ) => Box::new(relaxed::Relaxed::new(laws::MooneyRivlin::new(
-                shear_modulus,
-                alpha,
-            )?)),
-            (Wrinkling::Relaxed, MaterialSpec::NeoHookean { shear_modulus }) => {
-                Box::new(relaxed::Relaxed::new(laws::neo_hookean(shear_modulus)?))
-            }
-        })
+/// A boxed law is a law (so that the tension-field relaxation can wrap any of them).
+impl MembraneLaw for Box<dyn MembraneLaw> {
+    fn name(&self) -> String {
+        (**self).name()
     }
-
-    /// Validate the parameters and build the law.
-    pub fn build(&self) -> Result<Box<dyn MembraneLaw>, MaterialError> {
-        Ok(match *self {
-            MaterialSpec::Abb {
-                shear_modulus,
-                kuhn,
-            } => Box::new(laws::AnssariBenamBucchi::new(shear_modulus, kuhn)?),
-            MaterialSpec::MooneyRivlin {
-                shear_modulus,
-                alpha,
-            } => Box::new(laws::MooneyRivlin::new(shear_modulus, alpha)?),
-            MaterialSpec::NeoHookean { shear_modulus } => {
-                Box::new(laws::neo_hookean(shear_modulus)?)
-            }
-        })
+    fn shear_modulus(&self) -> f64 {
+        (**self).shear_modulus()
+    }
+    fn locking_limit(&self) -> Option<f64> {
+        (**self).locking_limit()
+    }
+    fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
+        (**self).derivatives_ab(a, b)
     }
 }
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_laws;

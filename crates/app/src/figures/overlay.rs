@@ -40,7 +40,7 @@ impl Overlay {
         let mut o = Overlay {
             label: label.to_string(),
             source: source.to_path_buf(),
-            material: report.material_spec,
+            material: report.material_spec.clone(),
             scales: report.scales,
             inflation: vec![],
             squeeze: vec![],
@@ -162,32 +162,60 @@ pub fn law_label(spec: &MaterialSpec) -> String {
         MaterialSpec::Abb { kuhn, .. } => format!("ABB, Kuhn N = {kuhn}"),
         MaterialSpec::MooneyRivlin { alpha, .. } => format!("Mooney–Rivlin, α = {alpha}"),
         MaterialSpec::NeoHookean { .. } => "neo-Hookean".into(),
+        _ => spec
+            .build()
+            .map(|l| l.name())
+            .unwrap_or_else(|_| spec.model().to_string()),
     }
 }
 
-/// Whether two specs are the same law (the shear modulus only scales, results are per μH).
+/// Whether two specs are the same law (the shear modulus only scales, results are per μH): the
+/// paper's laws by their parameters, any other by their dimensionless resultants N/(μH) at
+/// probe stretches (uniaxial, equibiaxial, pure shear and a general state), to 1e-12.
 pub fn same_law(a: &MaterialSpec, b: &MaterialSpec) -> bool {
     let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * x.abs().max(y.abs());
-    match (*a, *b) {
-        (MaterialSpec::Abb { kuhn: x, .. }, MaterialSpec::Abb { kuhn: y, .. }) => close(x, y),
+    let paper = |s: &MaterialSpec| {
+        matches!(
+            s,
+            MaterialSpec::Abb { .. }
+                | MaterialSpec::MooneyRivlin { .. }
+                | MaterialSpec::NeoHookean { .. }
+        )
+    };
+    if !(paper(a) && paper(b)) {
+        let (Ok(la), Ok(lb)) = (a.build(), b.build()) else {
+            return false;
+        };
+        let probes = [
+            (1.3, 1.3f64.powf(-0.5)),
+            (1.2, 1.2),
+            (1.25, 1.0),
+            (1.4, 1.1),
+        ];
+        return probes.iter().all(|&(l1, l2)| {
+            match (la.resultants(l1, l2), lb.resultants(l1, l2)) {
+                (Ok(x), Ok(y)) => close(x[0], y[0]) && close(x[1], y[1]),
+                _ => false,
+            }
+        });
+    }
+    match (a, b) {
+        (MaterialSpec::Abb { kuhn: x, .. }, MaterialSpec::Abb { kuhn: y, .. }) => close(*x, *y),
         (
             MaterialSpec::MooneyRivlin { alpha: x, .. },
             MaterialSpec::MooneyRivlin { alpha: y, .. },
-        ) => close(x, y),
+        ) => close(*x, *y),
         (MaterialSpec::NeoHookean { .. }, MaterialSpec::NeoHookean { .. }) => true,
         (MaterialSpec::NeoHookean { .. }, MaterialSpec::MooneyRivlin { alpha, .. })
         | (MaterialSpec::MooneyRivlin { alpha, .. }, MaterialSpec::NeoHookean { .. }) => {
-            alpha == 0.0
+            *alpha == 0.0
         }
         _ => false,
     }
 }
 
 /// The paper's law, the figures' default without overlays: ABB with 𝒩 = 30.
-pub const PAPER_LAW: MaterialSpec = MaterialSpec::Abb {
-    shear_modulus: 1.0,
-    kuhn: 30.0,
-};
+pub const PAPER_LAW: MaterialSpec = MaterialSpec::PAPER;
 
 /// A file-name-safe form of a label.
 pub(super) fn slug(s: &str) -> String {

@@ -141,7 +141,7 @@ pub fn write_all(
 ) -> Result<Vec<PathBuf>> {
     opts.check()?;
     let spec = law
-        .or_else(|| overlays.first().map(|o| o.material))
+        .or_else(|| overlays.first().map(|o| o.material.clone()))
         .unwrap_or(PAPER_LAW);
     for o in overlays {
         if !same_law(&o.material, &spec) {

@@ -81,7 +81,7 @@ pub fn run_with(
             contact_edge_fit: None,
         },
         material: String::new(),
-        material_spec: case.material,
+        material_spec: case.material.clone(),
         geometry: GeometryInfo {
             radius: case.geometry.radius,
             length: case.geometry.length,

@@ -95,7 +95,7 @@ impl<'a> Runner<'a> {
                 contact_edge_fit: fit,
             },
             material: model.law().name(),
-            material_spec: case.material,
+            material_spec: case.material.clone(),
             geometry: GeometryInfo {
                 radius: g.radius,
                 length: g.length,
