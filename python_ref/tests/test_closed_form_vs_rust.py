@@ -65,3 +65,56 @@ def test_limit_points_and_maxwell(tubemem):
     # quad's error estimate is ~1e-12 of the area; the Maxwell pressure inherits ~1e-11.
     assert rel(m["w"], wm) < 1e-9, (m["w"], wm)
     assert abs(m["lambda_s_lower"] - l1) < 1e-7 and abs(m["lambda_s_upper"] - l3) < 1e-7
+
+
+# The law library: each law's case-file table (given to the binary as --law) and its Python
+# law. The Python resultants are written from each published energy by hand (closed_form.
+# law_resultants); the Rust side computes them through its (tr C, det C) derivatives, its
+# inverse Langevin Newton and its separable-law series. Same tolerances as above.
+LIBRARY = {
+    "yeoh": 'model = "yeoh", c10 = 0.5, c20 = -0.01, c30 = 0.001',
+    "gent": 'model = "gent", shear_modulus = 1.0, jm = 50',
+    "gent-gent": 'model = "gent-gent", shear_modulus = 1.0, jm = 50, c2 = 0.2',
+    "arruda-boyce": 'model = "arruda-boyce", shear_modulus = 1.0, kuhn = 8',
+    "ogden": 'model = "ogden", mu = [6.3, 0.012, -0.1], alpha = [1.3, 5.0, -2.0]',
+    "svk": 'model = "saint-venant-kirchhoff", young_modulus = 2.9998, poisson_ratio = 0.4999',
+    "svk-0.3": 'model = "saint-venant-kirchhoff", young_modulus = 2.6, poisson_ratio = 0.3',
+}
+
+
+def _law(text):
+    import tomllib
+    return cf.law_of_spec(tomllib.loads("m = {" + text + "}")["m"])
+
+
+@pytest.mark.parametrize("name", sorted(LIBRARY))
+def test_law_library_inflation_and_flattening(tubemem, name):
+    text = LIBRARY[name]
+    law = _law(text)
+    for ls in [1.05, 1.3, 1.6, 2.2]:
+        g = tubemem("gps", "inflate", "--law", text, "--hypothesis", "gps", "--stretch", ls, "--json")
+        w, lz = cf.gps_inflation(ls, law=law)
+        assert rel(g["w"], w) < 1e-10 and rel(g["lambda_z"], lz) < 1e-10, (ls, g, w, lz)
+        p = tubemem("gps", "inflate", "--law", text, "--hypothesis", "ps", "--stretch", ls, "--json")
+        assert rel(p["w"], cf.ps_inflation(ls, law=law)) < 1e-10
+    for r in cf.gps_flattening(1.3, [1.1, 0.8], law=law):
+        s = tubemem("gps", "flatten", "--law", text, "--initial-stretch", 1.3, "--rho", r["rho"], "--json")
+        for k in ["w", "lambda_s", "lambda_z", "chi", "force"]:
+            assert rel(s[k], r[k]) < 1e-9, (k, s[k], r[k])
+
+
+@pytest.mark.parametrize("name", sorted(LIBRARY))
+def test_law_library_pressure_maximum(tubemem, name):
+    """The GPS pressure maximum where the law has one (Python: a scan and a bounded Brent
+    search on w(ls), to 1e-12 in ls), and none where it has none (a scan to ls = 4 and the Rust
+    scan agree)."""
+    text = LIBRARY[name]
+    ref = cf.gps_pressure_maximum(law=_law(text))
+    lim = tubemem("gps", "limits", "--law", text, "--json")
+    if ref is None:
+        assert lim["max"] is None, lim
+        return
+    ls, wm, _ = ref
+    assert lim["max"] is not None, (name, ref)
+    assert abs(lim["max"]["lambda_s"] - ls) < 1e-7, (lim["max"], ls)
+    assert rel(lim["max"]["w"], wm) < 1e-12, (lim["max"], wm)

@@ -9,9 +9,12 @@ Different formulations on purpose, so that agreement means something:
 * Maxwell pressure: equal areas on the (v, w) curve with scipy.integrate.quad.
 
 Laws: the Anssari-Benam--Bucchi law (eqs. 58-59, 62) everywhere; Mooney-Rivlin (eqs. 86-87,
-alpha = 0 is neo-Hookean) for free inflation and flattening (`law=("mooney-rivlin", alpha)`;
-`law_of_spec` maps a summary.json material_spec). Limit points, Maxwell pressure and the
-channel/polygon hand calculations are the paper's ABB example only.
+alpha = 0 is neo-Hookean) and the law library (Yeoh, Gent, Gent-Gent, Arruda-Boyce, Ogden,
+plane-stress Saint-Venant-Kirchhoff: `law_resultants`, written from each published energy by
+hand, not from the Rust code) for free inflation, flattening and the pressure maximum
+(`law=(name, parameters)`; `law_of_spec` maps a summary.json or case-file material table).
+Limit points by complex step, the Maxwell pressure and the channel/polygon hand calculations
+are the paper's ABB example only.
 """
 
 import numpy as np
@@ -38,7 +41,8 @@ def lock_lambda_z(ls, kuhn):
 
 
 def law_of_spec(spec):
-    """The `law` tuple of a summary.json `material_spec` (results are per mu H: mu drops out)."""
+    """The `law` tuple of a summary.json `material_spec` or a case file's [material] table
+    (results are per mu H: the modulus drops out where it only scales)."""
     model = spec.get("model")
     if model == "abb":
         return ("abb", float(spec["kuhn"]))
@@ -46,23 +50,95 @@ def law_of_spec(spec):
         return ("mooney-rivlin", float(spec["alpha"]))
     if model == "neo-hookean":
         return ("mooney-rivlin", 0.0)
+    if model == "yeoh":
+        return ("yeoh", (float(spec["c10"]), float(spec.get("c20", 0.0)), float(spec.get("c30", 0.0))))
+    if model == "gent":
+        return ("gent", float(spec["jm"]))
+    if model == "gent-gent":
+        return ("gent-gent", (float(spec["jm"]), float(spec["c2"]) / float(spec["shear_modulus"])))
+    if model == "arruda-boyce":
+        return ("arruda-boyce", float(spec["kuhn"]))
+    if model == "ogden":
+        return ("ogden", (tuple(map(float, spec["mu"])), tuple(map(float, spec["alpha"]))))
+    if model in ("saint-venant-kirchhoff", "svk"):
+        return ("svk", float(spec["poisson_ratio"]))
     raise ValueError(f"unknown material model {model!r}")
 
 
+def inverse_langevin(y):
+    """beta with coth(beta) - 1/beta = y, 0 < y < 1, by Brent's method (scipy)."""
+    f = lambda b: 1.0 / np.tanh(b) - 1.0 / b - y
+    return optimize.brentq(f, 1e-12, 1.0 / (1.0 - y) + 1.0, xtol=1e-15, rtol=1e-15)
+
+
+def _i1_law_w1(kind, p, i1):
+    """dW/dI1 per mu of the laws of I1 alone, from their published energies."""
+    if kind == "yeoh":  # W = C10 x + C20 x^2 + C30 x^3, mu = 2 C10
+        c10, c20, c30 = p
+        x = i1 - 3.0
+        return (c10 + 2 * c20 * x + 3 * c30 * x * x) / (2 * c10)
+    if kind == "gent":  # W = -(mu Jm/2) ln(1 - (I1 - 3)/Jm)
+        return 0.5 / (1.0 - (i1 - 3.0) / p)
+    if kind == "arruda-boyce":  # W = mu N [beta lr + ln(beta/sinh beta)], lr = sqrt(I1/(3N))
+        lr = np.sqrt(i1 / (3.0 * p))
+        return inverse_langevin(lr) / (6.0 * lr)
+    raise ValueError(kind)
+
+
+def law_resultants(ls, lz, law):
+    """(N_s, N_z)/(mu H) of the law library, lambda_I = ls, lambda_II = lz, from
+    N_1 = (1/lambda_2) dW/dlambda_1 (eq. 18) with each published energy differentiated by hand."""
+    kind, p = law
+    l3 = 1.0 / (ls * lz)
+    if kind in ("yeoh", "gent", "arruda-boyce", "gent-gent"):
+        i1 = ls**2 + lz**2 + l3**2
+        w1 = _i1_law_w1("gent", p[0], i1) if kind == "gent-gent" else _i1_law_w1(kind, p, i1)
+        # dI1/dls = 2 ls - 2/(ls^3 lz^2)
+        ns = 2 * w1 * (ls - 1.0 / (ls**3 * lz**2)) / lz
+        nz = 2 * w1 * (lz - 1.0 / (lz**3 * ls**2)) / ls
+        if kind == "gent-gent":  # + C2 ln(I2/3), dI2/dls = -2/ls^3 + 2 ls lz^2
+            i2 = 1 / ls**2 + 1 / lz**2 + (ls * lz) ** 2
+            w2 = p[1] / i2
+            ns += w2 * (-2.0 / ls**3 + 2 * ls * lz**2) / lz
+            nz += w2 * (-2.0 / lz**3 + 2 * lz * ls**2) / ls
+        return ns, nz
+    if kind == "ogden":  # W = sum mu_p/alpha_p (l1^a + l2^a + l3^a - 3), per mu = sum mu a / 2
+        mus, als = p
+        mu = 0.5 * sum(m * a for m, a in zip(mus, als))
+        wp = lambda l: sum(m * l ** (a - 1) for m, a in zip(mus, als)) / mu
+        # dW/dls = w'(ls) + w'(l3) dl3/dls, dl3/dls = -l3/ls
+        return (wp(ls) - wp(l3) * l3 / ls) / lz, (wp(lz) - wp(l3) * l3 / lz) / ls
+    if kind == "svk":  # W/mu = tr E^2 + nu/(1 - nu) (tr E)^2, E = (C - I)/2, plane stress
+        k = p / (1.0 - p)
+        es, ez = 0.5 * (ls**2 - 1), 0.5 * (lz**2 - 1)
+        return 2 * ls / lz * (es + k * (es + ez)), 2 * lz / ls * (ez + k * (es + ez))
+    raise ValueError(f"unknown law {kind!r}")
+
+
 def resultants(ls, lz, law):
-    """(N_s, N_z)/(mu H) of `law` = ("abb", kuhn) (eq. 58) or ("mooney-rivlin", alpha) (eqs. 86-87)."""
+    """(N_s, N_z)/(mu H) of `law` = ("abb", kuhn) (eq. 58), ("mooney-rivlin", alpha) (eqs. 86-87)
+    or a law of the library (`law_resultants`)."""
     kind, param = law
     if kind == "abb":
         return abb_resultants(ls, lz, param)
     if kind == "mooney-rivlin":
         return mr_resultants(ls, lz, param)
-    raise ValueError(f"unknown law {kind!r}")
+    return law_resultants(ls, lz, law)
+
+
+def _lock_i1(law):
+    """The I1 at which the law locks, or None."""
+    kind, p = law
+    return {"abb": lambda: 3 * p, "gent": lambda: 3 + p, "gent-gent": lambda: 3 + p[0],
+            "arruda-boyce": lambda: 3 * p}.get(kind, lambda: None)()
 
 
 def _lz_bracket(ls, law):
-    """An interval of lambda_z holding the root of N_s - 2 N_z (ABB: below locking)."""
-    if law[0] == "abb":
-        return 0.5, lock_lambda_z(ls, law[1]) * (1 - 1e-12)
+    """An interval of lambda_z holding the root of N_s - 2 N_z (below locking, if the law locks)."""
+    lock = _lock_i1(law)
+    if lock is not None:
+        f = lambda lz: ls**2 + lz**2 + 1 / (ls * lz) ** 2 - lock
+        return 0.5, optimize.brentq(f, 1.0, np.sqrt(lock), xtol=1e-15) * (1 - 1e-12)
     return 0.5, 20.0
 
 
