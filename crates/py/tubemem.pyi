@@ -12,7 +12,7 @@ __version__: str
 class TubememError(RuntimeError):
     """A closed-form solve or finite element run that failed (stage, step and cause)."""
 
-Material = Optional[Mapping[str, Any]]
+MaterialLike = Optional[Union["Material", Mapping[str, Any]]]
 ArrayLike = Union[float, npt.ArrayLike]
 Progress = Optional[Union[Callable[[dict], Any], Literal["tqdm"]]]
 
@@ -31,7 +31,7 @@ class Table:
     def to_pandas(self) -> Any: ...
 
 def gps_inflate(
-    stretch: ArrayLike, material: Material = None, hypothesis: str = "gps"
+    stretch: ArrayLike, material: MaterialLike = None, hypothesis: str = "gps"
 ) -> Union[dict[str, float], Table]:
     """Free inflation at hoop stretch λs (eq. 66 GPS, eq. 70 PS): w, lambda_s, lambda_z, n_s, n_z
     (a dict for a number, a Table of arrays of the input's shape for an array)."""
@@ -40,11 +40,11 @@ def gps_inflation_curve(
     stretch_to: float,
     points: int = 100,
     stretch_from: float = 1.0,
-    material: Material = None,
+    material: MaterialLike = None,
     hypothesis: str = "gps",
 ) -> Table: ...
 def gps_flatten(
-    initial_stretch: float, rho: ArrayLike, material: Material = None, hypothesis: str = "gps"
+    initial_stretch: float, rho: ArrayLike, material: MaterialLike = None, hypothesis: str = "gps"
 ) -> Union[dict[str, float], Table]:
     """Squeeze between two plates with the gas closed in (eqs. 76–77 GPS, 78–79 PS)."""
 
@@ -52,16 +52,16 @@ def gps_flattening_curve(
     initial_stretch: float,
     rho_to: float,
     points: int = 100,
-    material: Material = None,
+    material: MaterialLike = None,
     hypothesis: str = "gps",
 ) -> Table: ...
 def gps_section_at_pressure(
-    rho: float, w: float, guess: tuple[float, float], material: Material = None
+    rho: float, w: float, guess: tuple[float, float], material: MaterialLike = None
 ) -> dict[str, float]:
     """The GPS cross-section at half-gap rho under a given pressure w (eq. 76, no gas law)."""
 
-def gps_limits(material: Material = None, hypothesis: str = "gps") -> dict[str, Any]: ...
-def resultants(l1: float, l2: float, material: Material = None) -> tuple[float, float]:
+def gps_limits(material: MaterialLike = None, hypothesis: str = "gps") -> dict[str, Any]: ...
+def resultants(l1: float, l2: float, material: MaterialLike = None) -> tuple[float, float]:
     """Cauchy resultants (N1, N2)/(μH) at principal stretches (eq. 18)."""
 
 def run_case(
@@ -148,3 +148,39 @@ def verify(
     python_ref: Optional[Union[str, PathLike]] = None,
 ) -> dict[str, Any]:
     """Verification suites (or the study of one case): results.json's content as a dict."""
+
+
+class Material:
+    """A membrane law, validated on construction: Material("gent", shear_modulus=1.0, jm=50),
+    Material(model="invariants", energy="-(jm/2)*ln(1-(I1-3)/jm)", parameters={"jm": 50},
+    shear_modulus=1.0), or Material.from_dict(a case file's material table). The models:
+    abb, mooney-rivlin, neo-hookean, yeoh, gent, gent-gent, arruda-boyce, ogden,
+    saint-venant-kirchhoff (svk), invariants (an energy of I1, I2 as text), principal (w(l) as
+    text, W = w(λ1) + w(λ2) + w(λ3)). A bad law raises ValueError naming the parameter or the
+    energy's column."""
+
+    def __init__(self, model: Optional[str] = None, **params: Any) -> None: ...
+    @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> "Material": ...
+    def to_dict(self) -> dict[str, Any]: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def shear_modulus(self) -> float: ...
+    def resultants(self, l1: float, l2: float) -> tuple[float, float]: ...
+    def energy(self, l1: float, l2: float) -> float: ...
+    def nominal_stress(
+        self, mode: Literal["uniaxial", "equibiaxial", "pure_shear"], stretch: ArrayLike
+    ) -> np.ndarray: ...
+
+TestData = Union[str, PathLike, npt.ArrayLike, tuple[npt.ArrayLike, npt.ArrayLike]]
+
+def fit(
+    law: Union[str, "Material", Mapping[str, Any]],
+    uniaxial: Optional[TestData] = None,
+    equibiaxial: Optional[TestData] = None,
+    pure_shear: Optional[TestData] = None,
+) -> dict[str, Any]:
+    """Fit a law's parameters to test data (nominal stress against stretch; CSV paths, (N, 2)
+    arrays or (stretch, stress) pairs): material (the fitted Material), parameters (name,
+    value, std_error, determined), correlation, residual_std, warnings, …"""

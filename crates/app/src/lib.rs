@@ -31,6 +31,7 @@ pub mod edge_fit;
 pub mod edge_track;
 pub mod export;
 pub mod figures;
+pub mod fit;
 mod journal;
 pub mod main_job;
 pub mod model_setup;

@@ -3,6 +3,7 @@
 //! figures). Errors are `anyhow` chains whose outer context names the stage, step, key or file.
 
 pub mod console;
+pub mod fit_cmd;
 pub mod gps_cmd;
 pub mod material_args;
 pub mod verify_cmd;

@@ -59,6 +59,10 @@ enum Command {
         #[arg(long)]
         log: Option<PathBuf>,
     },
+    /// Fit a law's parameters to uniaxial, equibiaxial and pure-shear test data (nominal stress
+    /// against stretch), with each parameter's standard error and a warning for any the data
+    /// do not determine; prints the fitted material table for a case file.
+    Fit(tubemem_cli::fit_cmd::FitArgs),
     /// Run verification checks (suite files, or the study of one case) and write results.json,
     /// report.md, report.html and junit.xml. Exit code 0: all passed; 1: a check failed; 2: a
     /// usage or setup error.
@@ -274,6 +278,7 @@ fn run(cli: Cli) -> Result<()> {
         None => main_job(),
         Some(Command::Verify(_)) => anyhow::bail!("internal: `verify` is dispatched in main"),
         Some(Command::Gps { command }) => gps_cmd::run(command),
+        Some(Command::Fit(a)) => tubemem_cli::fit_cmd::run(a),
         Some(Command::Run {
             case,
             out,

@@ -41,6 +41,7 @@
 pub mod dual;
 mod error;
 pub mod expr;
+pub mod fit;
 pub mod laws;
 pub mod relaxed;
 pub mod separable;
@@ -425,4 +426,19 @@ impl MembraneLaw for Box<dyn MembraneLaw> {
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_fit;
+#[cfg(test)]
 mod tests_laws;
+
+/// An error and its sources, one line (for the tests).
+#[cfg(test)]
+fn error_chain_for_tests(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cur = e.source();
+    while let Some(c) = cur {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        cur = c.source();
+    }
+    s
+}

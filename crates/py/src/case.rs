@@ -26,7 +26,20 @@ impl PyCase {
     /// A case from a dict of its tables: its errors name dict paths (`material.kuhm`,
     /// `stage[1].target_rho`), not the lines of the TOML it is turned into.
     pub(crate) fn from_value(d: &Bound<'_, PyAny>, base_dir: PathBuf) -> PyResult<Self> {
-        let value: serde_json::Value = from_py(d, "case")?;
+        // a `Material` as the material table: its dict
+        let d = match d.cast::<pyo3::types::PyDict>() {
+            Ok(t) => match t.get_item("material")? {
+                Some(m) if m.cast::<crate::material::PyMaterial>().is_ok() => {
+                    let copy = t.copy()?;
+                    let spec = crate::material::spec_of(&m)?;
+                    copy.set_item("material", crate::convert::to_py(d.py(), &spec)?)?;
+                    copy.into_any()
+                }
+                _ => d.clone(),
+            },
+            Err(_) => d.clone(),
+        };
+        let value: serde_json::Value = from_py(&d, "case")?;
         let table = toml::Value::try_from(value)
             .map_err(|e| PyValueError::new_err(format!("case: {e}")))?;
         let text =

@@ -22,7 +22,12 @@ pub(crate) fn gps_err(e: GpsError) -> PyErr {
         // a material parameter out of range, or a stretch asked for beyond the locking limit,
         // is bad input
         GpsError::Material {
-            source: MaterialError::InvalidParameter { .. } | MaterialError::Locking { .. },
+            source:
+                MaterialError::InvalidParameter { .. }
+                | MaterialError::Parameter { .. }
+                | MaterialError::Expression { .. }
+                | MaterialError::Inadmissible { .. }
+                | MaterialError::Locking { .. },
             ..
         } => PyValueError::new_err(msg),
         _ => TubememError::new_err(msg),
@@ -33,6 +38,9 @@ pub(crate) fn material_err(e: MaterialError) -> PyErr {
     match e {
         // a stretch beyond the locking limit, asked for directly, is bad input too
         MaterialError::InvalidParameter { .. }
+        | MaterialError::Parameter { .. }
+        | MaterialError::Expression { .. }
+        | MaterialError::Inadmissible { .. }
         | MaterialError::InvalidState { .. }
         | MaterialError::Locking { .. } => {
             PyValueError::new_err(tubemem_material::tidy_numbers(&e.to_string()))

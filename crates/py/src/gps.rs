@@ -1,7 +1,7 @@
 //! The closed form: free inflation, flattening, the section at a given pressure, limit points
 //! and resultants, for numbers or numpy arrays.
 
-use crate::convert::{from_py, to_py};
+use crate::convert::to_py;
 use crate::errors::{gps_err, material_err, TubememError};
 use crate::table::Table;
 use pyo3::exceptions::PyValueError;
@@ -28,7 +28,7 @@ pub(crate) fn detached<'py, T: serde::Serialize + Send>(
 
 pub(crate) fn law(material: Option<&Bound<'_, PyAny>>) -> PyResult<Box<dyn MembraneLaw>> {
     let spec = match material {
-        Some(m) if !m.is_none() => from_py::<MaterialSpec>(m, "material")?,
+        Some(m) if !m.is_none() => crate::material::spec_of(m)?,
         _ => DEFAULT_MATERIAL,
     };
     spec.build().map_err(material_err)

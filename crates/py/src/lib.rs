@@ -17,6 +17,7 @@ mod case;
 mod convert;
 mod errors;
 mod gps;
+mod material;
 mod outcome;
 mod progress;
 mod run;
@@ -64,6 +65,8 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_class::<run::Run>()?;
     m.add_class::<case::PyCase>()?;
+    m.add_class::<material::PyMaterial>()?;
+    m.add_function(wrap_pyfunction!(material::fit, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::_sweep_one, m)?)?;
     Ok(())

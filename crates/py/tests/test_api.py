@@ -677,3 +677,76 @@ def test_units_reach_the_python_tables(tmp_path):
     assert r.summary["units"]["system"] == "SI"
     rows = list(csv.DictReader(open(tmp_path / "si" / "steps.csv")))
     np.testing.assert_array_equal(r.steps["pressure_pa"], [float(x["pressure_pa"]) for x in rows])
+
+
+def test_material_objects_and_energies_written_as_text():
+    """tubemem.Material: any law of the case files, validated on construction; the closed form
+    takes it as material=; an energy written as text gives the built-in law's numbers (to
+    1e-13 relative: the two derivative routes agree to round-off, crates/material's tests);
+    bad laws are ValueErrors naming the parameter or the column."""
+    gent = tubemem.Material("gent", shear_modulus=1.0, jm=50)
+    text = tubemem.Material(model="invariants", energy="-(jm / 2) * ln(1 - (I1 - 3) / jm)",
+                            parameters={"jm": 50}, shear_modulus=1.0)
+    assert gent.to_dict() == {"model": "gent", "shear_modulus": 1.0, "jm": 50.0}
+    assert tubemem.Material.from_dict(gent.to_dict()) == gent
+    for ls in [1.1, 1.5, 2.5]:
+        a, b = tubemem.gps_inflate(ls, material=gent), tubemem.gps_inflate(ls, material=text)
+        assert abs(a["w"] / b["w"] - 1) < 1e-13 and abs(a["lambda_z"] / b["lambda_z"] - 1) < 1e-13
+    assert tubemem.gps_limits(material=gent)["max"] is not None
+    # the uniaxial nominal stress of an I1 law: P = 2 (l - l^-2) W'(I1), W' = 1/2 / (1 - (I1 - 3)/Jm)
+    l = np.array([1.2, 2.0, 3.0])
+    i1 = l**2 + 2 / l
+    want = 2 * (l - l**-2) * 0.5 / (1 - (i1 - 3) / 50)
+    assert np.allclose(gent.nominal_stress("uniaxial", l), want, rtol=1e-12)
+    for kwargs, needle in [
+        (dict(model="gent", shear_modulus=1.0), "jm"),
+        (dict(model="yeoh", c10=0.5, c20=-1.0), "c20"),
+        (dict(model="invariants", energy="(I1 - 3)/2 * jn", parameters={"jm": 1}, shear_modulus=1), "column 14: unknown name `jn`"),
+        (dict(model="principal", energy="-(l^2 - 1)", shear_modulus=1), "not positive definite"),
+        (dict(model="ogden", mu=[1.0, -1.0], alpha=[2.0, 2.0]), "mu[1]"),
+    ]:
+        with pytest.raises(ValueError, match=None) as e:
+            tubemem.Material(**kwargs)
+        assert needle in str(e.value), (kwargs, str(e.value))
+
+
+def test_a_material_object_runs_in_a_case(tmp_path):
+    gent = tubemem.Material("gent", shear_modulus=1.0, jm=50)
+    case = tubemem.Case(geometry={"radius": 1.0, "length": 8.0}, material=gent,
+                        mesh={"around": 16, "along": 24, "symmetry": "eighth"},
+                        stage=[{"kind": "inflate", "control": "volume", "target_stretch": 1.2, "steps": 4}])
+    r = tubemem.run(case, tmp_path / "gent")
+    assert r.summary["material_spec"] == gent.to_dict()
+    assert "Gent" in r.summary["material"]
+
+
+def test_fit_takes_files_or_arrays_and_says_what_the_data_do_not_determine():
+    """tubemem.fit on the shipped synthetic Yeoh data (examples/fit: the stated law with 1 %
+    noise; python_ref/tubemem_ref/synthetic.py): every parameter within three standard errors;
+    from arrays, noise-free Ogden data give the law back; SVK's Poisson ratio from a uniaxial
+    test alone is reported as not determined (P = E l (l^2 - 1)/2 whatever nu)."""
+    from tubemem_ref import synthetic
+    ex = pathlib.Path(__file__).resolve().parents[3] / "examples" / "fit"
+    r = tubemem.fit("yeoh", uniaxial=ex / "yeoh_synthetic_uniaxial.csv",
+                    equibiaxial=str(ex / "yeoh_synthetic_equibiaxial.csv"),
+                    pure_shear=ex / "yeoh_synthetic_pure_shear.csv")
+    for p in r["parameters"]:
+        assert abs(p["value"] - synthetic.YEOH[p["name"]]) <= 3 * p["std_error"], p
+    assert isinstance(r["material"], tubemem.Material)
+    og = tubemem.Material("ogden", mu=[0.2, 0.002], alpha=[1.8, 5.0])
+    l = np.linspace(1.05, 3.5, 20)
+    r = tubemem.fit({"model": "ogden", "mu": [0.1, 0.01], "alpha": [2.0, 4.0]},
+                    uniaxial=np.c_[l, og.nominal_stress("uniaxial", l)],
+                    equibiaxial=(l[:12], og.nominal_stress("equibiaxial", l[:12])))
+    got = r["material"].to_dict()
+    assert np.allclose(got["mu"], [0.2, 0.002], rtol=1e-6) and np.allclose(got["alpha"], [1.8, 5.0], rtol=1e-6)
+    svk = tubemem.Material("svk", young_modulus=3.0, poisson_ratio=0.3)
+    rng = np.random.default_rng(1)
+    l = np.linspace(1.01, 1.5, 15)
+    p = svk.nominal_stress("uniaxial", l) + 1e-4 * rng.standard_normal(15)
+    r = tubemem.fit({"model": "svk", "young_modulus": 2.0, "poisson_ratio": 0.2}, uniaxial=np.c_[l, p])
+    assert any("poisson_ratio" in w for w in r["warnings"]), r["warnings"]
+    with pytest.raises(ValueError, match="more points than parameters"):
+        tubemem.fit("yeoh", uniaxial=np.c_[[1.1, 1.2], [0.1, 0.2]])
+    with pytest.raises(ValueError, match="give test data"):
+        tubemem.fit("yeoh")

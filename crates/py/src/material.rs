@@ -1,0 +1,223 @@
+//! `tubemem.Material`: a validated membrane law (any model of the case files, an energy
+//! written as text included) and `tubemem.fit`: its parameters from test data.
+
+use crate::convert::{from_py, to_py};
+use crate::errors::{material_err, TubememError};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use tubemem_material::fit::{Mode, TestData};
+use tubemem_material::{MaterialSpec, MembraneLaw};
+
+/// A membrane law, validated on construction: `Material("gent", shear_modulus=1.0, jm=50)`,
+/// `Material(model="invariants", energy="-(jm/2)*ln(1-(I1-3)/jm)", parameters={"jm": 50},
+/// shear_modulus=1.0)`, or `Material.from_dict(d)` with a case file's material table. Every
+/// closed-form function takes it as `material=`, and a `Case` as its `material` table.
+#[pyclass(name = "Material", module = "tubemem", frozen)]
+pub(crate) struct PyMaterial {
+    pub(crate) spec: MaterialSpec,
+    law: Box<dyn MembraneLaw>,
+}
+
+impl PyMaterial {
+    pub(crate) fn of(spec: MaterialSpec) -> PyResult<Self> {
+        let law = spec.build().map_err(material_err)?;
+        Ok(Self { spec, law })
+    }
+}
+
+/// The spec of a `material=` argument: a `Material`, or a dict of a material table.
+pub(crate) fn spec_of(m: &Bound<'_, PyAny>) -> PyResult<MaterialSpec> {
+    if let Ok(mat) = m.cast::<PyMaterial>() {
+        return Ok(mat.get().spec.clone());
+    }
+    from_py::<MaterialSpec>(m, "material")
+}
+
+fn mode_of(name: &str) -> PyResult<Mode> {
+    match name.replace(['-', ' '], "_").to_ascii_lowercase().as_str() {
+        "uniaxial" => Ok(Mode::Uniaxial),
+        "equibiaxial" => Ok(Mode::Equibiaxial),
+        "pure_shear" | "planar" => Ok(Mode::PureShear),
+        _ => Err(PyValueError::new_err(format!(
+            "mode = {name:?}: \"uniaxial\", \"equibiaxial\" or \"pure_shear\""
+        ))),
+    }
+}
+
+#[pymethods]
+impl PyMaterial {
+    #[new]
+    #[pyo3(signature = (model=None, **params))]
+    fn new(
+        py: Python<'_>,
+        model: Option<&str>,
+        params: Option<&Bound<'_, pyo3::types::PyDict>>,
+    ) -> PyResult<Self> {
+        let d = match params {
+            Some(p) => p.copy()?,
+            None => pyo3::types::PyDict::new(py),
+        };
+        if let Some(m) = model {
+            if d.contains("model")? {
+                return Err(PyValueError::new_err(
+                    "Material: give the model once (as the first argument or model=)",
+                ));
+            }
+            d.set_item("model", m)?;
+        }
+        if !d.contains("model")? {
+            return Err(PyValueError::new_err(format!(
+                "Material: name the model, one of {}",
+                MaterialSpec::MODELS
+                    .iter()
+                    .map(|(m, _)| *m)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        Self::of(from_py::<MaterialSpec>(d.as_any(), "material")?)
+    }
+    /// A material from a case file's material table as a dict.
+    #[staticmethod]
+    fn from_dict(d: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Self::of(from_py::<MaterialSpec>(d, "material")?)
+    }
+    /// The material table as a dict (as a case file writes it).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.spec)
+    }
+    /// The law's name with its parameters.
+    #[getter]
+    fn name(&self) -> String {
+        self.law.name()
+    }
+    /// The modulus μ the dimensionless results are per (ϖ = pR/(μH)).
+    #[getter]
+    fn shear_modulus(&self) -> f64 {
+        self.spec.shear_modulus()
+    }
+    /// The Cauchy resultants (N1, N2)/(μH) at principal stretches (l1, l2), eq. (18).
+    fn resultants(&self, l1: f64, l2: f64) -> PyResult<(f64, f64)> {
+        let [n1, n2] = self.law.resultants(l1, l2).map_err(material_err)?;
+        Ok((n1, n2))
+    }
+    /// The energy W/(μH) per reference area at principal stretches (l1, l2).
+    fn energy(&self, l1: f64, l2: f64) -> PyResult<f64> {
+        self.law.energy(l1, l2).map_err(material_err)
+    }
+    /// The nominal stress (in the law's modulus units) of a test, "uniaxial", "equibiaxial" or
+    /// "pure_shear", at each stretch of `stretch` (a number or an array): what `fit` compares
+    /// with the data.
+    fn nominal_stress<'py>(
+        &self,
+        py: Python<'py>,
+        mode: &str,
+        stretch: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let mode = mode_of(mode)?;
+        let np = py.import("numpy")?;
+        let arr = np.call_method1("asarray", (stretch, "float64"))?;
+        let flat: Vec<f64> = arr.call_method0("ravel")?.extract()?;
+        let out = flat
+            .iter()
+            .map(|&l| tubemem_material::fit::nominal_stress(self.law.as_ref(), mode, l))
+            .collect::<Result<Vec<f64>, _>>()
+            .map_err(material_err)?;
+        np.call_method1("asarray", (out,))?
+            .call_method1("reshape", (arr.getattr("shape")?,))
+    }
+    fn __repr__(&self) -> String {
+        format!("<tubemem.Material {}>", self.law.name())
+    }
+    fn __eq__(&self, other: &Self) -> bool {
+        self.spec == other.spec
+    }
+}
+
+/// One test's data: a path to a CSV file (stretch, nominal stress), or an (N, 2) array, or a
+/// (stretch, stress) pair of arrays.
+fn test_data(py: Python<'_>, mode: Mode, arg: &Bound<'_, PyAny>, what: &str) -> PyResult<TestData> {
+    if let Ok(p) = arg.extract::<PathBuf>() {
+        if arg.is_instance_of::<pyo3::types::PyString>() || p.is_file() {
+            return tubemem_app::fit::read_test(&p, mode).map_err(|e| {
+                PyValueError::new_err(format!("{what}: {}", tubemem_app::error_chain(&e)))
+            });
+        }
+    }
+    let np = py.import("numpy")?;
+    let bad = || {
+        PyValueError::new_err(format!("{what}: a CSV path, an (N, 2) array of (stretch, stress), or a (stretch, stress) pair of arrays"))
+    };
+    let arr = np
+        .call_method1("asarray", (arg, "float64"))
+        .map_err(|_| bad())?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    let (stretch, stress): (Vec<f64>, Vec<f64>) = match shape.as_slice() {
+        // (N, 2): one (stretch, stress) row per point (a 2 × 2 array is read so too)
+        [_, 2] => {
+            let t = arr.getattr("T")?;
+            (t.get_item(0)?.extract()?, t.get_item(1)?.extract()?)
+        }
+        [2, _] => (arr.get_item(0)?.extract()?, arr.get_item(1)?.extract()?),
+        _ => return Err(bad()),
+    };
+    Ok(TestData {
+        mode,
+        stretch,
+        stress,
+    })
+}
+
+/// Fit a law's parameters to test data: `law` a model name (starting values estimated from
+/// the data), a material dict with starting values, or a `Material`; `uniaxial`,
+/// `equibiaxial`, `pure_shear` each a CSV path, an (N, 2) array or a (stretch, stress) pair.
+/// Returns a dict: `material` (the fitted `Material`), `parameters` (name, value, std_error,
+/// determined), `correlation`, `residual_std`, `max_relative_residual`, `points`,
+/// `termination`, `evaluations` and `warnings` (a parameter the data do not determine).
+#[pyfunction]
+#[pyo3(signature = (law, uniaxial=None, equibiaxial=None, pure_shear=None))]
+pub(crate) fn fit<'py>(
+    py: Python<'py>,
+    law: &Bound<'py, PyAny>,
+    uniaxial: Option<&Bound<'py, PyAny>>,
+    equibiaxial: Option<&Bound<'py, PyAny>>,
+    pure_shear: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut data = vec![];
+    for (arg, mode, what) in [
+        (uniaxial, Mode::Uniaxial, "uniaxial"),
+        (equibiaxial, Mode::Equibiaxial, "equibiaxial"),
+        (pure_shear, Mode::PureShear, "pure_shear"),
+    ] {
+        if let Some(a) = arg.filter(|a| !a.is_none()) {
+            data.push(test_data(py, mode, a, what)?);
+        }
+    }
+    if data.is_empty() {
+        return Err(PyValueError::new_err(
+            "fit: give test data as uniaxial=, equibiaxial= and/or pure_shear=",
+        ));
+    }
+    let start = match law.extract::<String>() {
+        Ok(model) => tubemem_app::fit::default_start(&model, &data)
+            .map_err(|e| PyValueError::new_err(format!("law: {}", tubemem_app::error_chain(&e))))?,
+        Err(_) => spec_of(law)?,
+    };
+    let result = py
+        .detach(|| tubemem_app::fit::run_fit(&start, &data))
+        .map_err(|e| {
+            let msg = format!("fit: {}", tubemem_app::error_chain(&e));
+            match e {
+                tubemem_app::fit::FitError::Fit(tubemem_material::fit::FitError::Data(_))
+                | tubemem_app::fit::FitError::Start(_) => PyValueError::new_err(msg),
+                _ => TubememError::new_err(msg),
+            }
+        })?;
+    let d = to_py(py, &result)?;
+    d.set_item(
+        "material",
+        Bound::new(py, PyMaterial::of(result.spec.clone())?)?,
+    )?;
+    Ok(d)
+}
