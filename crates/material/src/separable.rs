@@ -46,9 +46,21 @@ pub trait StretchEnergy: Send + Sync + std::fmt::Debug {
 pub struct Separable<S> {
     pub energy: S,
     pub shear_modulus: f64,
+    /// 3 g(1), subtracted so that W = 0 at the reference state (computed once)
+    offset: f64,
 }
 
 impl<S: StretchEnergy> Separable<S> {
+    pub fn new(energy: S, shear_modulus: f64) -> Result<Self, MaterialError> {
+        let mut t = [0.0; 1];
+        energy.taylor(1.0, &mut t)?;
+        Ok(Self {
+            energy,
+            shear_modulus,
+            offset: 3.0 * t[0],
+        })
+    }
+
     /// G(a, b) and its derivatives: (G, G_a, G_b, G_aa, G_ab, G_bb).
     fn in_plane(&self, a: f64, b: f64) -> Result<[f64; 6], MaterialError> {
         let s = 0.5 * a;
@@ -122,11 +134,9 @@ impl<S: StretchEnergy> MembraneLaw for Separable<S> {
         let mut t = [0.0; 3];
         self.energy.taylor(y, &mut t)?;
         let (h0, h1, h2) = (t[0], t[1], 2.0 * t[2]);
-        let mut t1 = [0.0; 1];
-        self.energy.taylor(1.0, &mut t1)?;
         let (b2, b3) = (b * b, b * b * b);
         Ok(EnergyDerivatives {
-            w: g + h0 - 3.0 * t1[0],
+            w: g + h0 - self.offset,
             w_a: ga,
             w_b: gb - h1 / b2,
             w_aa: gaa,

@@ -187,10 +187,7 @@ impl PrincipalLaw {
             parameters_text(parameters)
         );
         let law = Self {
-            law: Separable {
-                energy: StretchExpr { expr, name },
-                shear_modulus,
-            },
+            law: Separable::new(StretchExpr { expr, name }, shear_modulus)?,
         };
         let mut t = [0.0; 3];
         law.law.energy.taylor(1.0, &mut t)?;

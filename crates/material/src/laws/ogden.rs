@@ -101,13 +101,13 @@ impl Ogden {
                 .join("; ")
         );
         Ok(Self {
-            law: Separable {
-                energy: OgdenTerms {
+            law: Separable::new(
+                OgdenTerms {
                     terms: mu.iter().zip(alpha).map(|(m, a)| (m / shear, *a)).collect(),
                     name,
                 },
-                shear_modulus: shear,
-            },
+                shear,
+            )?,
         })
     }
 }
