@@ -512,3 +512,78 @@ fn specs_build_their_laws_and_read_from_case_tables() {
         serde_json::from_str(r#"{"model": "yeoh", "c10": 0.5, "c40": 1.0}"#);
     assert!(bad.unwrap_err().to_string().contains("c40"));
 }
+
+/// The tension-field relaxation of every new law: in the wrinkled regime N2 = 0, N1 the
+/// uniaxial value at the natural width, and every derivative against central differences
+/// (away from the regime's boundary, where the second derivatives jump); h = 1e-6. (The
+/// plane-stress SVK sheet has a natural width only while λ1² < 1 + 1/ν, λ2² = 1 − ν(λ1² − 1):
+/// beyond, N2 > 0 at every λ2 and the state is taut; the stretches below stay within it.)
+#[test]
+fn the_relaxation_of_every_new_law_is_tension_free_and_its_derivatives_check() {
+    use relaxed::{Regime, Relaxed};
+    for law in new_laws() {
+        let n = law.name();
+        let r = Relaxed::new(law);
+        for (l1, f) in [(1.3, 0.6), (1.6, 0.5)] {
+            let mu = r.natural_width(l1).unwrap();
+            assert!(
+                r.law.resultants(l1, mu).unwrap()[1].abs() < 1e-12,
+                "{n}: natural width"
+            );
+            let (a, b) = (l1 * l1 + (f * mu).powi(2), (l1 * f * mu).powi(2));
+            assert_eq!(r.regime(a, b).unwrap(), Regime::Wrinkled, "{n}");
+            let [n1, n2] = r.resultants(l1, f * mu).unwrap();
+            assert!(n2.abs() < 1e-12, "{n}: N2 = {n2}");
+            let w1 = r.law.principal(l1, mu).unwrap().grad[0];
+            assert!(close(n1, w1 / (f * mu), 1e-10, 0.0), "{n}: N1");
+            let h = 1e-6;
+            let d = r.derivatives(a, b).unwrap();
+            let g = |a: f64, b: f64| r.derivatives(a, b).unwrap();
+            assert!(
+                close(
+                    d.w_a,
+                    (g(a + h, b).w - g(a - h, b).w) / (2.0 * h),
+                    1e-6,
+                    1e-9
+                ),
+                "{n} W_a"
+            );
+            assert!(
+                close(
+                    d.w_b,
+                    (g(a, b + h).w - g(a, b - h).w) / (2.0 * h),
+                    1e-6,
+                    1e-9
+                ),
+                "{n} W_b"
+            );
+            assert!(
+                close(
+                    d.w_aa,
+                    (g(a + h, b).w_a - g(a - h, b).w_a) / (2.0 * h),
+                    1e-6,
+                    1e-9
+                ),
+                "{n} W_aa"
+            );
+            assert!(
+                close(
+                    d.w_ab,
+                    (g(a, b + h).w_a - g(a, b - h).w_a) / (2.0 * h),
+                    1e-6,
+                    1e-9
+                ),
+                "{n} W_ab"
+            );
+            assert!(
+                close(
+                    d.w_bb,
+                    (g(a, b + h).w_b - g(a, b - h).w_b) / (2.0 * h),
+                    1e-6,
+                    1e-9
+                ),
+                "{n} W_bb"
+            );
+        }
+    }
+}
