@@ -14,6 +14,7 @@
 //! | [`term`] | force terms: the public [`term::Term`] / [`term::ElementTerm`] interface, the membrane and contact terms |
 //! | [`model`] | the model: assembly of the terms plus the enclosed volume, loads, solves, stability, the membrane problem |
 //! | [`continuation`] | arc-length continuation with located critical points |
+//! | [`manufactured`] | code verification: manufactured solutions, their body force and their errors |
 //! | [`newton`] | a damped Newton driver that knows nothing of membranes |
 //! | [`stepping`] | load stepping with cut-back and growth |
 //! | [`post`] | mid-span values, profiles, contact values, cell values |
@@ -33,6 +34,7 @@ pub mod dofs;
 pub mod element;
 pub mod geometry;
 pub mod linsolve;
+pub mod manufactured;
 pub mod model;
 pub mod newton;
 pub mod pattern;

@@ -37,6 +37,8 @@ pub trait Real:
     fn sqrt(self) -> Self;
     fn powi(self, n: i32) -> Self;
     fn recip(self) -> Self;
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
     /// self^p for a constant p (self > 0 where p is not an integer).
     fn powf(self, p: f64) -> Self {
         (self.ln() * p).exp()
@@ -69,6 +71,12 @@ impl Real for f64 {
     }
     fn recip(self) -> Self {
         f64::recip(self)
+    }
+    fn sin(self) -> Self {
+        f64::sin(self)
+    }
+    fn cos(self) -> Self {
+        f64::cos(self)
     }
     fn powf(self, p: f64) -> Self {
         f64::powf(self, p)
@@ -232,6 +240,14 @@ impl Real for HyperDual2 {
     fn lift(self, c: f64) -> Self {
         Self::constant(c)
     }
+    fn sin(self) -> Self {
+        let (s, c) = self.re.sin_cos();
+        self.chain(s, c, -s)
+    }
+    fn cos(self) -> Self {
+        let (s, c) = self.re.sin_cos();
+        self.chain(c, -s, -c)
+    }
     fn powf(self, p: f64) -> Self {
         let x = self.re;
         let xp = x.powf(p);
@@ -257,6 +273,12 @@ impl Real for num_dual::Dual2SVec64<2> {
     }
     fn recip(self) -> Self {
         num_dual::DualNum::recip(&self)
+    }
+    fn sin(self) -> Self {
+        num_dual::DualNum::sin(&self)
+    }
+    fn cos(self) -> Self {
+        num_dual::DualNum::cos(&self)
     }
 }
 

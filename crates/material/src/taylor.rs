@@ -177,6 +177,31 @@ impl<const N: usize> Real for Jet<N> {
     fn lift(self, c: f64) -> Self {
         Self::constant(c)
     }
+    fn sin(self) -> Self {
+        self.sin_cos().0
+    }
+    fn cos(self) -> Self {
+        self.sin_cos().1
+    }
+}
+
+impl<const N: usize> Jet<N> {
+    /// (sin, cos) together: s_k = (1/k) Σ i a_i c_{k−i}, c_k = −(1/k) Σ i a_i s_{k−i}.
+    pub fn sin_cos(self) -> (Self, Self) {
+        let a = self.t;
+        let (mut s, mut c) = ([0.0; N], [0.0; N]);
+        (s[0], c[0]) = a[0].sin_cos();
+        for k in 1..N {
+            let (mut ss, mut cc) = (0.0, 0.0);
+            for i in 1..=k {
+                ss += i as f64 * a[i] * c[k - i];
+                cc += i as f64 * a[i] * s[k - i];
+            }
+            s[k] = ss / k as f64;
+            c[k] = -cc / k as f64;
+        }
+        (Self { t: s }, Self { t: c })
+    }
 }
 
 #[cfg(test)]
@@ -228,6 +253,21 @@ mod tests {
             assert!((r.t[k] - q.t[k]).abs() < 1e-15);
             let want = (-1f64).powi(k as i32) / x0.powi(k as i32 + 1);
             assert!((r.t[k] - want).abs() < 1e-14);
+        }
+        // sin²(x) + cos²(x) = 1, and the coefficients of sin at x0
+        let (sn, cs) = x.sin_cos();
+        let one = sn * sn + cs * cs;
+        assert!((one.t[0] - 1.0).abs() < 1e-15);
+        for k in 1..8 {
+            assert!(one.t[k].abs() < 1e-14);
+        }
+        let mut fact = 1.0;
+        for k in 0..8 {
+            if k > 0 {
+                fact *= k as f64;
+            }
+            let want = (x0 + k as f64 * std::f64::consts::FRAC_PI_2).sin() / fact;
+            assert!((sn.t[k] - want).abs() < 1e-14, "sin {k}");
         }
         // sqrt(x)^2 = x
         let s = x.sqrt() * x.sqrt();

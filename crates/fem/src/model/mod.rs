@@ -71,6 +71,8 @@ pub struct Model {
     law: Box<dyn MembraneLaw>,
     /// force terms added to the membrane and the contact ([`Model::add_term`])
     terms: Vec<Box<dyn Term>>,
+    /// a load magnitude applied by the added terms ([`Model::set_load_scale`]; 0: none)
+    pub(super) load_scale: f64,
     elements: Elements,
     dofs: DofMap,
     pattern: Pattern,
@@ -110,6 +112,7 @@ impl Model {
             mesh,
             law,
             terms: Vec::new(),
+            load_scale: 0.0,
             elements,
             dofs,
             pattern,
@@ -197,6 +200,15 @@ impl Model {
     /// element, after the membrane and the contact.
     pub fn add_term(&mut self, term: Box<dyn Term>) {
         self.terms.push(term);
+    }
+
+    /// The magnitude (a force norm on the free dofs, per μH) of a load an added term applies,
+    /// such as a body force: Newton measures its residual against the largest of the internal
+    /// force, the pressure load and this (0, the default, adds nothing). Without it, a load
+    /// carried by a term alone is measured against the net internal force, which vanishes at
+    /// equilibrium.
+    pub fn set_load_scale(&mut self, scale: f64) {
+        self.load_scale = scale;
     }
 
     /// The names of the added terms, in the order they are summed.

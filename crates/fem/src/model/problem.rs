@@ -8,14 +8,16 @@ use super::*;
 /// force vanishes, and a residual measured against it alone would never converge.
 pub const PRESSURE_FLOOR: f64 = 1e-6;
 
-/// The force scale the residual is measured against: the internal force, the pressure load, or
-/// the load of [`PRESSURE_FLOOR`], whichever is largest.
-pub(super) fn force_scale(a: &Assembled, p: f64) -> f64 {
+/// The force scale the residual is measured against: the internal force, the pressure load,
+/// the load of [`PRESSURE_FLOOR`], or the added terms' load ([`Model::set_load_scale`]),
+/// whichever is largest.
+pub(super) fn force_scale(a: &Assembled, p: f64, load_scale: f64) -> f64 {
     let g = norm(&a.g);
     norm(&a.f_int)
         .max(p.abs() * g)
         .max(1e-12)
         .max(PRESSURE_FLOOR * g)
+        .max(load_scale)
 }
 
 /// The total potential of the modelled part: Π = W_int + E_contact − p V_part (pressure) or
@@ -232,7 +234,7 @@ impl newton::Problem for MembraneProblem<'_> {
             }
             _ => (0.0, None),
         };
-        let reference = force_scale(&a, p);
+        let reference = force_scale(&a, p, self.model.load_scale);
         let res = norm(&r) / reference;
         self.admissible(&a, p, res)?;
         let cscale = match (self.arc, self.load.loading) {
@@ -404,7 +406,7 @@ impl newton::Problem for MembraneProblem<'_> {
             .zip(&trial.g)
             .map(|(f, g)| f - pt * g)
             .collect();
-        let reft = force_scale(&trial, pt);
+        let reft = force_scale(&trial, pt, self.model.load_scale);
         let residual = norm(&rt) / reft;
         self.admissible(&trial, pt, residual)?;
         let out = Evaluation {
