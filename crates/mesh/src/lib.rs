@@ -26,6 +26,7 @@
 pub mod file;
 pub mod hoop;
 pub mod io;
+pub mod refine;
 pub mod shape;
 pub mod tube;
 pub mod volume;

@@ -521,3 +521,41 @@ fn the_hoop_transfer_is_exact_for_fields_of_its_order() {
     off[5][2] += 0.1;
     assert!(Transfer::between(&old, &off).is_err());
 }
+
+/// Uniform refinement: a generated 4-node capped tube split in four has four times the quads,
+/// passes the mesh checks (closed but for its symmetry planes, oriented), keeps its nodes on
+/// the exact surface when the projection puts them there, and encloses a volume nearer the
+/// exact one (the polyhedron's error falls as h²).
+#[test]
+fn splitting_a_tube_refines_it_on_its_surface() {
+    use crate::refine::split;
+    let (r, h) = (1.0, 2.0);
+    let project = |p: [f64; 3]| {
+        if p[2].abs() <= h {
+            let rho = p[0].hypot(p[1]);
+            [r * p[0] / rho, r * p[1] / rho, p[2]]
+        } else {
+            let c = h * p[2].signum();
+            let d = [p[0], p[1], p[2] - c];
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            [r * d[0] / n, r * d[1] / n, c + r * d[2] / n]
+        }
+    };
+    let coarse = crate::tube::capped_tube(r, 2.0 * h, 8, 4, Symmetry::Eighth).unwrap();
+    let fine = split(&coarse, project).unwrap();
+    assert_eq!(fine.quads.len(), 4 * coarse.quads.len());
+    for p in &fine.nodes {
+        let q = project(*p);
+        assert!(
+            (0..3).all(|i| (p[i] - q[i]).abs() < 1e-14),
+            "{p:?} off the surface"
+        );
+    }
+    let exact =
+        std::f64::consts::PI * r * r * 2.0 * h + 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+    let (vc, vf) = (8.0 * coarse.volume(), 8.0 * fine.volume());
+    assert!(
+        (vf - exact).abs() < 0.3 * (vc - exact).abs(),
+        "{vc} {vf} {exact}"
+    );
+}

@@ -107,8 +107,8 @@ impl Measure {
             at_least: false,
         }
     }
-    /// A fitted or observed value against an expectation `value ± within`.
-    fn expected(label: &str, symbol: &str, found: f64, e: &suite::Expect, note: &str) -> Self {
+    /// A fitted or observed value `found` against an expectation `value ± within`.
+    pub fn expected(label: &str, symbol: &str, found: f64, e: &suite::Expect, note: &str) -> Self {
         let d = (found - e.value).abs();
         Measure {
             quantity: format!("{label}|{symbol} − {}|", e.value),

@@ -55,6 +55,8 @@ fn spec(name: &str, kind: CheckKind, case: &str) -> CheckSpec {
         gold: None,
         rel_err: None,
         abs_zero: None,
+        loading: None,
+        pressure: None,
     }
 }
 

@@ -43,6 +43,7 @@ pub enum CheckKind {
     EndEffect,
     Invariance,
     Gold,
+    Manufactured,
 }
 
 impl CheckKind {
@@ -54,6 +55,7 @@ impl CheckKind {
             CheckKind::EndEffect => "end-effect",
             CheckKind::Invariance => "invariance",
             CheckKind::Gold => "gold",
+            CheckKind::Manufactured => "manufactured",
         }
     }
 }
@@ -114,6 +116,12 @@ pub struct CheckSpec {
     pub gold: Option<String>,
     pub rel_err: Option<f64>,
     pub abs_zero: Option<f64>,
+    // manufactured
+    /// how the manufactured state is loaded besides its body force: "none", "pressure"
+    /// (default), "volume" or "gas"
+    pub loading: Option<tubemem_fem::manufactured::study::MmsLoading>,
+    /// the manufactured pressure ϖ* (default 0.4; with `loading = "none"`, 0)
+    pub pressure: Option<f64>,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -320,6 +328,22 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
             }
         }
         CheckKind::Gold => {}
+        CheckKind::Manufactured => {
+            if c.expected_order.is_none() {
+                return Err(err(
+                    "a manufactured check needs `expected_order` (the element's L2 position order: 2 for quad4, 3 for quad9)"
+                        .into(),
+                ));
+            }
+            if c.meshes.unwrap_or(4) < 3 {
+                return Err(err("`meshes` must be at least 3".into()));
+            }
+            if let Some(p) = c.pressure {
+                if !(p.is_finite() && p >= 0.0) {
+                    return Err(err(format!("`pressure` = {p} must be finite and ≥ 0")));
+                }
+            }
+        }
     }
     if let Some(e) = c.epsilon {
         if !(e.is_finite() && e > 0.0) {

@@ -46,6 +46,7 @@ mod convergence;
 mod end_effect;
 mod gold;
 mod invariance;
+mod manufactured;
 mod reference;
 
 pub use reference::REFERENCES_HOWTO;
@@ -73,6 +74,7 @@ pub fn kind_of(kind: CheckKind) -> &'static dyn VerifyKind {
         CheckKind::EndEffect => &end_effect::EndEffect,
         CheckKind::Invariance => &invariance::Invariance,
         CheckKind::Gold => &gold::Gold,
+        CheckKind::Manufactured => &manufactured::Manufactured,
     }
 }
 
