@@ -15,6 +15,8 @@
 //! | [`model`] | the model: assembly of the terms plus the enclosed volume, loads, solves, stability, the membrane problem |
 //! | [`continuation`] | arc-length continuation with located critical points |
 //! | [`manufactured`] | code verification: manufactured solutions, their body force and their errors |
+//! | [`tension_field`] | wrinkling against a closed form: the annulus pulled at both rims |
+//! | [`edge_load`] | a dead radial traction on the free edges of an open sheet |
 //! | [`newton`] | a damped Newton driver that knows nothing of membranes |
 //! | [`stepping`] | load stepping with cut-back and growth |
 //! | [`post`] | mid-span values, profiles, contact values, cell values |
@@ -31,6 +33,7 @@
 pub mod contact;
 pub mod continuation;
 pub mod dofs;
+pub mod edge_load;
 pub mod element;
 pub mod geometry;
 pub mod linsolve;
@@ -41,6 +44,7 @@ pub mod pattern;
 pub mod post;
 pub mod slide;
 pub mod stepping;
+pub mod tension_field;
 pub mod term;
 
 pub use newton::NewtonSettings;
@@ -68,6 +72,10 @@ pub enum FemError {
     DegenerateNode { element: usize, node: usize },
     #[error("the state cannot be carried to the moved mesh: {reason}")]
     Remap { reason: String },
+    /// A load or problem the model cannot take (a pressure on an open sheet, a manufactured
+    /// problem set up inconsistently).
+    #[error("{reason}")]
+    Setup { reason: String },
     #[error("the mesh cannot follow the contact edge: {reason}")]
     Refit { reason: String },
     #[error("element {element}, Gauss point {gauss_point}")]

@@ -63,6 +63,22 @@ pub trait ElementTerm: Send + Sync {
     ) -> Result<f64, FemError>;
 }
 
+/// A shared term is a term (so that its owner can change it between solves, e.g. ramp a load
+/// through an atomic scale, while the model holds it).
+impl<T: ElementTerm> ElementTerm for std::sync::Arc<T> {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+    fn add<const N: usize, const D: usize>(
+        &self,
+        el: &ElementAt<'_, N>,
+        r: &mut SVector<f64, D>,
+        k: Option<&mut SMatrix<f64, D, D>>,
+    ) -> Result<f64, FemError> {
+        (**self).add(el, r, k)
+    }
+}
+
 /// A force term as the model stores it (object safe: one method per element kind). Implement
 /// [`ElementTerm`] instead; this follows.
 pub trait Term: Send + Sync {

@@ -24,6 +24,9 @@
 
 use crate::{EnergyDerivatives, MaterialError, MembraneLaw};
 
+/// The round-off allowance on the taut cone's boundary N2 = 0 (per μH).
+pub const N2_ROUNDOFF: f64 = 1e-14;
+
 /// The tension-field relaxation of a law.
 #[derive(Debug, Clone)]
 pub struct Relaxed<L> {
@@ -70,9 +73,13 @@ impl<L: MembraneLaw> Relaxed<L> {
         if l2 > 0.0 {
             // N2 = 0 (the stress-free state C = I included) is the boundary of the taut cone,
             // where the relaxed energy is C¹: take the taut branch there, so that Newton sees
-            // the law's stiffness when it starts from the reference configuration.
+            // the law's stiffness when it starts from the reference configuration. The
+            // boundary is taken with a round-off allowance, N2 ≥ −1e-14 (per μH): a reference
+            // state's C = I computed from positions has N2 of ±1e-16, and on the slack branch
+            // such a point would have no stiffness at all (a flat sheet started from rest
+            // failed its first Newton step so).
             let [_, n2] = self.law.resultants(l1, l2)?;
-            if n2 >= 0.0 {
+            if n2 >= -N2_ROUNDOFF {
                 return Ok(Regime::Taut);
             }
         }

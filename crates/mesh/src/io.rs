@@ -126,6 +126,7 @@ pub fn read_json(path: &Path, radius: f64) -> Result<Mesh, MeshError> {
         symmetry: f.symmetry,
         plugs: f.plugs,
         mid,
+        open: false,
     };
     mesh.check()?;
     Ok(mesh)

@@ -28,6 +28,7 @@ pub mod hoop;
 pub mod io;
 pub mod refine;
 pub mod shape;
+pub mod sheet;
 pub mod tube;
 pub mod volume;
 pub mod vtu;
@@ -206,6 +207,10 @@ pub struct Mesh {
     /// centre node of each quad (see the module [`mod@crate::shape`]); empty for a bilinear mesh. The
     /// corners stay in `quads`, so every topological check reads the corners alone.
     pub mid: Vec<[usize; 5]>,
+    /// A sheet with free edges (a flat membrane, an annulus): [`Mesh::check`] does not require
+    /// it closed, and it encloses no volume (only a zero pressure loads it). False for every
+    /// tube.
+    pub open: bool,
 }
 
 /// Distance below which a node counts as lying on a symmetry plane, relative to the mesh size.
@@ -467,7 +472,7 @@ impl Mesh {
                         .plugs
                         .iter()
                         .any(|r| r.contains(&key.0) && r.contains(&key.1));
-                    if !on_sym && !on_plug {
+                    if !on_sym && !on_plug && !self.open {
                         return Err(MeshError::Open {
                             a: key.0,
                             b: key.1,
@@ -521,8 +526,9 @@ impl Mesh {
                 b: edge.1,
             });
         }
+        // a sheet encloses nothing: its normals' side is the user's to choose
         let v = self.volume();
-        if !(v > 0.0) {
+        if !self.open && !(v > 0.0) {
             return Err(MeshError::InwardNormals { volume: v });
         }
         Ok(())

@@ -72,6 +72,7 @@ pub fn split(mesh: &Mesh, project: impl Fn([f64; 3]) -> [f64; 3]) -> Result<Mesh
         symmetry: mesh.symmetry,
         plugs: vec![],
         mid: vec![],
+        open: mesh.open,
     };
     out.check()?;
     Ok(out)

@@ -415,6 +415,7 @@ fn closed_mesh(
             symmetry: Symmetry::None,
             plugs: vec![],
             mid,
+            open: false,
         },
         symmetry,
     );
@@ -495,6 +496,7 @@ fn renumber(mesh: Mesh) -> Mesh {
         quads: mesh.quads.iter().map(|q| q.map(|i| new_id[i])).collect(),
         mid: mesh.mid.iter().map(|q| q.map(|i| new_id[i])).collect(),
         symmetry: mesh.symmetry,
+        open: mesh.open,
         plugs: mesh
             .plugs
             .iter()

@@ -5,9 +5,7 @@ use super::body::{BodyForce, Manufactured};
 use super::field::Field;
 use super::surface::CappedTube;
 use crate::model::{Load, Loading, Model, State};
-use crate::term::{ElementAt, ElementTerm};
 use crate::{with_elements, FemError};
-use nalgebra::{SMatrix, SVector};
 use std::sync::Arc;
 use tubemem_material::dual::HyperDual2;
 use tubemem_material::MembraneLaw;
@@ -59,23 +57,6 @@ pub struct MmsErrors {
     pub l2_resultants: f64,
     /// the FE pressure's relative error (p_h − p*)/p* (volume and gas loadings; 0 otherwise)
     pub pressure: f64,
-}
-
-/// The term that holds a shared [`BodyForce`] (so the study can set its scale).
-struct Shared(Arc<BodyForce>);
-
-impl ElementTerm for Shared {
-    fn name(&self) -> &str {
-        self.0.name()
-    }
-    fn add<const N: usize, const D: usize>(
-        &self,
-        el: &ElementAt<'_, N>,
-        r: &mut SVector<f64, D>,
-        k: Option<&mut SMatrix<f64, D, D>>,
-    ) -> Result<f64, FemError> {
-        self.0.add(el, r, k)
-    }
 }
 
 /// The reference position of every Gauss point of every element of `model`.
@@ -205,7 +186,7 @@ pub fn solve<F: Field>(
     around: usize,
 ) -> Result<MmsErrors, FemError> {
     if loading == MmsLoading::None && problem.pressure != 0.0 {
-        return Err(FemError::Remap {
+        return Err(FemError::Setup {
             reason: format!(
                 "a manufactured problem without pressure needs its body force made with p = 0, not {}",
                 problem.pressure
@@ -220,7 +201,7 @@ pub fn solve<F: Field>(
             source,
         })?,
     );
-    model.add_term(Box::new(Shared(body.clone())));
+    model.add_term(Box::new(body.clone()));
     body.set_scale(1.0);
     model.set_load_scale(body.load_norm(&model));
     let mut state: State = model.reference_state();

@@ -80,6 +80,18 @@ impl Model {
         load: &Load,
         arc: Option<&ArcConstraint<'_>>,
     ) -> Result<newton::NewtonReport, NewtonError<FemError>> {
+        // an open sheet encloses no volume: no pressure, volume or gas acts on it
+        if self.mesh.open && load.loading != Loading::Pressure(0.0) {
+            return Err(NewtonError::Problem {
+                iteration: 0,
+                source: FemError::Setup {
+                    reason: format!(
+                        "the mesh is an open sheet, which encloses no volume: only a zero pressure loads it, not {:?}",
+                        load.loading
+                    ),
+                },
+            });
+        }
         let settings = self.settings;
         let contact = load.contact.clone();
         self.augmented(
