@@ -44,6 +44,7 @@ pub enum CheckKind {
     Invariance,
     Gold,
     Manufactured,
+    TensionField,
 }
 
 impl CheckKind {
@@ -56,6 +57,7 @@ impl CheckKind {
             CheckKind::Invariance => "invariance",
             CheckKind::Gold => "gold",
             CheckKind::Manufactured => "manufactured",
+            CheckKind::TensionField => "tension-field",
         }
     }
 }
@@ -122,6 +124,10 @@ pub struct CheckSpec {
     pub loading: Option<tubemem_fem::manufactured::study::MmsLoading>,
     /// the manufactured pressure ϖ* (default 0.4; with `loading = "none"`, 0)
     pub pressure: Option<f64>,
+    // tension-field
+    /// the annulus and its rim tractions (default R_in = 1, R_out = 4, T_in = 3e-4,
+    /// T_out = 1e-4, per μH)
+    pub annulus: Option<tubemem_fem::tension_field::Annulus>,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -201,6 +207,9 @@ pub const REFERENCE_QUANTITIES: &[&str] = &[
     "limit_max_w",
     "limit_max_lambda_s",
 ];
+/// The quantities of a tension-field check: the wrinkled radius's relative error, the
+/// resultants' L2 error over T_out against the tension-field solution and against Lamé's.
+pub const TENSION_FIELD_QUANTITIES: &[&str] = &["wrinkle_radius", "stress", "lame_stress"];
 /// Final mid-span quantities of a run (convergence, end-effect).
 pub const FINAL_QUANTITIES: &[&str] = &["w", "lambda_s", "lambda_z", "n_s", "n_z", "chi", "force"];
 
@@ -328,6 +337,43 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
             }
         }
         CheckKind::Gold => {}
+        CheckKind::TensionField => {
+            known(TENSION_FIELD_QUANTITIES, &mut c.tolerance.keys())?;
+            if c.tolerance.is_empty() {
+                return Err(err(
+                    "a tension-field check needs at least one `tolerance.<quantity>` (wrinkle_radius, stress, lame_stress)".into(),
+                ));
+            }
+            if c.meshes.unwrap_or(4) < 2 {
+                return Err(err("`meshes` must be at least 2".into()));
+            }
+            if let Some(a) = &c.annulus {
+                let ordered = a.r_in > 0.0 && a.r_out > a.r_in && a.t_in > 0.0 && a.t_out > 0.0;
+                let finite = [a.r_in, a.r_out, a.t_in, a.t_out]
+                    .iter()
+                    .all(|v| v.is_finite());
+                if !(ordered && finite) {
+                    return Err(err(
+                        "`annulus` needs 0 < r_in < r_out and tractions t_in, t_out > 0".into(),
+                    ));
+                }
+            }
+            let a = c
+                .annulus
+                .unwrap_or(super::kinds::tension_field::DEFAULT_ANNULUS);
+            if c.tolerance.contains_key("wrinkle_radius") && a.wrinkle_radius().is_none() {
+                return Err(err(format!(
+                    "this annulus has no wrinkled zone to measure (Lamé's hoop resultant at the hub is {:.3e} ≥ 0, or T_in R_in > T_out R_out and no tension field balances it): drop `tolerance.wrinkle_radius` or raise t_in",
+                    a.lame(a.r_in)[1]
+                )));
+            }
+            if !(0..=5).contains(&c.start.unwrap_or(1)) {
+                return Err(err(
+                    "`start` of a tension-field check must be 0 … 5 (8·2^start elements around)"
+                        .into(),
+                ));
+            }
+        }
         CheckKind::Manufactured => {
             if c.expected_order.is_none() {
                 return Err(err(

@@ -48,6 +48,7 @@ mod gold;
 mod invariance;
 mod manufactured;
 mod reference;
+pub(crate) mod tension_field;
 
 pub use reference::REFERENCES_HOWTO;
 
@@ -75,6 +76,7 @@ pub fn kind_of(kind: CheckKind) -> &'static dyn VerifyKind {
         CheckKind::Invariance => &invariance::Invariance,
         CheckKind::Gold => &gold::Gold,
         CheckKind::Manufactured => &manufactured::Manufactured,
+        CheckKind::TensionField => &tension_field::TensionField,
     }
 }
 
