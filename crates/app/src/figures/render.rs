@@ -263,7 +263,10 @@ pub(crate) fn rasterize(svg: &str, dpi: f64, path: &Path) -> Result<Vec<u8>> {
         font_family: FONT_FAMILY.to_string(),
         ..Default::default()
     };
-    let tree = resvg::usvg::Tree::from_str(svg, &opt).map_err(|e| err(e.to_string()))?;
+    // the bundled DejaVu Sans has no mathematical script letters (the ABB law's 𝒩 drew as a
+    // box): the PNG spells it N; the SVG keeps 𝒩 for viewers with a fuller font
+    let svg = svg.replace('𝒩', "N");
+    let tree = resvg::usvg::Tree::from_str(&svg, &opt).map_err(|e| err(e.to_string()))?;
     let scale = (dpi / BASE_DPI) as f32;
     let size = tree
         .size()

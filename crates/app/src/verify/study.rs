@@ -57,6 +57,7 @@ fn spec(name: &str, kind: CheckKind, case: &str) -> CheckSpec {
         abs_zero: None,
         loading: None,
         pressure: None,
+        plates: None,
         annulus: None,
     }
 }

@@ -124,6 +124,9 @@ pub struct CheckSpec {
     pub loading: Option<tubemem_fem::manufactured::study::MmsLoading>,
     /// the manufactured pressure ϖ* (default 0.4; with `loading = "none"`, 0)
     pub pressure: Option<f64>,
+    /// the contact variant: the manufactured state squeezed between the plates y = ±1.15 R,
+    /// which must supply a manufactured contact pressure where it lies on them (default false)
+    pub plates: Option<bool>,
     // tension-field
     /// the annulus and its rim tractions (default R_in = 1, R_out = 4, T_in = 3e-4,
     /// T_out = 1e-4, per μH)

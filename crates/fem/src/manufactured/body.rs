@@ -7,7 +7,9 @@
 //! C_{αβ}, the invariants a = G^{αβ} C_{αβ}, b = det C_{αβ}/det G_{αβ}, the law's W_a, W_b
 //! (whose ξ-derivatives are W_aa a' + W_ab b' and W_ab a' + W_bb b', from the law's own second
 //! derivatives), S^{αβ}, and Q^β = √G S^{αβ} x_{,α}; then b = −(1/√G) Σ_β ∂_β Q^β − p n_A with
-//! n_A = (x_{,1} × x_{,2})/√G.
+//! n_A = (x_{,1} × x_{,2})/√G. A field pressed against planes ([`Field::contact_traction`])
+//! has the planes' traction t_c removed too (b − t_c: the body force and the planes together
+//! hold x*).
 
 use super::field::Field;
 use super::surface::CappedTube;
@@ -139,8 +141,10 @@ pub struct Exact {
     pub x: [f64; 3],
     /// the principal Cauchy resultants N1 ≥ N2 (per μH)
     pub resultants: [f64; 2],
-    /// the body force per reference area (with the pressure's share removed)
+    /// the body force per reference area (with the pressure's and the planes' shares removed)
     pub body_force: [f64; 3],
+    /// the traction the planes supply per reference area
+    pub contact: [f64; 3],
 }
 
 /// The manufactured problem: a field on the exact capped tube, a law and a pressure.
@@ -226,14 +230,16 @@ impl<F: Field> Manufactured<'_, F> {
             }
         }
         let n = cross(fx.t[0], fx.t[1]);
+        let contact = self.field.contact_traction(gx.x);
         let body_force: [f64; 3] =
-            std::array::from_fn(|i| -div[i] / sg.v - self.pressure * n[i] / sg.v);
+            std::array::from_fn(|i| -div[i] / sg.v - self.pressure * n[i] / sg.v - contact[i]);
         let (l1, l2) = principal(a.v, b.v);
         let r = self.law.resultants(l1.sqrt(), l2.sqrt())?;
         Ok(Exact {
             x: fx.x,
             resultants: [r[0].max(r[1]), r[0].min(r[1])],
             body_force,
+            contact,
         })
     }
 }

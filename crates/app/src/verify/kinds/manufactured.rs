@@ -7,7 +7,11 @@
 //! manufactured problem (`loading`, `pressure`). Measured: the position error in L2 (held to
 //! `expected_order` on the finest two ratios), in L∞ at the Gauss points and the nodes, and
 //! the resultants' L2 error (their orders reported), and the pressure where the loading finds
-//! one.
+//! one. With `plates = true` the state is squeezed between the plates y = ±1.15 R
+//! ([`Pressed`]): the FE must find the contact zone and the manufactured contact pressure with
+//! its augmented Lagrangian at the nodes; the contact pressure's L2 order and the largest
+//! penetration are reported too. Its families need finer meshes (32 to 256 around; measured in
+//! crates/fem/tests/manufactured.rs).
 
 use super::{plot, KindResult, COLORS};
 use crate::case::Case;
@@ -15,8 +19,9 @@ use crate::figures::{Figure, Series, Stroke};
 use crate::verify::suite::Check;
 use crate::verify::{vary, CheckResult, Measure, VerifyOptions};
 use std::path::Path;
+use tubemem_fem::contact::ContactPoints;
 use tubemem_fem::manufactured::body::Manufactured as Problem;
-use tubemem_fem::manufactured::field::TubeField;
+use tubemem_fem::manufactured::field::{Field, Pressed, TubeField};
 use tubemem_fem::manufactured::study::{order, solve, MmsErrors, MmsLoading};
 use tubemem_fem::manufactured::surface::CappedTube;
 use tubemem_fem::model::Model;
@@ -27,6 +32,9 @@ kind!(
     "manufactured",
     manufactured
 );
+
+/// One error measure of a family member.
+type Metric = fn(&MmsErrors) -> f64;
 
 /// The manufactured pressure when the check names none.
 const DEFAULT_PRESSURE: f64 = 0.4;
@@ -83,6 +91,39 @@ fn family(c: &Check, case: &Case, n: usize) -> Result<Vec<(usize, tubemem_mesh::
         .collect()
 }
 
+/// The manufactured problem of `field` solved on every mesh of the family; a field pressed
+/// against planes is held by the FE's contact at the nodes (the augmented Lagrangian of
+/// [`tubemem_fem::manufactured::study`]; the case's `[contact]` is not used).
+fn solve_family<F: Field>(
+    field: &F,
+    case: &Case,
+    law: &dyn tubemem_material::MembraneLaw,
+    build: &dyn Fn() -> Result<Box<dyn tubemem_material::MembraneLaw>, String>,
+    pressure: f64,
+    loading: MmsLoading,
+    meshes: Vec<(usize, tubemem_mesh::Mesh)>,
+) -> Result<Vec<MmsErrors>, String> {
+    let problem = Problem {
+        field,
+        surface: surface(case),
+        law,
+        pressure,
+    };
+    let points = if field.planes().is_empty() {
+        ContactPoints::Gauss
+    } else {
+        ContactPoints::Nodal
+    };
+    meshes
+        .into_iter()
+        .map(|(around, mesh)| {
+            let model = Model::new(mesh, build()?).map_err(|e| crate::error_chain(&e))?;
+            solve(model, &problem, loading, around, points)
+                .map_err(|e| format!("mesh {around}: {}", crate::error_chain(&e)))
+        })
+        .collect()
+}
+
 fn surface(case: &Case) -> CappedTube {
     CappedTube {
         radius: case.geometry.radius,
@@ -105,22 +146,33 @@ fn manufactured(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResul
     };
     let wrinkling = case.solver.wrinkling;
     let law = case.material.build_with(wrinkling).map_err(err)?;
-    let field = TubeField::standard(case.geometry.radius, case.geometry.length);
-    let problem = Problem {
-        field: &field,
-        surface: surface(&case),
-        law: law.as_ref(),
-        pressure,
-    };
     let meshes = family(c, &case, n)?;
-    let mut rows: Vec<MmsErrors> = vec![];
-    for (around, mesh) in meshes {
-        let model = Model::new(mesh, case.material.build_with(wrinkling).map_err(err)?)
-            .map_err(|e| crate::error_chain(&e))?;
-        let e = solve(model, &problem, loading, around)
-            .map_err(|e| format!("mesh {around}: {}", crate::error_chain(&e)))?;
-        rows.push(e);
-    }
+    let build = || case.material.build_with(wrinkling).map_err(err);
+    let (rows, field_name) = if c.spec.plates.unwrap_or(false) {
+        let field = Pressed::standard(case.geometry.radius, case.geometry.length);
+        let rows = solve_family(
+            &field,
+            &case,
+            law.as_ref(),
+            &build,
+            pressure,
+            loading,
+            meshes,
+        )?;
+        (rows, field.name())
+    } else {
+        let field = TubeField::standard(case.geometry.radius, case.geometry.length);
+        let rows = solve_family(
+            &field,
+            &case,
+            law.as_ref(),
+            &build,
+            pressure,
+            loading,
+            meshes,
+        )?;
+        (rows, field.name())
+    };
     let k = rows.len();
     let ord = |m: fn(&MmsErrors) -> f64| -> [f64; 2] {
         [
@@ -141,7 +193,7 @@ fn manufactured(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResul
     let expected = c.spec.expected_order.as_ref().ok_or("no expected_order")?;
     for (i, o) in ord(|e| e.l2_position).iter().enumerate() {
         r.measures.push(Measure::expected(
-            &format!("L2 position order, meshes {}–{}", k - 2 + i, k - 1 + i),
+            &format!("L2 position order, meshes {}–{}: ", k - 2 + i, k - 1 + i),
             "p",
             *o,
             expected,
@@ -169,6 +221,19 @@ fn manufactured(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResul
         last.l2_position,
         format!("{} equations", last.equations),
     ));
+    if c.spec.plates.unwrap_or(false) {
+        let o = ord(|e| e.l2_contact);
+        r.measures.push(Measure::reported(
+            "contact pressure L2 order",
+            o[1],
+            format!("finest two ratios {:.2}, {:.2}", o[0], o[1]),
+        ));
+        r.measures.push(Measure::reported(
+            "contact pressure L2 error / max q*, finest mesh",
+            last.l2_contact,
+            format!("largest penetration {:.1e} R", last.penetration),
+        ));
+    }
     if matches!(loading, MmsLoading::Volume | MmsLoading::Gas) {
         r.measures.push(Measure::reported(
             "pressure error, finest mesh",
@@ -177,33 +242,34 @@ fn manufactured(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResul
         ));
     }
     r.details = serde_json::json!({
-        "field": tubemem_fem::manufactured::field::Field::name(&field),
+        "field": field_name,
         "law": law.name(),
         "loading": loading.label(),
         "pressure": pressure,
         "meshes": rows,
     });
-    let series: Vec<Series> = [
-        (
-            "L2 position",
-            (|e: &MmsErrors| e.l2_position) as fn(&MmsErrors) -> f64,
-        ),
+    let mut measured: Vec<(&str, Metric)> = vec![
+        ("L2 position", |e| e.l2_position),
         ("L∞ position", |e| e.max_position),
         ("L2 resultants", |e| e.l2_resultants),
-    ]
-    .iter()
-    .enumerate()
-    .map(|(i, (label, m))| Series {
-        label: label.to_string(),
-        points: rows
-            .iter()
-            .map(|e| ((e.around as f64).log10(), m(e).log10()))
-            .collect(),
-        color: COLORS[i % COLORS.len()],
-        stroke: Stroke::Solid,
-        width: 2,
-    })
-    .collect();
+    ];
+    if c.spec.plates.unwrap_or(false) {
+        measured.push(("L2 contact pressure", |e| e.l2_contact));
+    }
+    let series: Vec<Series> = measured
+        .iter()
+        .enumerate()
+        .map(|(i, (label, m))| Series {
+            label: label.to_string(),
+            points: rows
+                .iter()
+                .map(|e| ((e.around as f64).log10(), m(e).log10()))
+                .collect(),
+            color: COLORS[i % COLORS.len()],
+            stroke: Stroke::Solid,
+            width: 2,
+        })
+        .collect();
     let _ = dir;
     plot(
         &Figure {
