@@ -91,37 +91,45 @@ fn family(c: &Check, case: &Case, n: usize) -> Result<Vec<(usize, tubemem_mesh::
         .collect()
 }
 
-/// The manufactured problem of `field` solved on every mesh of the family; a field pressed
-/// against planes is held by the FE's contact at the nodes (the augmented Lagrangian of
-/// [`tubemem_fem::manufactured::study`]; the case's `[contact]` is not used).
-fn solve_family<F: Field>(
-    field: &F,
-    case: &Case,
-    law: &dyn tubemem_material::MembraneLaw,
-    build: &dyn Fn() -> Result<Box<dyn tubemem_material::MembraneLaw>, String>,
+/// What a family's solve needs besides its field.
+struct FamilySolve<'a> {
+    case: &'a Case,
+    law: &'a dyn tubemem_material::MembraneLaw,
+    build: &'a dyn Fn() -> Result<Box<dyn tubemem_material::MembraneLaw>, String>,
     pressure: f64,
     loading: MmsLoading,
     meshes: Vec<(usize, tubemem_mesh::Mesh)>,
-) -> Result<Vec<MmsErrors>, String> {
-    let problem = Problem {
-        field,
-        surface: surface(case),
-        law,
-        pressure,
-    };
-    let points = if field.planes().is_empty() {
-        ContactPoints::Gauss
-    } else {
-        ContactPoints::Nodal
-    };
-    meshes
-        .into_iter()
-        .map(|(around, mesh)| {
-            let model = Model::new(mesh, build()?).map_err(|e| crate::error_chain(&e))?;
-            solve(model, &problem, loading, around, points)
-                .map_err(|e| format!("mesh {around}: {}", crate::error_chain(&e)))
-        })
-        .collect()
+}
+
+impl FamilySolve<'_> {
+    /// The manufactured problem of `field` solved on every mesh of the family, and the field's
+    /// name; a field pressed against planes is held by the FE's contact at the nodes (the
+    /// augmented Lagrangian of [`tubemem_fem::manufactured::study`]; the case's `[contact]` is
+    /// not used).
+    fn solve<F: Field>(self, field: &F) -> Result<(Vec<MmsErrors>, String), String> {
+        let problem = Problem {
+            field,
+            surface: surface(self.case),
+            law: self.law,
+            pressure: self.pressure,
+        };
+        let points = if field.planes().is_empty() {
+            ContactPoints::Gauss
+        } else {
+            ContactPoints::Nodal
+        };
+        let rows = self
+            .meshes
+            .into_iter()
+            .map(|(around, mesh)| {
+                let model =
+                    Model::new(mesh, (self.build)()?).map_err(|e| crate::error_chain(&e))?;
+                solve(model, &problem, self.loading, around, points)
+                    .map_err(|e| format!("mesh {around}: {}", crate::error_chain(&e)))
+            })
+            .collect::<Result<_, String>>()?;
+        Ok((rows, field.name()))
+    }
 }
 
 fn surface(case: &Case) -> CappedTube {
@@ -146,32 +154,20 @@ fn manufactured(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResul
     };
     let wrinkling = case.solver.wrinkling;
     let law = case.material.build_with(wrinkling).map_err(err)?;
-    let meshes = family(c, &case, n)?;
     let build = || case.material.build_with(wrinkling).map_err(err);
+    let family = FamilySolve {
+        case: &case,
+        law: law.as_ref(),
+        build: &build,
+        pressure,
+        loading,
+        meshes: family(c, &case, n)?,
+    };
+    let (radius, length) = (case.geometry.radius, case.geometry.length);
     let (rows, field_name) = if c.spec.plates.unwrap_or(false) {
-        let field = Pressed::standard(case.geometry.radius, case.geometry.length);
-        let rows = solve_family(
-            &field,
-            &case,
-            law.as_ref(),
-            &build,
-            pressure,
-            loading,
-            meshes,
-        )?;
-        (rows, field.name())
+        family.solve(&Pressed::standard(radius, length))?
     } else {
-        let field = TubeField::standard(case.geometry.radius, case.geometry.length);
-        let rows = solve_family(
-            &field,
-            &case,
-            law.as_ref(),
-            &build,
-            pressure,
-            loading,
-            meshes,
-        )?;
-        (rows, field.name())
+        family.solve(&TubeField::standard(radius, length))?
     };
     let k = rows.len();
     let ord = |m: fn(&MmsErrors) -> f64| -> [f64; 2] {
