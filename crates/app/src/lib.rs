@@ -24,6 +24,7 @@
 //!
 //! Errors are typed ([`AppError`], [`case::CaseError`]) and keep their cause as `source()`.
 
+pub mod atlas;
 pub mod case;
 pub mod checkpoint;
 pub mod curves;

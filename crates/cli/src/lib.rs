@@ -2,6 +2,7 @@
 //! lines, over the application layer `tubemem_app` (which owns cases, runs, outputs and
 //! figures). Errors are `anyhow` chains whose outer context names the stage, step, key or file.
 
+pub mod atlas_cmd;
 pub mod console;
 pub mod fit_cmd;
 pub mod gps_cmd;

@@ -67,6 +67,11 @@ enum Command {
     /// report.md, report.html and junit.xml. Exit code 0: all passed; 1: a check failed; 2: a
     /// usage or setup error.
     Verify(tubemem_cli::verify_cmd::VerifyArgs),
+    /// Where GPS holds: run an atlas file (one FE run per λs* and L/R), fit the end-effect law
+    /// per (λs*, ρ, quantity) and write the minimum L/R per ε (atlas.csv) with its maps;
+    /// `tubemem atlas predict DIR …` prints the laws' prediction at a point. Exit code 0:
+    /// written; 1: member runs failed (kept as errors); 2: a usage or setup error.
+    Atlas(tubemem_cli::atlas_cmd::AtlasArgs),
     /// Write the case's model (mesh, symmetry conditions, neo-Hookean or Mooney–Rivlin
     /// material, follower pressure and load steps) as an input deck of another code, to run the
     /// identical model there. Squeeze, confine and arc-length stages and the ABB law are refused
@@ -277,6 +282,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => main_job(),
         Some(Command::Verify(_)) => anyhow::bail!("internal: `verify` is dispatched in main"),
+        Some(Command::Atlas(_)) => anyhow::bail!("internal: `atlas` is dispatched in main"),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Fit(a)) => tubemem_cli::fit_cmd::run(a),
         Some(Command::Run {
@@ -352,6 +358,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(Command::Verify(a)) = cli.command {
         return ExitCode::from(tubemem_cli::verify_cmd::run(a));
+    }
+    if let Some(Command::Atlas(a)) = cli.command {
+        return ExitCode::from(tubemem_cli::atlas_cmd::run(a));
     }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

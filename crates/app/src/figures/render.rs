@@ -49,17 +49,39 @@ pub(super) fn draw_series<'a, 'b: 'a>(
     err: &dyn Fn(String) -> AppError,
 ) -> Result<()> {
     let style = s.color.stroke_width(s.width);
+    // a non-finite point breaks the curve (a contour's separate pieces): each run of finite
+    // points is drawn on its own, the legend entry once
+    let mut runs: Vec<&[(f64, f64)]> = s
+        .points
+        .split(|p| !(p.0.is_finite() && p.1.is_finite()))
+        .filter(|r| !r.is_empty())
+        .collect();
+    if runs.is_empty() {
+        runs.push(&[]);
+    }
+    // the later pieces without a legend entry (plotters lists labelled series only)
+    for r in &runs[1..] {
+        match stroke_pattern(s.stroke) {
+            Some((dash, gap)) => chart
+                .draw_series(DashedLineSeries::new(r.iter().copied(), dash, gap, style))
+                .map(|_| ()),
+            None => chart
+                .draw_series(LineSeries::new(r.iter().copied(), style))
+                .map(|_| ()),
+        }
+        .map_err(|e| err(e.to_string()))?;
+    }
     let anno = match stroke_pattern(s.stroke) {
         Some((dash, gap)) => chart
             .draw_series(DashedLineSeries::new(
-                s.points.iter().copied(),
+                runs[0].iter().copied(),
                 dash,
                 gap,
                 style,
             ))
             .map_err(|e| err(e.to_string()))?,
         None => chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), style))
+            .draw_series(LineSeries::new(runs[0].iter().copied(), style))
             .map_err(|e| err(e.to_string()))?,
     };
     let pattern = stroke_pattern(s.stroke);

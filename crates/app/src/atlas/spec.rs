@@ -1,0 +1,413 @@
+//! The atlas file: a case template (every table of a case file except `[[stage]]`) and an
+//! `[atlas]` table naming the grid. Read and validated whole before any run starts; each member
+//! case is built and parsed here too, so a template the case reader refuses fails the atlas at
+//! once, naming the member.
+
+use super::AtlasError;
+use crate::case::Case;
+use crate::verify::stats::EndLaw;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The quantities an atlas can fit: the mid-span FE against the GPS flattening at the same ρ.
+pub const QUANTITIES: [&str; 5] = ["w", "force", "chi", "lambda_s", "lambda_z"];
+
+/// The `[atlas]` table.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AtlasSpec {
+    /// the mid-span hoop stretches λs* the tube is inflated to (each a member family)
+    pub stretches: Vec<f64>,
+    /// the half-gaps ρ = r/R along each squeeze path at which the errors are taken and fitted;
+    /// each is the end of a squeeze stage, so the FE lands on it exactly
+    pub rho: Vec<f64>,
+    /// the tube lengths L/R run for each λs* (at least three: c, A and a residual)
+    pub lengths: Vec<f64>,
+    /// elements along per R of tube length (`[mesh] along` = this × L/R, rounded up to even)
+    pub along_per_radius: f64,
+    /// the tolerances ε on |FE/GPS − 1|'s end effect for which the minimum L/R is reported
+    #[serde(default = "default_epsilon")]
+    pub epsilon: Vec<f64>,
+    /// the quantities fitted (default all five: w, force, chi, lambda_s, lambda_z)
+    #[serde(default = "default_quantities")]
+    pub quantities: Vec<String>,
+    /// the end-effect law; default from the physics of the stage: the gas-closed squeeze's
+    /// error falls as 1/(L/R) (the caps keep gas the plates do not squeeze), "inverse"
+    #[serde(default = "default_law")]
+    pub law: EndLaw,
+    /// the largest relative rms residual of a fit before its point is flagged
+    #[serde(default = "default_max_residual")]
+    pub max_residual: f64,
+    /// the largest step in ρ within a squeeze stage
+    #[serde(default = "default_rho_step")]
+    pub rho_step: f64,
+    /// the plane-strain map (closed forms only): its λs* and ρ ranges and points per axis
+    #[serde(default)]
+    pub ps_map: PsMapSpec,
+    /// keys added to the generated inflate stage (default: control = "volume", steps = 6)
+    #[serde(default)]
+    pub inflate: toml::Table,
+    /// keys added to every generated squeeze stage (contact_method, gap_tolerance, …)
+    #[serde(default)]
+    pub squeeze: toml::Table,
+}
+
+/// `[atlas.ps_map]`: the grid of the closed-form map of |PS/GPS − 1|.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PsMapSpec {
+    /// [low, high] λs* (default: the atlas's stretches' range, widened to [1.05, …] at least)
+    pub stretches: Option<[f64; 2]>,
+    /// [low, high] ρ (default: the lowest ρ of the atlas to the highest λs*)
+    pub rho: Option<[f64; 2]>,
+    /// points per axis (default 41)
+    pub points: Option<usize>,
+}
+
+fn default_epsilon() -> Vec<f64> {
+    vec![1e-2, 1e-3]
+}
+fn default_quantities() -> Vec<String> {
+    QUANTITIES.iter().map(|s| s.to_string()).collect()
+}
+fn default_law() -> EndLaw {
+    EndLaw::Inverse
+}
+/// The bound the verify suites hold an end-effect fit to (the paper suite's squeeze fits have
+/// 0.005–0.007, the inflation's exponential 6e-4: a tenfold margin over the worst).
+fn default_max_residual() -> f64 {
+    0.05
+}
+fn default_rho_step() -> f64 {
+    0.05
+}
+
+/// One FE run of the atlas: a λs* and a length.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Member {
+    /// its folder under `runs/`: `ls<λs*>_lr<L/R>`
+    pub name: String,
+    pub stretch: f64,
+    pub length: f64,
+    /// the case file it runs (written as `runs/<name>/case.toml`)
+    pub case_text: String,
+}
+
+/// A validated atlas.
+#[derive(Clone, Debug)]
+pub struct Atlas {
+    pub spec: AtlasSpec,
+    /// the case template: the atlas file without `[atlas]`
+    pub template: toml::Table,
+    /// where relative paths of the template (a user mesh) are resolved
+    pub base_dir: PathBuf,
+    /// every run, λs* outer, length inner
+    pub members: Vec<Member>,
+    /// the law of the template's [material]
+    pub material: tubemem_material::MaterialSpec,
+}
+
+fn bad(key: &str, message: impl Into<String>) -> AtlasError {
+    AtlasError::Invalid {
+        key: key.to_string(),
+        message: message.into(),
+    }
+}
+
+/// A name part for a number: 1.3 → "1.3", 40 → "40".
+fn tag(v: f64) -> String {
+    format!("{v}")
+}
+
+impl Atlas {
+    /// Read and validate an atlas file.
+    pub fn read(path: &Path) -> Result<Self, AtlasError> {
+        let text = std::fs::read_to_string(path).map_err(|source| AtlasError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let base = path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        Self::parse(&text, &base)
+    }
+
+    /// Validate an atlas given as text; relative paths resolve against `base_dir`.
+    pub fn parse(text: &str, base_dir: &Path) -> Result<Self, AtlasError> {
+        #[derive(Deserialize)]
+        struct Only {
+            atlas: Option<AtlasSpec>,
+        }
+        // the [atlas] table typed (an unknown or mistyped key is named with its line)
+        let only: Only = toml::from_str(text).map_err(AtlasError::Syntax)?;
+        let spec = only.atlas.ok_or_else(|| {
+            bad(
+                "atlas",
+                "the file has no [atlas] table (stretches, rho, lengths, along_per_radius)",
+            )
+        })?;
+        let mut template: toml::Table = toml::from_str(text).map_err(AtlasError::Syntax)?;
+        template.remove("atlas");
+        if template.contains_key("stage") {
+            return Err(bad(
+                "stage",
+                "an atlas makes its own stages (inflate to each λs*, squeeze through each ρ): remove the [[stage]] tables and put stage keys in [atlas.inflate] or [atlas.squeeze]",
+            ));
+        }
+        check(&spec, &template)?;
+        let mut members = vec![];
+        let mut material = None;
+        for &s in &spec.stretches {
+            for &l in &spec.lengths {
+                let name = format!("ls{}_lr{}", tag(s), tag(l));
+                let case_text = member_case(&spec, &template, s, l)?;
+                // the member case as the case reader sees it: refused here, before any run
+                let case = Case::parse(&case_text).map_err(|source| AtlasError::Member {
+                    member: name.clone(),
+                    source,
+                })?;
+                material.get_or_insert(case.material);
+                members.push(Member {
+                    name,
+                    stretch: s,
+                    length: l,
+                    case_text,
+                });
+            }
+        }
+        Ok(Atlas {
+            spec,
+            template,
+            base_dir: base_dir.to_path_buf(),
+            members,
+            material: material.expect("at least one member (stretches and lengths are not empty)"),
+        })
+    }
+
+    /// The ρ levels below λs* (the squeeze's stage ends), highest first.
+    pub fn levels(&self, stretch: f64) -> Vec<f64> {
+        levels(&self.spec, stretch)
+    }
+
+    /// The case file of one member ([`member_case`]).
+    pub fn member_case(&self, stretch: f64, length: f64) -> Result<String, AtlasError> {
+        member_case(&self.spec, &self.template, stretch, length)
+    }
+}
+
+/// The ρ levels of `spec` below λs*, highest first.
+pub fn levels(spec: &AtlasSpec, stretch: f64) -> Vec<f64> {
+    let mut r: Vec<f64> = spec.rho.iter().copied().filter(|&r| r < stretch).collect();
+    r.sort_by(|a, b| b.total_cmp(a));
+    r
+}
+
+/// The case file of one member: the template at length L/R (along ∝ L), inflated to λs*,
+/// then one squeeze stage per ρ level, each in steps of at most `rho_step`.
+pub fn member_case(
+    spec: &AtlasSpec,
+    template: &toml::Table,
+    stretch: f64,
+    length: f64,
+) -> Result<String, AtlasError> {
+    let mut t = template.clone();
+    let geometry = t
+        .entry("geometry")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+        .as_table_mut()
+        .ok_or_else(|| bad("geometry", "must be a table"))?;
+    let radius = match geometry.get("radius") {
+        None => 1.0,
+        Some(v) => v
+            .as_float()
+            .or(v.as_integer().map(|i| i as f64))
+            .ok_or_else(|| bad("geometry.radius", "must be a number"))?,
+    };
+    if geometry.contains_key("length") {
+        return Err(bad(
+            "geometry.length",
+            "an atlas sets the length from [atlas] lengths: remove it",
+        ));
+    }
+    geometry.insert("length".into(), toml::Value::Float(length * radius));
+    let mesh = t
+        .entry("mesh")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+        .as_table_mut()
+        .ok_or_else(|| bad("mesh", "must be a table"))?;
+    if mesh.contains_key("along") {
+        return Err(bad(
+            "mesh.along",
+            "an atlas sets the elements along from [atlas] along_per_radius: remove it",
+        ));
+    }
+    let along = (spec.along_per_radius * length).ceil() as i64;
+    mesh.insert("along".into(), toml::Value::Integer(along + along % 2));
+    // lean member folders: no VTU unless the template asks, no checkpoints
+    let output = t
+        .entry("output")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let Some(o) = output.as_table_mut() {
+        o.entry("vtu")
+            .or_insert_with(|| toml::Value::String("none".into()));
+    }
+    let solver = t
+        .entry("solver")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let Some(s) = solver.as_table_mut() {
+        s.entry("checkpoint_every")
+            .or_insert(toml::Value::Integer(0));
+    }
+    let mut stages = vec![];
+    let mut inflate = toml::Table::new();
+    inflate.insert("kind".into(), "inflate".into());
+    inflate.insert("control".into(), "volume".into());
+    inflate.insert("steps".into(), toml::Value::Integer(6));
+    inflate.extend(spec.inflate.clone());
+    inflate.insert("target_stretch".into(), toml::Value::Float(stretch));
+    stages.push(toml::Value::Table(inflate));
+    // the plates start at the tube's half-height (≥ λs*: the cap junction can stand out)
+    let mut from = stretch;
+    for rho in levels(spec, stretch) {
+        let mut s = toml::Table::new();
+        s.insert("kind".into(), "squeeze".into());
+        s.extend(spec.squeeze.clone());
+        s.insert("target_rho".into(), toml::Value::Float(rho));
+        let n = ((from - rho) / spec.rho_step).ceil().max(1.0) as i64;
+        s.insert("steps".into(), toml::Value::Integer(n));
+        stages.push(toml::Value::Table(s));
+        from = rho;
+    }
+    t.insert("stage".into(), toml::Value::Array(stages));
+    toml::to_string(&t).map_err(|e| bad("atlas", format!("the member case cannot be written: {e}")))
+}
+
+fn check(s: &AtlasSpec, template: &toml::Table) -> Result<(), AtlasError> {
+    let positive = |key: &str, v: &[f64]| -> Result<(), AtlasError> {
+        if v.is_empty() {
+            return Err(bad(key, "is empty"));
+        }
+        if let Some(x) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+            return Err(bad(key, format!("{x} is not a positive number")));
+        }
+        let mut sorted = v.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        if sorted.windows(2).any(|w| w[0] == w[1]) {
+            return Err(bad(key, "has a repeated value"));
+        }
+        Ok(())
+    };
+    positive("atlas.stretches", &s.stretches)?;
+    if let Some(x) = s.stretches.iter().find(|x| **x <= 1.0) {
+        return Err(bad(
+            "atlas.stretches",
+            format!("λs* = {x}: an inflated tube has λs* > 1"),
+        ));
+    }
+    positive("atlas.rho", &s.rho)?;
+    positive("atlas.lengths", &s.lengths)?;
+    if s.lengths.len() < 3 {
+        return Err(bad(
+            "atlas.lengths",
+            format!(
+                "{} lengths: the end-effect law has two coefficients and needs a third length for its residual",
+                s.lengths.len()
+            ),
+        ));
+    }
+    positive("atlas.epsilon", &s.epsilon)?;
+    if !(s.along_per_radius.is_finite() && s.along_per_radius > 0.0) {
+        return Err(bad(
+            "atlas.along_per_radius",
+            format!("{} is not a positive number", s.along_per_radius),
+        ));
+    }
+    if !(s.rho_step.is_finite() && s.rho_step > 0.0) {
+        return Err(bad(
+            "atlas.rho_step",
+            format!("{} is not a positive number", s.rho_step),
+        ));
+    }
+    if !(s.max_residual.is_finite() && s.max_residual > 0.0) {
+        return Err(bad(
+            "atlas.max_residual",
+            format!("{} is not a positive number", s.max_residual),
+        ));
+    }
+    if s.quantities.is_empty() {
+        return Err(bad("atlas.quantities", "is empty"));
+    }
+    if let Some(q) = s
+        .quantities
+        .iter()
+        .find(|q| !QUANTITIES.contains(&q.as_str()))
+    {
+        return Err(bad(
+            "atlas.quantities",
+            format!("{q:?} is not one of {}", QUANTITIES.join(", ")),
+        ));
+    }
+    for &st in &s.stretches {
+        if !s.rho.iter().any(|&r| r < st) {
+            return Err(bad(
+                "atlas.rho",
+                format!("no level is below λs* = {st}: the plates would not touch the tube"),
+            ));
+        }
+    }
+    if let Some(n) = s.ps_map.points {
+        if !(3..=400).contains(&n) {
+            return Err(bad("atlas.ps_map.points", format!("{n} is outside 3–400")));
+        }
+    }
+    for (key, r) in [
+        ("atlas.ps_map.stretches", s.ps_map.stretches),
+        ("atlas.ps_map.rho", s.ps_map.rho),
+    ] {
+        if let Some([a, b]) = r {
+            if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
+                return Err(bad(
+                    key,
+                    format!("[{a}, {b}] must be two increasing positive numbers"),
+                ));
+            }
+        }
+    }
+    if let Some([a, _]) = s.ps_map.stretches {
+        if a <= 1.0 {
+            return Err(bad(
+                "atlas.ps_map.stretches",
+                format!("λs* = {a}: an inflated tube has λs* > 1"),
+            ));
+        }
+    }
+    for key in [
+        "kind",
+        "target_stretch",
+        "target_pressure",
+        "target_volume_ratio",
+    ] {
+        if s.inflate.contains_key(key) {
+            return Err(bad(
+                &format!("atlas.inflate.{key}"),
+                "is set by the atlas (an inflate stage to each λs*)",
+            ));
+        }
+    }
+    for key in ["kind", "target_rho", "steps", "plane"] {
+        if s.squeeze.contains_key(key) {
+            return Err(bad(
+                &format!("atlas.squeeze.{key}"),
+                "is set by the atlas (a squeeze stage to each ρ, steps from rho_step)",
+            ));
+        }
+    }
+    if template.get("mesh").and_then(|m| m.get("file")).is_some() {
+        return Err(bad(
+            "mesh.file",
+            "an atlas builds its tubes (a user mesh has one length)",
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,289 @@
+//! The atlas (`tubemem_app::atlas`): atlas/ci.toml run, its inverse laws held against FE runs at
+//! lengths the atlas did not use, its coefficient against the README's direct L/R study, the
+//! plane-strain map against the closed form, resume, failed members and bad files.
+
+use std::path::{Path, PathBuf};
+use tubemem_app::atlas::{self, member, Atlas, Member, MemberResult};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tubemem-atlas-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn ci_atlas() -> (Atlas, String) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../atlas/ci.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    (Atlas::read(&path).unwrap(), text)
+}
+
+/// One FE run of the atlas's tube at a length of our choosing.
+fn run_at(atlas: &Atlas, stretch: f64, length: f64, dir: &Path) -> MemberResult {
+    let m = Member {
+        name: format!("held_out_ls{stretch}_lr{length}"),
+        stretch,
+        length,
+        case_text: atlas.member_case(stretch, length).unwrap(),
+    };
+    let r = member::run(atlas, &m, dir);
+    assert!(r.error.is_none(), "{:?}", r.error);
+    r
+}
+
+fn measured(r: &MemberResult, rho: f64, q: &str) -> f64 {
+    let qi = atlas::spec::QUANTITIES
+        .iter()
+        .position(|x| *x == q)
+        .unwrap();
+    r.level(rho).unwrap().values[qi].unwrap().error()
+}
+
+/// The ci atlas (ABB 𝒩 = 30, plates, 9-node 32 around, L/R = 10, 20, 40): every point has a
+/// law; the law c + A/(L/R) predicts FE runs at L/R = 30 (not in the atlas) within 10 % of the
+/// prediction at three (λs*, ρ) points (the issue's requirement); at the atlas's minimum L/R
+/// for ε = 1e-2 the measured end effect |FE/GPS − 1 − c| lies in [0.8 ε, 1.2 ε] at three
+/// points; ϖ's coefficient at λs* = 1.3, ρ = 0.8 matches the README's direct study
+/// (A = −0.2521 from 64 four-node elements around at L/R = 20, 40, 80) within 5 %: two fits of
+/// one law on different meshes and lengths, each with a relative residual of about 0.005, so a
+/// few per cent is their expected spread; a wrong law (exponential) or a wrong quantity is off
+/// by far more.
+#[test]
+fn the_ci_atlas_predicts_lengths_it_did_not_run() {
+    let (atlas, text) = ci_atlas();
+    let out = tmp("ci");
+    let o = atlas::run(&atlas, &text, &out, 2, &|_| {}).unwrap();
+    assert!(o.missing.is_empty());
+    assert!(o.results.iter().all(|r| r.error.is_none()));
+    let flagged: Vec<_> = o.points.iter().filter(|p| p.flag.is_some()).collect();
+    assert!(flagged.is_empty(), "{flagged:?}");
+    let point = |s: f64, rho: f64, q: &str| {
+        o.points
+            .iter()
+            .find(|p| p.stretch == s && p.rho == rho && p.quantity == q)
+            .unwrap()
+    };
+    let a = point(1.3, 0.8, "w").fit.unwrap().a;
+    assert!((a / -0.2521 - 1.0).abs() < 0.05, "A = {a}");
+    // held-out length L/R = 30
+    let r13 = run_at(&atlas, 1.3, 30.0, &out.join("held_out_13"));
+    let r12 = run_at(&atlas, 1.2, 30.0, &out.join("held_out_12"));
+    for (r, s, rho, q) in [
+        (&r13, 1.3, 0.8, "w"),
+        (&r13, 1.3, 0.9, "force"),
+        (&r12, 1.2, 1.0, "w"),
+        (&r12, 1.2, 0.9, "force"),
+    ] {
+        let predicted = point(s, rho, q).predict(30.0).unwrap();
+        let m = measured(r, rho, q);
+        eprintln!("held out L/R = 30, λs* = {s}, ρ = {rho}, {q}: measured {m:.5e}, predicted {predicted:.5e}, {:.2} %", 100.0 * (m / predicted - 1.0));
+        assert!(
+            (m - predicted).abs() <= 0.1 * predicted.abs(),
+            "{q} at ({s}, {rho}): {m} against {predicted}"
+        );
+    }
+    // at the minimum length for ε = 1e-2
+    for (s, rho, q) in [(1.3, 0.8, "w"), (1.3, 0.9, "force"), (1.2, 0.9, "force")] {
+        let p = point(s, rho, q);
+        let l = p.min_length[0].unwrap();
+        let r = run_at(&atlas, s, l, &out.join(format!("min_{s}_{rho}_{q}")));
+        let end = (measured(&r, rho, q) - p.fit.unwrap().c).abs();
+        eprintln!("at the minimum L/R = {l:.3} for ε = 1e-2, λs* = {s}, ρ = {rho}, {q}: |FE/GPS − 1 − c| = {end:.4e}");
+        assert!(
+            (0.8e-2..=1.2e-2).contains(&end),
+            "{q} at ({s}, {rho}), L/R = {l}: {end}"
+        );
+    }
+    // resumed: nothing rerun, the same files
+    let csv = std::fs::read(out.join("atlas.csv")).unwrap();
+    let again = atlas::run(&atlas, &text, &out, 2, &|p| assert!(p.resumed)).unwrap();
+    assert_eq!(again.resumed, atlas.members.len());
+    assert_eq!(std::fs::read(out.join("atlas.csv")).unwrap(), csv);
+    // every member folder keeps the case it ran, which the case reader accepts as it is
+    for m in &atlas.members {
+        let t = std::fs::read_to_string(out.join("runs").join(&m.name).join("case.toml")).unwrap();
+        tubemem_app::case::Case::parse(&t).unwrap();
+    }
+    // predict at a grid point is the point's law; between grid points it interpolates
+    let json = atlas::predict::read(&out).unwrap();
+    let at = atlas::predict::predict(&json, 1.3, 0.8, 30.0).unwrap();
+    assert_eq!(at[0].error, point(1.3, 0.8, "w").predict(30.0).unwrap());
+    let mid = atlas::predict::predict(&json, 1.25, 0.85, 30.0).unwrap();
+    assert!(mid[0].error.is_finite());
+    let e = atlas::predict::predict(&json, 1.5, 0.85, 30.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("outside the atlas's grid"), "{e}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The plane-strain map is the closed form: each grid value equals gps::flatten's at that
+/// point, to the last bit (its CSV holds shortest round-trip numbers).
+#[test]
+fn the_ps_map_is_the_closed_form_at_every_point() {
+    let law = tubemem_material::MaterialSpec::Svk {
+        young_modulus: 1.0,
+        poisson_ratio: 0.3,
+    };
+    let built = law.build().unwrap();
+    let g = atlas::ps_map::grid(built.as_ref(), (1.05, 1.4), (0.7, 1.4), 9);
+    let csv = atlas::ps_map::csv(&g);
+    let mut checked = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (s, rho): (f64, f64) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+        let q = f[2];
+        if rho >= s {
+            assert!(f[3].is_empty() && f[4].is_empty(), "{line}");
+            continue;
+        }
+        let v = |h| {
+            let st = tubemem_gps::flatten(built.as_ref(), h, s, rho).unwrap();
+            match q {
+                "w" => st.w,
+                "force" => st.force,
+                "chi" => st.chi,
+                _ => st.lambda_s,
+            }
+        };
+        let (gps, ps) = (
+            v(tubemem_gps::Hypothesis::Gps),
+            v(tubemem_gps::Hypothesis::Ps),
+        );
+        assert_eq!(f[3].parse::<f64>().unwrap(), gps, "{line}");
+        assert_eq!(f[4].parse::<f64>().unwrap(), ps, "{line}");
+        assert_eq!(
+            f[5].parse::<f64>().unwrap(),
+            (ps / gps - 1.0).abs(),
+            "{line}"
+        );
+        checked += 1;
+    }
+    assert!(checked > 100, "{checked}");
+}
+
+/// A member that fails is kept as an error with the levels it reached; the other members are
+/// fitted and the failed member's points are flagged `run-failed` with its reason.
+#[test]
+fn a_failed_member_is_kept_and_loses_none_of_the_others() {
+    let text = r#"
+[geometry]
+radius = 1.0
+thickness = 0.01
+caps = "hemisphere"
+[material]
+model = "abb"
+shear_modulus = 1.0
+kuhn = 30
+[mesh]
+around = 16
+symmetry = "eighth"
+[solver]
+max_iterations = 4
+[atlas]
+stretches = [1.2, 2.0]
+rho = [1.1, 1.0]
+lengths = [10, 20, 40]
+along_per_radius = 2
+inflate = { steps = 1 }
+"#;
+    let atlas = Atlas::parse(text, Path::new(".")).unwrap();
+    let out = tmp("failed");
+    let o = atlas::run(&atlas, text, &out, 2, &|_| {}).unwrap();
+    let failed: Vec<_> = o.results.iter().filter(|r| r.error.is_some()).collect();
+    assert!(
+        !failed.is_empty() && failed.iter().all(|r| r.stretch == 2.0),
+        "{failed:?}"
+    );
+    for p in &o.points {
+        if p.stretch == 1.2 {
+            assert!(p.flag.is_none() && p.min_length[0].is_some(), "{p:?}");
+        } else {
+            let f = p.flag.as_ref().unwrap();
+            assert_eq!(f.flag, "run-failed", "{f:?}");
+            assert!(f.reason.contains("did not reach"), "{f:?}");
+        }
+    }
+    let csv = std::fs::read_to_string(out.join("atlas.csv")).unwrap();
+    assert!(csv.contains(",run-failed,"));
+    let runs = std::fs::read_to_string(out.join("runs.csv")).unwrap();
+    assert!(runs.contains("no convergence"), "{runs}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Bad atlas files: the key (and where the TOML reader knows it, the line) is named, and
+/// nothing is written.
+#[test]
+fn bad_atlas_files_name_the_key() {
+    let base = r#"
+[geometry]
+radius = 1.0
+thickness = 0.01
+[material]
+model = "neo-hookean"
+shear_modulus = 1.0
+[mesh]
+around = 16
+symmetry = "eighth"
+"#;
+    let err = |atlas: &str| {
+        let e = Atlas::parse(&format!("{base}{atlas}"), Path::new(".")).unwrap_err();
+        tubemem_app::error_chain(&e)
+    };
+    let ok =
+        "[atlas]\nstretches = [1.3]\nrho = [1.0]\nlengths = [10, 20, 40]\nalong_per_radius = 2\n";
+    assert!(Atlas::parse(&format!("{base}{ok}"), Path::new(".")).is_ok());
+    let e = err(&ok.replace("rho =", "rhoo ="));
+    assert!(e.contains("rhoo") && e.contains("line 13"), "{e}");
+    let e = err(&ok.replace("[10, 20, 40]", "[10, 20]"));
+    assert!(
+        e.contains("atlas.lengths") && e.contains("third length"),
+        "{e}"
+    );
+    let e = err(&ok.replace("[1.0]", "[1.4]"));
+    assert!(
+        e.contains("atlas.rho") && e.contains("no level is below λs* = 1.3"),
+        "{e}"
+    );
+    let e = err(&ok.replace("[1.3]", "[0.9]"));
+    assert!(e.contains("atlas.stretches"), "{e}");
+    let e = err(&format!("{ok}quantities = [\"force\", \"pressure\"]\n"));
+    assert!(
+        e.contains("atlas.quantities") && e.contains("\"pressure\""),
+        "{e}"
+    );
+    let e = err(&format!("{ok}squeeze = {{ target_rho = 0.5 }}\n"));
+    assert!(e.contains("atlas.squeeze.target_rho"), "{e}");
+    let e = Atlas::parse(
+        &format!(
+            "{}{ok}",
+            base.replace("thickness", "length = 20.0\nthickness")
+        ),
+        Path::new("."),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("geometry.length"), "{e}");
+    let e = err(&format!("{ok}\n[[stage]]\nkind = \"inflate\"\n"));
+    assert!(e.contains("`stage`"), "{e}");
+    // a template the case reader refuses names the member
+    let e = Atlas::parse(
+        &format!("{}{ok}", base.replace("around = 16", "around = 3")),
+        Path::new("."),
+    )
+    .unwrap_err();
+    let chain = tubemem_app::error_chain(&e);
+    assert!(
+        chain.contains("atlas member ls1.3_lr10") && chain.contains("[mesh]"),
+        "{chain}"
+    );
+    // a folder that holds something else is refused and left as it was
+    let out = tmp("foreign");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let atlas = Atlas::parse(&format!("{base}{ok}"), Path::new(".")).unwrap();
+    let e = atlas::run(&atlas, &format!("{base}{ok}"), &out, 1, &|_| {})
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("holds no atlas"), "{e}");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
+    std::fs::remove_dir_all(&out).unwrap();
+}
