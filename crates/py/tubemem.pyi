@@ -120,6 +120,22 @@ def run(
     progress: Progress = None,
 ) -> Run: ...
 
+def atlas(
+    atlas: Union[str, PathLike],
+    out: Union[str, PathLike],
+    client: Any = None,
+    workers: Optional[int] = None,
+    progress: Optional[Callable[[dict[str, Any]], Any]] = None,
+) -> Any:
+    """Run an atlas file (one FE run per λs* and L/R; locally on `workers` threads, or on a Dask
+    client, bit for bit the same) into `out`, fit the end-effect laws, and return an xarray
+    Dataset: error_<q>, fe_<q>, gps_<q> over (lambda_s_star, rho, length_ratio);
+    min_length_ratio_<q> over (lambda_s_star, rho, epsilon); c_<q>, a_<q>, fit_residual_<q>,
+    flag_<q> over (lambda_s_star, rho). Also written as out/atlas.nc. `progress`: a callable
+    given {"member", "done", "total", "error"} per finished member."""
+
+def _atlas_member(atlas_text: str, base_dir: str, index: int, dir: str) -> str: ...
+
 def sweep(
     cases: list,
     out: Union[str, PathLike],

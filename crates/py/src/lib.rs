@@ -13,6 +13,7 @@
 //! Dicts cross the boundary as JSON (serde on this side, `json` on the Python side): every
 //! result type already serializes for `summary.json`, so there is one conversion to keep right.
 
+mod atlas;
 mod case;
 mod convert;
 mod errors;
@@ -69,5 +70,7 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(material::fit, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::_sweep_one, m)?)?;
+    m.add_function(wrap_pyfunction!(atlas::atlas, m)?)?;
+    m.add_function(wrap_pyfunction!(atlas::_atlas_member, m)?)?;
     Ok(())
 }

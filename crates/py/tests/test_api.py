@@ -750,3 +750,43 @@ def test_fit_takes_files_or_arrays_and_says_what_the_data_do_not_determine():
         tubemem.fit("yeoh", uniaxial=np.c_[[1.1, 1.2], [0.1, 0.2]])
     with pytest.raises(ValueError, match="give test data"):
         tubemem.fit("yeoh")
+
+
+def _ci_atlas():
+    import pathlib
+    return pathlib.Path(__file__).resolve().parents[3] / "atlas" / "ci.toml"
+
+
+def test_atlas_on_a_dask_local_cluster_equals_the_local_one_bit_for_bit(tmp_path):
+    """tubemem.atlas on a LocalCluster of 2 worker processes writes the same atlas.csv, runs.csv
+    and atlas.json, byte for byte, as on threads of this process, and returns the same Dataset
+    (dimensions lambda_s_star, rho, length_ratio), also written as atlas.nc."""
+    import dask.distributed as distributed  # in the test requirements: a missing one fails
+    import xarray as xr
+
+    seen = []
+    local = tubemem.atlas(_ci_atlas(), tmp_path / "local", workers=2, progress=seen.append)
+    assert sorted(d["done"] for d in seen) == list(range(1, 7)) and all(d["error"] is None for d in seen)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        remote = tubemem.atlas(_ci_atlas(), tmp_path / "dask", client=client)
+    for name in ("atlas.csv", "runs.csv", "atlas.json"):
+        assert (tmp_path / "local" / name).read_bytes() == (tmp_path / "dask" / name).read_bytes(), name
+    assert local.identical(remote)
+    assert dict(local.sizes) == {"lambda_s_star": 2, "rho": 4, "length_ratio": 3, "epsilon": 2}
+    w = local["error_w"].sel(lambda_s_star=1.3, rho=0.8)
+    assert w.dims == ("length_ratio",) and bool((w < 0).all())
+    assert float(local["a_w"].sel(lambda_s_star=1.3, rho=0.8)) < 0
+    assert (local["flag_w"] == "").all()
+    back = xr.open_dataset(tmp_path / "local" / "atlas.nc", engine="scipy")
+    assert float(back["min_length_ratio_force"].sel(lambda_s_star=1.3, rho=0.8, epsilon=1e-3)) == float(local["min_length_ratio_force"].sel(lambda_s_star=1.3, rho=0.8, epsilon=1e-3))
+    back.close()
+    # every member's folder keeps the case it ran
+    assert (tmp_path / "dask" / "runs" / "ls1.3_lr40" / "case.toml").is_file()
+
+
+def test_atlas_errors_name_the_key(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(_ci_atlas().read_text().replace("lengths =", "length ="))
+    with pytest.raises(ValueError, match="length"):
+        tubemem.atlas(bad, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
