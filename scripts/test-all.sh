@@ -41,6 +41,10 @@ echo "== Python API: maturin develop (crates/py, release)"
 VIRTUAL_ENV="$PWD/.venv" .venv/bin/maturin develop --release --quiet -m crates/py/Cargo.toml
 echo "== tubemem verify verify/ci.toml (FE against closed form, references and gold files)"
 TUBEMEM_PYTHON="$PWD/.venv/bin/python" target/release/tubemem verify verify/ci.toml --out target/verify-ci
+echo "== tubemem atlas atlas/ci.toml (the small atlas: 6 FE runs, fits, maps; about 10 s)"
+rm -rf target/atlas-ci
+target/release/tubemem atlas atlas/ci.toml --out target/atlas-ci
+target/release/tubemem atlas predict target/atlas-ci --lambda-s-star 1.3 --rho 0.8 --length-ratio 80
 echo "== pytest: python_ref/tests"
 TUBEMEM_BIN="$PWD/target/release/tubemem" .venv/bin/python -m pytest python_ref/tests -q
 echo "== the Python package installs with plain pip in a fresh venv (no maturin beforehand)"

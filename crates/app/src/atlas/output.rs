@@ -99,8 +99,8 @@ pub fn runs_csv(atlas: &Atlas, results: &[MemberResult]) -> String {
     s
 }
 
-/// The segments where the bilinear interpolant of `z` on the grid (`xs` × `ys`, z[i][j] at
-/// (xs[i], ys[j])) crosses `level` (marching squares; a cell with a missing corner has none),
+/// The segments where the bilinear interpolant of `z` on the grid (`xs` × `ys`, `z[i][j]` at
+/// (`xs[i]`, `ys[j]`)) crosses `level` (marching squares; a cell with a missing corner has none),
 /// as one polyline broken by NaN points between segments.
 pub fn contour(xs: &[f64], ys: &[f64], z: &[Vec<f64>], level: f64) -> Vec<(f64, f64)> {
     let mut out = vec![];
@@ -143,7 +143,7 @@ pub fn contour(xs: &[f64], ys: &[f64], z: &[Vec<f64>], level: f64) -> Vec<(f64, 
     out
 }
 
-/// The contour levels of a minimum L/R map: 1, 2, 5 × 10^k across the finite values.
+/// The contour levels of a minimum L/R map: 1, 1.5, 2, 3, 5, 7 × 10^k across the finite values.
 pub fn nice_levels(values: impl Iterator<Item = f64>) -> Vec<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for v in values.filter(|v| v.is_finite() && *v > 0.0) {
@@ -156,7 +156,7 @@ pub fn nice_levels(values: impl Iterator<Item = f64>) -> Vec<f64> {
     let mut out = vec![];
     let mut e = lo.log10().floor() as i32;
     while 10f64.powi(e) <= hi {
-        for m in [1.0, 2.0, 5.0] {
+        for m in [1.0, 1.5, 2.0, 3.0, 5.0, 7.0] {
             let v = m * 10f64.powi(e);
             if v > lo && v < hi {
                 out.push(v);

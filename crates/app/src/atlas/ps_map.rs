@@ -96,7 +96,12 @@ pub fn figure(grid: &[Vec<PsPoint>], q: &str, epsilon: &[f64], law: &str) -> Fig
         .iter()
         .map(|c| {
             c.iter()
-                .map(|p| p.difference(q).max(1e-300).log10())
+                // a missing point stays NaN (f64::max would turn it into the floor: a false
+                // contour along the edge of the squeezed states)
+                .map(|p| match p.difference(q) {
+                    d if d.is_finite() => d.max(1e-300).log10(),
+                    _ => f64::NAN,
+                })
                 .collect()
         })
         .collect();
