@@ -13,9 +13,9 @@ use tubemem_app::atlas::{self, Atlas, Progress};
 pub struct AtlasArgs {
     #[command(subcommand)]
     pub command: Option<AtlasCommand>,
-    /// The atlas file (TOML: a case template without stages, and an [atlas] table).
+    /// The atlas file (TOML: a case template without stages, and an `[atlas]` table).
     pub file: Option<PathBuf>,
-    /// Output folder: runs/<member>/ (each with its case.toml), atlas.csv, runs.csv,
+    /// Output folder: `runs/<member>/` (each with its case.toml), atlas.csv, runs.csv,
     /// atlas.json, ps_map.csv, figures/. A folder holding the same atlas is resumed.
     #[arg(long)]
     pub out: Option<PathBuf>,

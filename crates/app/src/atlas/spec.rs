@@ -103,7 +103,7 @@ pub struct Atlas {
     pub base_dir: PathBuf,
     /// every run, λs* outer, length inner
     pub members: Vec<Member>,
-    /// the law of the template's [material]
+    /// the law of the template's `[material]`
     pub material: tubemem_material::MaterialSpec,
 }
 
