@@ -287,3 +287,57 @@ symmetry = "eighth"
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// The `atlas-point` verify kind through a suite, as a user writes it: a coarse atlas (its
+/// runs take a tenth of a second) held at a length it did not run; a tolerance of 1e-6 of the
+/// prediction fails it (the kind can fail: the law is a fit, not an identity); a point off the
+/// grid or a length the atlas ran is refused before anything runs.
+#[test]
+fn the_atlas_point_kind_holds_a_held_out_length_and_can_fail() {
+    use tubemem_app::verify::suite::read_suite;
+    use tubemem_app::verify::{run_check, Status, VerifyOptions};
+    let d = tmp("kind");
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::write(
+        d.join("coarse.toml"),
+        "[geometry]\nradius = 1.0\nthickness = 0.01\n[material]\nmodel = \"abb\"\nshear_modulus = 1.0\nkuhn = 30\n[mesh]\naround = 16\nsymmetry = \"eighth\"\n[atlas]\nstretches = [1.3]\nrho = [1.0, 0.9]\nlengths = [10, 20, 40]\nalong_per_radius = 2\n",
+    )
+    .unwrap();
+    let suite = |point: &str, tol: f64| {
+        std::fs::write(
+            d.join("suite.toml"),
+            format!("[[check]]\nname = \"p\"\nkind = \"atlas-point\"\ncase = \"coarse.toml\"\npoint = {point}\nquantities = [\"w\"]\ntolerance.prediction = {{ value = {tol:e}, source = \"test\" }}\n"),
+        )
+        .unwrap();
+        read_suite(&d.join("suite.toml"))
+            .map(|mut s| s.1.remove(0))
+            .map_err(|e| e.to_string())
+    };
+    let at30 = "{ lambda_s_star = 1.3, rho = 0.9, length_ratio = 30 }";
+    let r = run_check(
+        &suite(at30, 0.1).unwrap(),
+        &d.join("out"),
+        &VerifyOptions::default(),
+    );
+    assert_eq!(r.status, Status::Pass, "{}", r.message);
+    let off = r.measures[0].measured;
+    assert!(off > 1e-6 && off < 0.1, "{off}");
+    let r = run_check(
+        &suite(at30, 1e-6).unwrap(),
+        &d.join("out2"),
+        &VerifyOptions::default(),
+    );
+    assert_eq!(r.status, Status::Fail, "{}", r.message);
+    let e = suite(
+        "{ lambda_s_star = 1.3, rho = 0.85, length_ratio = 30 }",
+        0.1,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("point.rho") && e.contains("not on the atlas's grid"),
+        "{e}"
+    );
+    let e = suite("{ lambda_s_star = 1.3, rho = 0.9, length_ratio = 20 }", 0.1).unwrap_err();
+    assert!(e.contains("one of the atlas's lengths"), "{e}");
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -59,6 +59,7 @@ fn spec(name: &str, kind: CheckKind, case: &str) -> CheckSpec {
         pressure: None,
         plates: None,
         annulus: None,
+        point: None,
     }
 }
 

@@ -45,6 +45,7 @@ pub enum CheckKind {
     Gold,
     Manufactured,
     TensionField,
+    AtlasPoint,
 }
 
 impl CheckKind {
@@ -58,6 +59,7 @@ impl CheckKind {
             CheckKind::Gold => "gold",
             CheckKind::Manufactured => "manufactured",
             CheckKind::TensionField => "tension-field",
+            CheckKind::AtlasPoint => "atlas-point",
         }
     }
 }
@@ -131,6 +133,19 @@ pub struct CheckSpec {
     /// the annulus and its rim tractions (default R_in = 1, R_out = 4, T_in = 3e-4,
     /// T_out = 1e-4, per μH)
     pub annulus: Option<tubemem_fem::tension_field::Annulus>,
+    // atlas-point
+    /// the atlas point held to its law and the held-out length: `{ lambda_s_star, rho,
+    /// length_ratio }` (λs* and ρ on the atlas's grid, the length not among its lengths)
+    pub point: Option<AtlasPointSpec>,
+}
+
+/// `point` of an `atlas-point` check.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AtlasPointSpec {
+    pub lambda_s_star: f64,
+    pub rho: f64,
+    pub length_ratio: f64,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -377,6 +392,29 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
                 ));
             }
         }
+        CheckKind::AtlasPoint => {
+            known(&["prediction"], &mut c.tolerance.keys())?;
+            if !c.tolerance.contains_key("prediction") {
+                return Err(err(
+                    "an atlas-point check needs `tolerance.prediction` (the measured error's distance from the law's prediction, over the prediction)".into(),
+                ));
+            }
+            match c.point {
+                None => {
+                    return Err(err(
+                        "an atlas-point check needs `point` = { lambda_s_star, rho, length_ratio }"
+                            .into(),
+                    ))
+                }
+                Some(p) if !(p.length_ratio.is_finite() && p.length_ratio > 0.0) => {
+                    return Err(err(format!(
+                        "`point.length_ratio` = {} must be a positive number",
+                        p.length_ratio
+                    )))
+                }
+                Some(_) => {}
+            }
+        }
         CheckKind::Manufactured => {
             if c.expected_order.is_none() {
                 return Err(err(
@@ -439,14 +477,55 @@ pub fn read_suite(path: &Path) -> Result<(String, Vec<Check>), SuiteError> {
                 dir.clone(),
             ),
         };
-        // the case must be valid before anything runs
-        crate::case::Case::parse(&case_text).map_err(|e| {
-            err(format!(
-                "check `{}`: its case: {}",
-                spec.name,
-                crate::error_chain(&e)
-            ))
-        })?;
+        // the case must be valid before anything runs (an atlas-point check's is an atlas
+        // file, whose point must be on its grid at a length it does not run)
+        if spec.kind == CheckKind::AtlasPoint {
+            let a = crate::atlas::Atlas::parse(&case_text, &base_dir).map_err(|e| {
+                err(format!(
+                    "check `{}`: its atlas: {}",
+                    spec.name,
+                    crate::error_chain(&e)
+                ))
+            })?;
+            let p = spec.point.expect("validated");
+            let on = |grid: &[f64], v: f64, key: &str| {
+                if grid.contains(&v) {
+                    Ok(())
+                } else {
+                    Err(err(format!(
+                        "check `{}`: `point.{key}` = {v} is not on the atlas's grid {grid:?}",
+                        spec.name
+                    )))
+                }
+            };
+            on(&a.spec.stretches, p.lambda_s_star, "lambda_s_star")?;
+            on(&a.spec.rho, p.rho, "rho")?;
+            if a.spec.lengths.contains(&p.length_ratio) {
+                return Err(err(format!(
+                    "check `{}`: `point.length_ratio` = {} is one of the atlas's lengths: hold the law at a length it did not fit",
+                    spec.name, p.length_ratio
+                )));
+            }
+            if let Some(q) = spec
+                .quantities
+                .iter()
+                .flatten()
+                .find(|q| !a.spec.quantities.contains(q))
+            {
+                return Err(err(format!(
+                    "check `{}`: `{q}` is not one of the atlas's quantities {:?}",
+                    spec.name, a.spec.quantities
+                )));
+            }
+        } else {
+            crate::case::Case::parse(&case_text).map_err(|e| {
+                err(format!(
+                    "check `{}`: its case: {}",
+                    spec.name,
+                    crate::error_chain(&e)
+                ))
+            })?;
+        }
         let gold_dir = dir.join(
             spec.gold
                 .clone()

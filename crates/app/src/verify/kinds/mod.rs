@@ -41,6 +41,7 @@ macro_rules! kind {
     };
 }
 
+mod atlas_point;
 mod closed_form;
 mod convergence;
 mod end_effect;
@@ -77,6 +78,7 @@ pub fn kind_of(kind: CheckKind) -> &'static dyn VerifyKind {
         CheckKind::Gold => &gold::Gold,
         CheckKind::Manufactured => &manufactured::Manufactured,
         CheckKind::TensionField => &tension_field::TensionField,
+        CheckKind::AtlasPoint => &atlas_point::AtlasPoint,
     }
 }
 
