@@ -39,9 +39,11 @@ pub mod model_setup;
 pub mod observer;
 pub mod output;
 pub mod output_file;
+pub mod quantity;
 pub mod report;
 pub mod run;
 pub mod stage;
+pub mod stats;
 pub mod verify;
 
 use std::path::PathBuf;

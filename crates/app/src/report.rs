@@ -364,6 +364,10 @@ pub struct StageSummary {
     /// a confine stage: its planes as the case gave them
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub planes: Vec<crate::case::PlaneSpec>,
+    /// a confine stage: the inflated λs* its closed form starts from (a confine stage that
+    /// continues one starts from the same λs*, as a squeeze continuing a squeeze does)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_stretch: Option<f64>,
     /// an arc-length stage: the critical points located on its path, in path order
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub critical_points: Vec<CriticalRecord>,

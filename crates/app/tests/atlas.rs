@@ -251,6 +251,23 @@ symmetry = "eighth"
         e.contains("atlas.quantities") && e.contains("\"pressure\""),
         "{e}"
     );
+    // planes: each plane's keys named with its index; the plates' quantities refused
+    let planes = "[[atlas.plane]]\nnormal = [0, 1]\n[[atlas.plane]]\nnormal = [0, -1]\n";
+    assert!(Atlas::parse(&format!("{base}{ok}{planes}"), Path::new(".")).is_ok());
+    let e = err(&format!("{ok}{}", planes.replacen("[0, 1]", "[0, 0]", 1)));
+    assert!(e.contains("atlas.plane[1].normal"), "{e}");
+    let e = err(&format!(
+        "{ok}{planes}[[atlas.plane]]\nnormal = [1, 0]\noffset = -2\n"
+    ));
+    assert!(e.contains("atlas.plane[3].offset"), "{e}");
+    let fixed = "[[atlas.plane]]\nnormal = [0, 1]\noffset = 1.2\n[[atlas.plane]]\nnormal = [0, -1]\noffset = 1.2\n";
+    let e = err(&format!("{ok}{fixed}"));
+    assert!(e.contains("none moves with ρ"), "{e}");
+    let e = err(&format!("{}quantities = [\"force\"]\n{planes}", ok));
+    assert!(
+        e.contains("atlas.quantities") && e.contains("wall_force"),
+        "{e}"
+    );
     let e = err(&format!("{ok}squeeze = {{ target_rho = 0.5 }}\n"));
     assert!(e.contains("atlas.squeeze.target_rho"), "{e}");
     let e = Atlas::parse(
@@ -340,4 +357,55 @@ fn the_atlas_point_kind_holds_a_held_out_length_and_can_fail() {
     let e = suite("{ lambda_s_star = 1.3, rho = 0.9, length_ratio = 20 }", 0.1).unwrap_err();
     assert!(e.contains("one of the atlas's lengths"), "{e}");
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A channel atlas (atlas/channel_abb30.toml: fixed side walls x = ±1.35 R, plates y = ±ρ moved
+/// through four levels, one confine stage each): every confine stage after the first continues
+/// from the walls where the last one left them and compares with GPS from the same inflated
+/// λs* (as a squeeze continuing a squeeze does); every point has a law; the law predicts a run
+/// at L/R = 30, which the atlas did not use, within 10 % of the prediction (the issue's
+/// requirement) for ϖ and the wall force at two levels.
+#[test]
+fn a_channel_atlas_chains_its_confine_stages_and_predicts_a_held_out_length() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../atlas/channel_abb30.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let atlas = Atlas::read(&path).unwrap();
+    let out = tmp("channel");
+    let o = atlas::run(&atlas, &text, &out, 2, &|_| {}).unwrap();
+    assert!(o.results.iter().all(|r| r.error.is_none()));
+    let flagged: Vec<_> = o.points.iter().filter(|p| p.flag.is_some()).collect();
+    assert!(flagged.is_empty(), "{flagged:?}");
+    // every confine stage's closed form starts from the inflation's λs*
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("runs/ls1.3_lr20/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let stages = summary["stages"].as_array().unwrap();
+    assert_eq!(stages.len(), 5);
+    let first = stages[1]["initial_stretch"].as_f64().unwrap();
+    assert!((first - 1.3).abs() < 1e-5, "{first}");
+    for s in &stages[2..] {
+        assert_eq!(s["initial_stretch"].as_f64(), Some(first));
+    }
+    let r = run_at(&atlas, 1.3, 30.0, &out.join("held_out"));
+    for (rho, q) in [
+        (1.2, "w"),
+        (1.2, "wall_force"),
+        (1.1, "w"),
+        (1.1, "wall_force"),
+    ] {
+        let p = o
+            .points
+            .iter()
+            .find(|p| p.stretch == 1.3 && p.rho == rho && p.quantity == q)
+            .unwrap();
+        let predicted = p.predict(30.0).unwrap();
+        let m = measured(&r, rho, q);
+        eprintln!("channel, held out L/R = 30, ρ = {rho}, {q}: measured {m:.5e}, predicted {predicted:.5e}, {:.2} %", 100.0 * (m / predicted - 1.0));
+        assert!(
+            (m - predicted).abs() <= 0.1 * predicted.abs(),
+            "{q} at ρ = {rho}: {m} against {predicted}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out);
 }

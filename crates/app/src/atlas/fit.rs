@@ -5,7 +5,7 @@
 
 use super::member::MemberResult;
 use super::spec::{Atlas, QUANTITIES};
-use crate::verify::stats::{self, EndFit};
+use crate::stats::{self, EndFit};
 use serde::{Deserialize, Serialize};
 
 /// Why a point has no law.

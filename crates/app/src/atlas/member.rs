@@ -4,8 +4,8 @@
 //! which is how an interrupted atlas knows which runs it has.
 
 use super::spec::{Atlas, Member, QUANTITIES};
+use crate::quantity::step_pair;
 use crate::report::{RunReport, StageOutcome};
-use crate::verify::quantity::step_pair;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -77,7 +77,9 @@ pub fn extract(member: &Member, atlas: &Atlas, report: &RunReport) -> Vec<Level>
         let Some(last) = stage.steps.last() else {
             break;
         };
-        let contact = last.contact.is_some_and(|c| c.values.chi > 0.0);
+        // plates: the mid-span ring's contact width; planes: any wall that pushes
+        let contact = last.contact.is_some_and(|c| c.values.chi > 0.0)
+            || last.walls.iter().any(|w| w.force > 0.0);
         out.push(Level {
             rho,
             contact,

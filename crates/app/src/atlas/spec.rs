@@ -5,12 +5,28 @@
 
 use super::AtlasError;
 use crate::case::Case;
-use crate::verify::stats::EndLaw;
+use crate::stats::EndLaw;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The quantities an atlas can fit: the mid-span FE against the GPS flattening at the same ρ.
-pub const QUANTITIES: [&str; 5] = ["w", "force", "chi", "lambda_s", "lambda_z"];
+/// The quantities an atlas can fit: the mid-span FE against GPS at the same ρ (the flattening
+/// between plates; for planes, the confined section, whose `wall_force` is the worst wall's).
+pub const QUANTITIES: [&str; 6] = ["w", "force", "chi", "lambda_s", "lambda_z", "wall_force"];
+/// Those of a squeeze between plates (the default).
+pub const PLATE_QUANTITIES: [&str; 5] = ["w", "force", "chi", "lambda_s", "lambda_z"];
+/// Those of a confinement by planes.
+pub const PLANE_QUANTITIES: [&str; 4] = ["w", "wall_force", "lambda_s", "lambda_z"];
+
+/// `[[atlas.plane]]`: a plane of a confine atlas, parallel to the tube's axis, n·x ≤ d.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AtlasPlane {
+    /// [nx, ny] (normalized by the case reader)
+    pub normal: [f64; 2],
+    /// a wall that stays at d = `offset` (in R); without it the plane moves with ρ: d = ρ at
+    /// each level
+    pub offset: Option<f64>,
+}
 
 /// The `[atlas]` table.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -28,9 +44,16 @@ pub struct AtlasSpec {
     /// the tolerances ε on |FE/GPS − 1|'s end effect for which the minimum L/R is reported
     #[serde(default = "default_epsilon")]
     pub epsilon: Vec<f64>,
-    /// the quantities fitted (default all five: w, force, chi, lambda_s, lambda_z)
-    #[serde(default = "default_quantities")]
+    /// the quantities fitted (default: w, force, chi, lambda_s, lambda_z between plates; w,
+    /// wall_force, lambda_s, lambda_z between planes)
+    #[serde(default)]
     pub quantities: Vec<String>,
+    /// planes instead of plates: a confine stage per level, the moving planes at d = ρ
+    #[serde(default)]
+    pub plane: Vec<AtlasPlane>,
+    /// a confine atlas: where the moving planes start, λs* + this (in R; default 0.05)
+    #[serde(default = "default_start_gap")]
+    pub start_gap: f64,
     /// the end-effect law; default from the physics of the stage: the gas-closed squeeze's
     /// error falls as 1/(L/R) (the caps keep gas the plates do not squeeze), "inverse"
     #[serde(default = "default_law")]
@@ -47,7 +70,7 @@ pub struct AtlasSpec {
     /// keys added to the generated inflate stage (default: control = "volume", steps = 6)
     #[serde(default)]
     pub inflate: toml::Table,
-    /// keys added to every generated squeeze stage (contact_method, gap_tolerance, …)
+    /// keys added to every generated squeeze (or confine) stage (contact_method, …)
     #[serde(default)]
     pub squeeze: toml::Table,
 }
@@ -67,8 +90,8 @@ pub struct PsMapSpec {
 fn default_epsilon() -> Vec<f64> {
     vec![1e-2, 1e-3]
 }
-fn default_quantities() -> Vec<String> {
-    QUANTITIES.iter().map(|s| s.to_string()).collect()
+fn default_start_gap() -> f64 {
+    0.05
 }
 fn default_law() -> EndLaw {
     EndLaw::Inverse
@@ -141,7 +164,7 @@ impl Atlas {
         }
         // the [atlas] table typed (an unknown or mistyped key is named with its line)
         let only: Only = toml::from_str(text).map_err(AtlasError::Syntax)?;
-        let spec = only.atlas.ok_or_else(|| {
+        let mut spec = only.atlas.ok_or_else(|| {
             bad(
                 "atlas",
                 "the file has no [atlas] table (stretches, rho, lengths, along_per_radius)",
@@ -154,6 +177,14 @@ impl Atlas {
                 "stage",
                 "an atlas makes its own stages (inflate to each λs*, squeeze through each ρ): remove the [[stage]] tables and put stage keys in [atlas.inflate] or [atlas.squeeze]",
             ));
+        }
+        if spec.quantities.is_empty() {
+            let q: &[&str] = if spec.plane.is_empty() {
+                &PLATE_QUANTITIES
+            } else {
+                &PLANE_QUANTITIES
+            };
+            spec.quantities = q.iter().map(|s| s.to_string()).collect();
         }
         check(&spec, &template)?;
         let mut members = vec![];
@@ -267,14 +298,42 @@ pub fn member_case(
     inflate.extend(spec.inflate.clone());
     inflate.insert("target_stretch".into(), toml::Value::Float(stretch));
     stages.push(toml::Value::Table(inflate));
-    // the plates start at the tube's half-height (≥ λs*: the cap junction can stand out)
-    let mut from = stretch;
+    // the plates start at the tube's half-height (≥ λs*: the cap junction can stand out); the
+    // moving planes of a confine atlas at λs* + start_gap
+    let mut from = if spec.plane.is_empty() {
+        stretch
+    } else {
+        stretch + spec.start_gap
+    };
     for rho in levels(spec, stretch) {
         let mut s = toml::Table::new();
-        s.insert("kind".into(), "squeeze".into());
-        s.extend(spec.squeeze.clone());
-        s.insert("target_rho".into(), toml::Value::Float(rho));
         let n = ((from - rho) / spec.rho_step).ceil().max(1.0) as i64;
+        if spec.plane.is_empty() {
+            s.insert("kind".into(), "squeeze".into());
+            s.extend(spec.squeeze.clone());
+            s.insert("target_rho".into(), toml::Value::Float(rho));
+        } else {
+            s.insert("kind".into(), "confine".into());
+            s.extend(spec.squeeze.clone());
+            let planes = spec
+                .plane
+                .iter()
+                .map(|p| {
+                    let mut t = toml::Table::new();
+                    t.insert(
+                        "normal".into(),
+                        toml::Value::Array(
+                            p.normal.iter().map(|&v| toml::Value::Float(v)).collect(),
+                        ),
+                    );
+                    let (a, b) = p.offset.map_or((from, rho), |d| (d, d));
+                    t.insert("offset".into(), toml::Value::Float(a));
+                    t.insert("target".into(), toml::Value::Float(b));
+                    toml::Value::Table(t)
+                })
+                .collect();
+            s.insert("plane".into(), toml::Value::Array(planes));
+        }
         s.insert("steps".into(), toml::Value::Integer(n));
         stages.push(toml::Value::Table(s));
         from = rho;
@@ -338,14 +397,43 @@ fn check(s: &AtlasSpec, template: &toml::Table) -> Result<(), AtlasError> {
     if s.quantities.is_empty() {
         return Err(bad("atlas.quantities", "is empty"));
     }
-    if let Some(q) = s
-        .quantities
-        .iter()
-        .find(|q| !QUANTITIES.contains(&q.as_str()))
-    {
+    // plates have a contact force and width; planes have each wall's force
+    let (allowed, what): (&[&str], &str) = if s.plane.is_empty() {
+        (&PLATE_QUANTITIES, "between plates")
+    } else {
+        (&PLANE_QUANTITIES, "between [[atlas.plane]] walls")
+    };
+    if let Some(q) = s.quantities.iter().find(|q| !allowed.contains(&q.as_str())) {
         return Err(bad(
             "atlas.quantities",
-            format!("{q:?} is not one of {}", QUANTITIES.join(", ")),
+            format!("{q:?} is not one of {} ({what})", allowed.join(", ")),
+        ));
+    }
+    for (k, p) in s.plane.iter().enumerate() {
+        let key = format!("atlas.plane[{}]", k + 1);
+        if !(p.normal.iter().all(|v| v.is_finite()) && p.normal[0].hypot(p.normal[1]) > 0.0) {
+            return Err(bad(
+                &format!("{key}.normal"),
+                format!("{:?} is not a finite non-zero [nx, ny]", p.normal),
+            ));
+        }
+        if let Some(d) = p.offset.filter(|d| !(d.is_finite() && *d > 0.0)) {
+            return Err(bad(
+                &format!("{key}.offset"),
+                format!("{d}: a wall n·x ≤ d must have d > 0 (the tube's axis on its side)"),
+            ));
+        }
+    }
+    if !s.plane.is_empty() && s.plane.iter().all(|p| p.offset.is_some()) {
+        return Err(bad(
+            "atlas.plane",
+            "every plane has an `offset`, so none moves with ρ: leave `offset` out of the pressing planes",
+        ));
+    }
+    if !(s.start_gap.is_finite() && s.start_gap >= 0.0) {
+        return Err(bad(
+            "atlas.start_gap",
+            format!("{} is not ≥ 0", s.start_gap),
         ));
     }
     for &st in &s.stretches {
@@ -395,7 +483,7 @@ fn check(s: &AtlasSpec, template: &toml::Table) -> Result<(), AtlasError> {
             ));
         }
     }
-    for key in ["kind", "target_rho", "steps", "plane"] {
+    for key in ["kind", "target_rho", "steps", "plane", "target", "offset"] {
         if s.squeeze.contains_key(key) {
             return Err(bad(
                 &format!("atlas.squeeze.{key}"),

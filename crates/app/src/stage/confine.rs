@@ -43,7 +43,14 @@ impl StageKind for Confine {
                 state.p
             ));
         }
-        // no plane may start inside the tube
+        // no plane may start inside the tube; one that continues a confine stage may touch it
+        // as that stage's contact left it, by up to the penetration a step accepts
+        // (MAX_PENETRATION_FRACTION of its distance from the axis)
+        let touch = if input.continues_confine {
+            MAX_PENETRATION_FRACTION
+        } else {
+            0.0
+        };
         for (k, p) in planes.iter().enumerate() {
             let len = p.normal[0].hypot(p.normal[1]);
             let reach = state
@@ -51,7 +58,7 @@ impl StageKind for Confine {
                 .iter()
                 .map(|x| (p.normal[0] * x[0] + p.normal[1] * x[1]) / len)
                 .fold(f64::NEG_INFINITY, f64::max);
-            if reach > p.offset / len {
+            if reach > p.offset / len + touch * (p.offset / len).abs() {
                 return Err(format!(
                     "plane {}: `offset` = {} cuts the tube, which reaches n·x = {reach:.6} along its normal: start it further out",
                     k + 1,

@@ -71,6 +71,9 @@ pub struct RangeInput<'a> {
     pub start: &'a MidSpan,
     /// the previous stage's final contact, if it was a squeeze
     pub previous_squeeze: Option<FinalContact>,
+    /// the previous stage was a confine stage that finished: its walls may still touch the
+    /// tube, within the penetration a step accepts
+    pub continues_confine: bool,
     /// the stage's `penalty` or `penetration_tolerance`
     pub penalty: Option<PenaltySpec>,
 }

@@ -41,6 +41,11 @@ pub(crate) fn setup_stage(
         Some(StageOutcome::Finished(s)) => s.final_state.contact,
         _ => None,
     };
+    // the λs* of the confine stage this one continues, if the previous stage was one
+    let previous_confine: Option<f64> = match report.stages.last().map(|s| &s.outcome) {
+        Some(StageOutcome::Finished(s)) if kind.planes().is_some() => s.initial_stretch,
+        _ => None,
+    };
     report
         .warnings
         .extend(kind.warnings(plan, run.law, run.limits));
@@ -114,6 +119,7 @@ pub(crate) fn setup_stage(
         v0,
         start: &start,
         previous_squeeze,
+        continues_confine: previous_confine.is_some(),
         penalty: plan.penalty,
     });
     let (mut from, to, penalty) = match range {
@@ -144,6 +150,10 @@ pub(crate) fn setup_stage(
         pv: if closed_gas { pv } else { 0.0 },
         penalty,
         // a squeeze that continues a squeeze compares with the flattening from the same λs*
-        start_lambda_s: previous_squeeze.map_or(start.lambda_s, |c| c.initial_stretch),
+        // and a confine that continues a confine from the same λs* too
+        start_lambda_s: previous_squeeze
+            .map(|c| c.initial_stretch)
+            .or(previous_confine)
+            .unwrap_or(start.lambda_s),
     })
 }

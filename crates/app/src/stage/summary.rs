@@ -86,6 +86,7 @@ pub(crate) fn stage_report(
         relative_error_vs_gps_at_fe_pressure: comparison.local_errors,
         walls: comparison.walls,
         planes: r.kind.planes().map(<[_]>::to_vec).unwrap_or_default(),
+        initial_stretch: r.kind.planes().map(|_| r.start_lambda_s),
         critical_points: criticals,
         nonuniformity: stage_nonuniformity,
         gps_applicable: stage_nonuniformity.is_none_or(|u| u <= NONUNIFORM)

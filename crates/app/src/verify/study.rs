@@ -24,10 +24,10 @@
 //!
 //! The verdict says whether GPS describes the tube's mid-span and to what accuracy.
 
-use super::stats::EndLaw;
 use super::suite::{CaseRef, Check, CheckKind, CheckSpec, Expect, Tol};
 use super::VerifyError;
 use super::{run_checks, CheckResult, Event, Status, VerifyOptions};
+use crate::stats::EndLaw;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -278,7 +278,7 @@ impl StudyPlan {
             let ends = end_fits
                 .as_ref()
                 .and_then(|f| f.get(q.as_str()))
-                .and_then(|f| serde_json::from_value::<super::stats::EndFit>(f["fit"].clone()).ok())
+                .and_then(|f| serde_json::from_value::<crate::stats::EndFit>(f["fit"].clone()).ok())
                 .map(|f| (f.end_effect(self.l), f.length_for(1e-3)));
             allowances.push(Allowance {
                 quantity: q.clone(),

@@ -11,7 +11,7 @@
 //! tolerance.w = { value = 1.5e-3, source = "64-gon factor 1/cos(π/64) − 1 = 1.2e-3" }
 //! ```
 
-use super::stats::EndLaw;
+use crate::stats::EndLaw;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -3,8 +3,8 @@
 
 use super::{member, plot, rel, KindResult, COLORS};
 use crate::figures::{Figure, Series, Stroke};
+use crate::quantity::step_pair;
 use crate::report::StepRecord;
-use crate::verify::quantity::step_pair;
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use plotters::style::RGBColor;

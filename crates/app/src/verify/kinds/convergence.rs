@@ -1,9 +1,9 @@
 //! `convergence`: a mesh family: observed order, Richardson extrapolation and GCI
-//! ([`stats::gci`](crate::verify::stats::gci)), the reference within the extrapolated value ± GCI.
+//! ([`stats::gci`](crate::stats::gci)), the reference within the extrapolated value ± GCI.
 
 use super::{plot, rel, KindResult, COLORS};
 use crate::figures::{Figure, Series, Stroke};
-use crate::verify::quantity::{final_value, step_pair};
+use crate::quantity::{final_value, step_pair};
 use crate::verify::suite::Check;
 use crate::verify::{run_member, stats, vary, CheckResult, Measure, VerifyOptions};
 use std::path::Path;

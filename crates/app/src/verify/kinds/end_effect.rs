@@ -1,9 +1,9 @@
 //! `end-effect`: a length family: the mid-span error against GPS fitted to c + A exp(−k L/R)
-//! (open inflation) or c + A/(L/R) (gas-closed squeeze) ([`stats`](crate::verify::stats)).
+//! (open inflation) or c + A/(L/R) (gas-closed squeeze) ([`stats`](crate::stats)).
 
 use super::{plot, rel, KindResult, COLORS};
 use crate::figures::{Figure, Markers, Series, Stroke};
-use crate::verify::quantity::step_pair;
+use crate::quantity::step_pair;
 use crate::verify::suite::Check;
 use crate::verify::{run_member, stats, vary, CheckResult, Measure, VerifyOptions};
 use std::path::Path;

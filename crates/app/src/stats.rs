@@ -1,7 +1,7 @@
-//! The arithmetic of the verification checks: grid convergence (Roache's GCI in the form of
-//! Celik et al. 2008, ASME J. Fluids Eng. 130, 078001, "Procedure for estimation and reporting of
-//! uncertainty due to discretization in CFD applications") and the end-effect laws fitted to
-//! the mid-span error against the tube length.
+//! The arithmetic of the verification checks and the atlas: grid convergence (Roache's GCI in
+//! the form of Celik et al. 2008, ASME J. Fluids Eng. 130, 078001, "Procedure for estimation
+//! and reporting of uncertainty due to discretization in CFD applications") and the end-effect
+//! laws fitted to the mid-span error against the tube length.
 
 /// The three-grid study of one quantity (grid 1 the finest).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
