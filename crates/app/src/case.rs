@@ -151,6 +151,25 @@ pub struct Case {
     hash: String,
 }
 
+/// A member run's output defaults (a verify member, an atlas member), written into its case
+/// table unless the case sets them: `[output] vtu = vtu` and no checkpoints.
+pub(crate) fn member_output_defaults(t: &mut toml::Table, vtu: &str) {
+    let output = t
+        .entry("output")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let Some(o) = output.as_table_mut() {
+        o.entry("vtu")
+            .or_insert_with(|| toml::Value::String(vtu.into()));
+    }
+    let solver = t
+        .entry("solver")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let Some(s) = solver.as_table_mut() {
+        s.entry("checkpoint_every")
+            .or_insert(toml::Value::Integer(0));
+    }
+}
+
 /// FNV-1a (64 bit) of the case text: the record of which case ran (run.json, summary.json,
 /// checkpoints, the VTU field data). The case owns it, so the case module depends on no writer.
 pub fn case_hash(text: &str) -> String {

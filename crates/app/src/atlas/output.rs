@@ -167,16 +167,7 @@ pub fn nice_levels(values: impl Iterator<Item = f64>) -> Vec<f64> {
     out
 }
 
-const COLORS: [RGBColor; 8] = [
-    RGBColor(31, 90, 180),
-    RGBColor(200, 50, 40),
-    RGBColor(20, 140, 60),
-    RGBColor(150, 60, 170),
-    RGBColor(230, 130, 0),
-    RGBColor(90, 90, 90),
-    RGBColor(0, 150, 160),
-    RGBColor(160, 110, 40),
-];
+use crate::figures::PALETTE as COLORS;
 
 /// The map of the minimum L/R for quantity `q` and the `e`-th ε over (λs*, ρ): contours of
 /// log L/R, the grid points valid (filled) or flagged (hollow).

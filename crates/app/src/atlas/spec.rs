@@ -276,20 +276,7 @@ pub fn member_case(
     let along = (spec.along_per_radius * length).ceil() as i64;
     mesh.insert("along".into(), toml::Value::Integer(along + along % 2));
     // lean member folders: no VTU unless the template asks, no checkpoints
-    let output = t
-        .entry("output")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    if let Some(o) = output.as_table_mut() {
-        o.entry("vtu")
-            .or_insert_with(|| toml::Value::String("none".into()));
-    }
-    let solver = t
-        .entry("solver")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    if let Some(s) = solver.as_table_mut() {
-        s.entry("checkpoint_every")
-            .or_insert(toml::Value::Integer(0));
-    }
+    crate::case::member_output_defaults(&mut t, "none");
     let mut stages = vec![];
     let mut inflate = toml::Table::new();
     inflate.insert("kind".into(), "inflate".into());

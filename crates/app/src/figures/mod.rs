@@ -48,6 +48,18 @@ const FE_COLORS: [RGBColor; 3] = [
     RGBColor(230, 130, 0),
 ];
 
+/// The colours of a figure's numbered series (the verify kinds' and the atlas's curves).
+pub const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 90, 180),
+    RGBColor(200, 50, 40),
+    RGBColor(20, 140, 60),
+    RGBColor(150, 60, 170),
+    RGBColor(230, 130, 0),
+    RGBColor(90, 90, 90),
+    RGBColor(0, 150, 160),
+    RGBColor(160, 110, 40),
+];
+
 /// The figure canvas in pixels at [`BASE_DPI`].
 pub const CANVAS: (u32, u32) = (1100, 760);
 /// The DPI at which the PNG is [`CANVAS`] pixels.

@@ -421,20 +421,7 @@ impl From<VerifyError> for String {
 pub fn vary(text: &str, edit: impl FnOnce(&mut toml::Table)) -> Result<String, VerifyError> {
     let mut t: toml::Table = toml::from_str(text).map_err(VerifyError::Toml)?;
     edit(&mut t);
-    let output = t
-        .entry("output")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    if let Some(o) = output.as_table_mut() {
-        o.entry("vtu")
-            .or_insert_with(|| toml::Value::String("stage-end".into()));
-    }
-    let solver = t
-        .entry("solver")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    if let Some(s) = solver.as_table_mut() {
-        s.entry("checkpoint_every")
-            .or_insert(toml::Value::Integer(0));
-    }
+    crate::case::member_output_defaults(&mut t, "stage-end");
     toml::to_string(&t).map_err(VerifyError::TomlWrite)
 }
 

@@ -13,7 +13,6 @@ use super::suite::{Check, CheckKind};
 use super::{run_member, vary, CheckResult, VerifyOptions};
 use crate::figures::{rasterize, render_svg, Figure};
 use crate::report::RunReport;
-use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
 
 /// A kind whose check is one function `f(check, dir, options, result)`: its unit type and its
@@ -101,14 +100,7 @@ fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
 }
 
-const COLORS: [RGBColor; 6] = [
-    RGBColor(31, 90, 180),
-    RGBColor(200, 50, 40),
-    RGBColor(20, 140, 60),
-    RGBColor(150, 60, 170),
-    RGBColor(230, 130, 0),
-    RGBColor(90, 90, 90),
-];
+pub(crate) use crate::figures::PALETTE as COLORS;
 
 /// Draw a small figure to PNG bytes (for the HTML report).
 fn plot(fig: &Figure, r: &mut CheckResult) {
