@@ -6,6 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N=${N:-5}
+# The main job runs in its own folder, so a relative OLD/NEW must be made absolute first.
+OLD=$(realpath "$OLD"); NEW=$(realpath "$NEW")
 work=$(mktemp -d)
 for r in $(seq "$N"); do
   for b in old new; do
