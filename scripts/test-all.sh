@@ -23,6 +23,11 @@ echo "== cargo doc (library docs, rustdoc warnings are errors)"
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --lib
 echo "== module cycles (a module may not depend on one that depends on it)"
 python3 scripts/module-cycles.py
+# the man-page test renders every page with groff, as man does
+if ! command -v groff > /dev/null; then
+  echo "== installing groff-base (the man-page test renders the pages with groff)"
+  apt-get install -y -qq groff-base > /dev/null || { sudo -n apt-get install -y -qq groff-base > /dev/null; }
+fi
 echo "== cargo test (workspace)"
 cargo test --workspace
 # The Python tests drive the release binary (the same one users run).

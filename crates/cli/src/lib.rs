@@ -7,6 +7,7 @@ pub mod console;
 pub mod fit_cmd;
 pub mod gps_cmd;
 pub mod material_args;
+pub mod shell_cmd;
 pub mod verify_cmd;
 
 /// Write one line to standard output. A closed or full standard output (`> /dev/full`, a pipe

@@ -5,7 +5,7 @@
 
 use anyhow::Context;
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -111,6 +111,21 @@ enum Command {
         /// PNG resolution (the canvas is 11 × 7.6 in; 100 dpi = 1100 × 760 pixels).
         #[arg(long, default_value_t = tubemem_app::figures::BASE_DPI)]
         dpi: f64,
+    },
+    /// Print the shell completion script for bash, zsh, fish, elvish or PowerShell, generated
+    /// from these options (bash: `source <(tubemem completions bash)`).
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: tubemem_cli::shell_cmd::Shell,
+    },
+    /// Write the man pages (tubemem.1 and one per subcommand, tubemem-run.1, …), generated from
+    /// these options (read one with `man -l DIR/tubemem-run.1`).
+    Man {
+        /// Output folder (created if missing). A file there that is not a tubemem man page is
+        /// refused and nothing is written.
+        #[arg(long)]
+        out: PathBuf,
     },
 }
 
@@ -285,6 +300,14 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Atlas(_)) => anyhow::bail!("internal: `atlas` is dispatched in main"),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Fit(a)) => tubemem_cli::fit_cmd::run(a),
+        Some(Command::Completions { shell }) => {
+            tubemem_cli::shell_cmd::completions(shell, Cli::command())
+        }
+        Some(Command::Man { out }) => {
+            let written = tubemem_cli::shell_cmd::man_pages(Cli::command(), &out)?;
+            tubemem_cli::say!("wrote {} man pages to {}", written.len(), out.display())?;
+            Ok(())
+        }
         Some(Command::Run {
             case,
             out,
