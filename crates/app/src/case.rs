@@ -125,7 +125,7 @@ macro_rules! invalid {
     ($($arg:tt)*) => { return Err(CaseError::Invalid(format!($($arg)*))) };
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
     /// the folder of the case file (user mesh paths are relative to it)
@@ -149,6 +149,21 @@ pub struct Case {
     /// the hash of the case text ([`case_hash`])
     #[serde(skip)]
     hash: String,
+}
+
+/// The JSON Schema of a case file (draft 2020-12), derived from the types the case is read
+/// into, so it takes exactly the keys [`Case::parse`] takes (unknown keys are refused, as
+/// `deny_unknown_fields` refuses them). Editors read it to complete and check TOML (Taplo:
+/// `#:schema ./case.schema.json` on the first line). The cross-key rules (a squeeze needs
+/// `target_rho`, a law's parameter ranges) stay with [`Case::parse`].
+pub fn schema() -> serde_json::Value {
+    let mut schema = schemars::schema_for!(Case);
+    schema.insert("title".into(), "tubemem case file".into());
+    schema.insert(
+        "description".into(),
+        "A tubemem case: the tube ([geometry]), its law ([material]), its mesh ([mesh]), the solver, the outputs, the units and the stages ([[stage]]).".into(),
+    );
+    schema.to_value()
 }
 
 /// A member run's output defaults (a verify member, an atlas member), written into its case
@@ -182,7 +197,7 @@ pub fn case_hash(text: &str) -> String {
 }
 
 /// Which converged steps get a VTU frame.
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum VtuFrames {
     /// every converged step (every `vtu_every`-th)
@@ -195,7 +210,7 @@ pub enum VtuFrames {
 }
 
 /// Which converged steps get a profile along the tube (stage ends always do).
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum ProfileFrames {
     /// every converged step (each costs about one residual assembly)
@@ -206,7 +221,7 @@ pub enum ProfileFrames {
 }
 
 /// `[output]`: optional.
-#[derive(Debug, Deserialize, Clone, Copy)]
+#[derive(Debug, Deserialize, Clone, Copy, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// "every" (default) | "stage-end" | "none"
@@ -232,7 +247,7 @@ pub struct OutputSpec {
 }
 
 /// How VTU arrays are written.
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum VtuFormat {
     #[default]
@@ -258,7 +273,7 @@ impl Default for OutputSpec {
 }
 
 /// `[solver]`: optional.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
     /// "relaxed" (tension-field theory, default) or "none"
@@ -306,7 +321,7 @@ fn default_max_iterations() -> usize {
     30
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Geometry {
     pub radius: f64,
@@ -321,19 +336,21 @@ pub struct Geometry {
 /// `[units]`: `system = "SI"` says the case's radius, length and thickness are in metres and
 /// its shear modulus in pascals; the outputs then carry dimensional values beside the
 /// dimensionless ones (pressure in Pa, resultants and forces per length in N/m).
-#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct UnitsSpec {
     pub system: UnitSystem,
 }
 
-#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, schemars::JsonSchema)]
 pub enum UnitSystem {
     #[serde(rename = "SI")]
     Si,
 }
 
-#[derive(Debug, Deserialize, Serialize, Default, PartialEq, Eq, Clone, Copy)]
+#[derive(
+    Debug, Deserialize, Serialize, Default, PartialEq, Eq, Clone, Copy, schemars::JsonSchema,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Caps {
     #[default]
@@ -341,7 +358,7 @@ pub enum Caps {
     RigidPlug,
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
     /// a user mesh (tubemem JSON, see `tubemem_mesh::io`; `python -m tubemem_ref.meshio_io`
@@ -389,7 +406,7 @@ impl MeshSpec {
     }
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Kind {
     Inflate,
@@ -401,12 +418,13 @@ pub enum Kind {
 /// One `[[stage.plane]]` of a confine stage: the wall {x : n·x = d} in the cross-section, the
 /// membrane on n·x ≤ d; `offset` is d at the start of the stage and `target` at its end (moved
 /// linearly in the stage's load parameter, 0 → 1).
-#[derive(Debug, Deserialize, Serialize, Clone, Copy, PartialEq)]
+#[derive(Debug, Deserialize, Serialize, Clone, Copy, PartialEq, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneSpec {
     /// [nx, ny]: the plane is parallel to the tube's axis, so its normal has two components
     /// (three are refused, not truncated)
     #[serde(deserialize_with = "two_components")]
+    #[schemars(with = "[f64; 2]")]
     pub normal: [f64; 2],
     pub offset: f64,
     pub target: f64,
@@ -452,7 +470,7 @@ impl PlaneSpec {
     }
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum ControlKind {
     Pressure,
@@ -461,7 +479,7 @@ pub enum ControlKind {
     ArcLength,
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StageSpec {
     pub kind: Kind,
@@ -502,14 +520,14 @@ pub struct StageSpec {
 }
 
 /// `contact_method` of a squeeze or confine stage.
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum ContactMethod {
     Penalty,
     Augmented,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum BranchSpec {
     /// stay on the path the continuation is on (the default)

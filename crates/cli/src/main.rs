@@ -112,6 +112,9 @@ enum Command {
         #[arg(long, default_value_t = tubemem_app::figures::BASE_DPI)]
         dpi: f64,
     },
+    /// Print the JSON Schema of case files (for editors: Taplo and Even Better TOML complete
+    /// and check a case file with `#:schema ./case.schema.json` on its first line).
+    Schema,
     /// Print the shell completion script for bash, zsh, fish, elvish or PowerShell, generated
     /// from these options (bash: `source <(tubemem completions bash)`).
     Completions {
@@ -300,6 +303,11 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Atlas(_)) => anyhow::bail!("internal: `atlas` is dispatched in main"),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Fit(a)) => tubemem_cli::fit_cmd::run(a),
+        Some(Command::Schema) => {
+            let text = serde_json::to_string_pretty(&tubemem_app::case::schema())?;
+            tubemem_cli::say!("{text}")?;
+            Ok(())
+        }
         Some(Command::Completions { shell }) => {
             tubemem_cli::shell_cmd::completions(shell, Cli::command())
         }

@@ -21,6 +21,7 @@ const PAGES: &[&str] = &[
     "tubemem-atlas-predict",
     "tubemem-export",
     "tubemem-figures",
+    "tubemem-schema",
     "tubemem-completions",
     "tubemem-man",
 ];

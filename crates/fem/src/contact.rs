@@ -61,7 +61,9 @@ pub enum Enforcement {
 /// ∫N_a dA0 (a nodal quadrature: one constraint per node and plane, where the Gauss points of
 /// an element, 9 of them on 9 nodes but closer together, give nearly dependent constraints
 /// along a contact edge that cuts the element).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum ContactPoints {
     #[default]

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 
 /// A typed material description (what case files and the CLI name); [`MaterialSpec::build`]
 /// validates it into a law.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "model", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum MaterialSpec {
     /// Anssari-Benam & Bucchi generalized neo-Hookean (paper eqs. 19–23).
@@ -61,7 +61,9 @@ pub enum MaterialSpec {
 }
 
 /// Whether compressive states are relaxed (tension-field theory) or kept as computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Wrinkling {
     /// Pipkin's relaxed energy: no compressive resultant (the default for finite elements).

@@ -153,7 +153,9 @@ pub const TUBE_TOLERANCE: f64 = 1e-2;
 
 /// Which symmetry planes bound the mesh (open edges are allowed only on these planes, and the
 /// matching displacement component is fixed there).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Symmetry {
     /// the whole surface

@@ -56,7 +56,17 @@ pub const GAUSS3_RULE: [(f64, f64, f64); 9] = {
 };
 
 /// The kind of membrane element of a mesh.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum ElementKind {
     /// bilinear, flat-faceted (the default)
