@@ -77,3 +77,12 @@ def test_a_material_key_of_another_law_is_refused(validator):
     case = _squeeze()
     case["material"] = {"model": "yeoh", "c10": 0.5, "c20": 0.01}
     assert not list(validator.iter_errors(case))
+
+
+def test_a_count_beyond_any_integer_is_refused(validator):
+    # JSON Schema's `integer` is any whole number; the schema bounds counts by u64's range,
+    # as tubemem does (`around = 1e308` is refused by both)
+    case = _squeeze()
+    case["mesh"]["around"] = 1e308
+    e = _refused_at(validator, case)
+    assert list(e.absolute_path) == ["mesh", "around"]

@@ -156,14 +156,33 @@ pub struct Case {
 /// `deny_unknown_fields` refuses them). Editors read it to complete and check TOML (Taplo:
 /// `#:schema ./case.schema.json` on the first line). The cross-key rules (a squeeze needs
 /// `target_rho`, a law's parameter ranges) stay with [`Case::parse`].
+///
+/// A count (`"format": "uint"`) gets the largest value it can hold as its `maximum`, so that
+/// `around = 1e308` is refused as tubemem refuses it. JSON Schema's `integer` is any number
+/// with no fractional part, so a whole float written for a count (`around = 16.0`) passes a
+/// JSON validator; TOML-aware editors, and tubemem, refuse it.
 pub fn schema() -> serde_json::Value {
+    fn bound_counts(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                if m.get("format").and_then(|f| f.as_str()) == Some("uint") {
+                    m.insert("maximum".into(), u64::MAX.into());
+                }
+                m.values_mut().for_each(bound_counts);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(bound_counts),
+            _ => {}
+        }
+    }
     let mut schema = schemars::schema_for!(Case);
     schema.insert("title".into(), "tubemem case file".into());
     schema.insert(
         "description".into(),
         "A tubemem case: the tube ([geometry]), its law ([material]), its mesh ([mesh]), the solver, the outputs, the units and the stages ([[stage]]).".into(),
     );
-    schema.to_value()
+    let mut value = schema.to_value();
+    bound_counts(&mut value);
+    value
 }
 
 /// A member run's output defaults (a verify member, an atlas member), written into its case

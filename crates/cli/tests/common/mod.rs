@@ -94,10 +94,47 @@ pub fn spawn_run(case: &Path, out: &Path) -> std::process::Child {
 
 /// A scratch folder `name` with `text` as its `case.toml`; the case file's path.
 pub fn write_case(name: &str, text: &str) -> PathBuf {
+    check_against_schema(text);
     let d = tmp(name);
     let p = d.join("case.toml");
     std::fs::write(&p, text).unwrap();
     p
+}
+
+/// The case-file schema of `tubemem schema` (`tubemem_app::case::schema`), compiled once.
+fn schema() -> &'static jsonschema::Validator {
+    static V: std::sync::OnceLock<jsonschema::Validator> = std::sync::OnceLock::new();
+    V.get_or_init(|| {
+        jsonschema::validator_for(&tubemem_app::case::schema())
+            .expect("the case schema is a valid JSON Schema")
+    })
+}
+
+/// Every case a test writes is held to `tubemem schema` both ways: a case the schema refuses
+/// is one tubemem refuses, and a case the schema takes is not refused for its keys or types
+/// (a `CaseError::Syntax`); the cross-key rules (a squeeze needs `target_rho`, ranges) are
+/// `Case::parse`'s alone. A TOML syntax error is left to the test that wrote it.
+pub fn check_against_schema(text: &str) {
+    let Ok(value) = text.parse::<toml::Table>() else {
+        return;
+    };
+    let json = serde_json::to_value(&value).expect("TOML converts to JSON");
+    let parsed = tubemem_app::case::Case::parse(text);
+    let refusal = schema()
+        .iter_errors(&json)
+        .next()
+        .map(|e| format!("{e} at {}", e.instance_path()));
+    match refusal {
+        Some(e) => assert!(
+            parsed.is_err(),
+            "the schema refuses a case tubemem takes ({e})"
+        ),
+        None => assert!(
+            !matches!(parsed, Err(tubemem_app::case::CaseError::Syntax(_))),
+            "the schema takes a case whose keys or types tubemem refuses: {}",
+            parsed.err().map(|e| e.to_string()).unwrap_or_default()
+        ),
+    }
 }
 
 /// The small tube shared with the Python tests.
@@ -145,6 +182,7 @@ pub fn edit(text: &str, from: &str, to: &str) -> String {
 /// Case `text` written as `dir/NAME.toml` and run into `dir/NAME` with `extra` arguments:
 /// (case file, run folder, the run's output).
 pub fn run_text(dir: &Path, name: &str, text: &str, extra: &[&str]) -> (PathBuf, PathBuf, Output) {
+    check_against_schema(text);
     let case = dir.join(format!("{name}.toml"));
     std::fs::write(&case, text).unwrap();
     let out = dir.join(name);
