@@ -160,7 +160,7 @@ pub struct Case {
 /// A count (`"format": "uint"`) gets the largest value it can hold as its `maximum`, so that
 /// `around = 1e308` is refused as tubemem refuses it. JSON Schema's `integer` is any number
 /// with no fractional part, so a whole float written for a count (`around = 16.0`) passes a
-/// JSON validator; TOML-aware editors, and tubemem, refuse it.
+/// JSON validator (and Taplo 0.9); tubemem refuses it.
 pub fn schema() -> serde_json::Value {
     fn bound_counts(v: &mut serde_json::Value) {
         match v {
