@@ -26,7 +26,7 @@ python3 scripts/module-cycles.py
 # the man-page test renders every page with groff, as man does
 if ! command -v groff > /dev/null; then
   echo "== installing groff-base (the man-page test renders the pages with groff)"
-  apt-get install -y -qq groff-base > /dev/null || { sudo -n apt-get install -y -qq groff-base > /dev/null; }
+  apt-get install -y -qq groff-base > /dev/null || sudo -n apt-get install -y -qq groff-base > /dev/null
 fi
 echo "== cargo test (workspace)"
 cargo test --workspace

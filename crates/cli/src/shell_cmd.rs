@@ -58,8 +58,7 @@ fn pages(cmd: &clap::Command, prefix: &str) -> Result<Vec<(String, String, Vec<u
 /// Write `tubemem.1` and a page per subcommand (`tubemem-run.1`, `tubemem-gps-inflate.1`, …)
 /// into `out`. Every page is checked before any is written: a file of that name that is not a
 /// tubemem man page is refused and nothing is written.
-pub fn man_pages(cmd: clap::Command, out: &Path) -> Result<Vec<PathBuf>> {
-    let mut cmd = cmd;
+pub fn man_pages(mut cmd: clap::Command, out: &Path) -> Result<Vec<PathBuf>> {
     cmd.build();
     let pages = pages(&cmd, "")?;
     for (file, title, _) in &pages {

@@ -6,7 +6,7 @@ use super::fit::{law_name, Point};
 use super::member::MemberResult;
 use super::spec::{Atlas, QUANTITIES};
 use super::AtlasError;
-use crate::figures::{Figure, FigureOptions, Markers, Series, Stroke};
+use crate::figures::{series_color, Figure, FigureOptions, Markers, Series, Stroke};
 use plotters::style::RGBColor;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -167,8 +167,6 @@ pub fn nice_levels(values: impl Iterator<Item = f64>) -> Vec<f64> {
     out
 }
 
-use crate::figures::PALETTE as COLORS;
-
 /// The map of the minimum L/R for quantity `q` and the `e`-th ε over (λs*, ρ): contours of
 /// log L/R, the grid points valid (filled) or flagged (hollow).
 pub fn min_length_figure(atlas: &Atlas, points: &[Point], q: &str, e: usize) -> Figure {
@@ -202,7 +200,7 @@ pub fn min_length_figure(atlas: &Atlas, points: &[Point], q: &str, e: usize) -> 
         .map(|(k, &lv)| Series {
             label: format!("L/R = {lv}"),
             points: contour(&xs, &ys, &z, lv.ln()),
-            color: COLORS[k % COLORS.len()],
+            color: series_color(k),
             stroke: Stroke::Solid,
             width: 2,
         })

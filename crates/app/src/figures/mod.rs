@@ -49,7 +49,7 @@ const FE_COLORS: [RGBColor; 3] = [
 ];
 
 /// The colours of a figure's numbered series (the verify kinds' and the atlas's curves).
-pub const PALETTE: [RGBColor; 8] = [
+const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 90, 180),
     RGBColor(200, 50, 40),
     RGBColor(20, 140, 60),
@@ -59,6 +59,11 @@ pub const PALETTE: [RGBColor; 8] = [
     RGBColor(0, 150, 160),
     RGBColor(160, 110, 40),
 ];
+
+/// The colour of a figure's `k`-th series: the eight-colour palette, cycled.
+pub fn series_color(k: usize) -> RGBColor {
+    PALETTE[k % PALETTE.len()]
+}
 
 /// The figure canvas in pixels at [`BASE_DPI`].
 pub const CANVAS: (u32, u32) = (1100, 760);

@@ -3,9 +3,9 @@
 //! tube at a length the atlas did not use, and the measured FE/GPS − 1 of each quantity must
 //! agree with the law's prediction c + A f(L/R) within `tolerance.prediction` of the prediction.
 
-use super::{plot, KindResult, COLORS};
+use super::{plot, KindResult};
 use crate::atlas::{self, Atlas, Member};
-use crate::figures::{Figure, Markers, Series, Stroke};
+use crate::figures::{series_color, Figure, Markers, Series, Stroke};
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use std::path::Path;
@@ -102,7 +102,7 @@ fn atlas_point(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult)
             serde_json::json!({"measured": measured, "predicted": predicted, "fit": point.fit, "errors": point.errors}),
         );
         let fit = point.fit.expect("a prediction has a fit");
-        let color = COLORS[k % COLORS.len()];
+        let color = series_color(k);
         let mut pts: Vec<(f64, f64)> = a
             .spec
             .lengths

@@ -1,8 +1,8 @@
 //! `closed-form`: the mid-span against GPS at every step (and the section under the FE's own
 //! pressure for a squeeze), per-quantity relative tolerances; PS reported.
 
-use super::{member, plot, rel, KindResult, COLORS};
-use crate::figures::{Figure, Series, Stroke};
+use super::{member, plot, rel, KindResult};
+use crate::figures::{series_color, Figure, Series, Stroke};
 use crate::quantity::step_pair;
 use crate::report::StepRecord;
 use crate::verify::suite::Check;
@@ -115,7 +115,7 @@ fn closed_form(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult
         series.push(Series {
             label: format!("{q}: |FE/GPS − 1| / tolerance"),
             points: pts,
-            color: COLORS[k % COLORS.len()],
+            color: series_color(k),
             stroke: Stroke::Solid,
             width: 2,
         });

@@ -1,8 +1,8 @@
 //! `convergence`: a mesh family: observed order, Richardson extrapolation and GCI
 //! ([`stats::gci`](crate::stats::gci)), the reference within the extrapolated value ± GCI.
 
-use super::{plot, rel, KindResult, COLORS};
-use crate::figures::{Figure, Series, Stroke};
+use super::{plot, rel, KindResult};
+use crate::figures::{series_color, Figure, Series, Stroke};
 use crate::quantity::{final_value, step_pair};
 use crate::verify::suite::Check;
 use crate::verify::{run_member, stats, vary, CheckResult, Measure, VerifyOptions};
@@ -131,7 +131,7 @@ fn convergence(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult
                 series.push(Series {
                     label: format!("{q}: φ/φ_finest − 1 (oscillatory)"),
                     points: against(phi[0]),
-                    color: COLORS[qi % COLORS.len()],
+                    color: series_color(qi),
                     stroke: Stroke::Dashed,
                     width: 2,
                 });
@@ -210,7 +210,7 @@ fn convergence(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult
                 series.push(Series {
                     label,
                     points: against(reference_value),
-                    color: COLORS[qi % COLORS.len()],
+                    color: series_color(qi),
                     stroke: Stroke::Solid,
                     width: 2,
                 });

@@ -1,8 +1,8 @@
 //! `end-effect`: a length family: the mid-span error against GPS fitted to c + A exp(−k L/R)
 //! (open inflation) or c + A/(L/R) (gas-closed squeeze) ([`stats`](crate::stats)).
 
-use super::{plot, rel, KindResult, COLORS};
-use crate::figures::{Figure, Markers, Series, Stroke};
+use super::{plot, rel, KindResult};
+use crate::figures::{series_color, Figure, Markers, Series, Stroke};
 use crate::quantity::step_pair;
 use crate::verify::suite::Check;
 use crate::verify::{run_member, stats, vary, CheckResult, Measure, VerifyOptions};
@@ -166,7 +166,7 @@ fn end_effect(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult)
                 .zip(errs)
                 .map(|(l, e)| (*l, log(e - f.c)))
                 .collect(),
-            color: COLORS[k % COLORS.len()],
+            color: series_color(k),
             hollow: false,
         });
         series.push(Series {
@@ -181,7 +181,7 @@ fn end_effect(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult)
                     (l, log(f.end_effect(l)))
                 })
                 .collect(),
-            color: COLORS[k % COLORS.len()],
+            color: series_color(k),
             stroke: Stroke::Solid,
             width: 2,
         });

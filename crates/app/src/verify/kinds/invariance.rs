@@ -1,8 +1,8 @@
 //! `invariance`: the middle region within which every profile quantity stays within ε of its
 //! mid-span value, at every step.
 
-use super::{member, plot, KindResult, COLORS};
-use crate::figures::{Figure, Series, Stroke};
+use super::{member, plot, KindResult};
+use crate::figures::{series_color, Figure, Series, Stroke};
 use crate::report::StepRecord;
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
@@ -154,14 +154,14 @@ fn invariance(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult)
             std::iter::once(Series {
                 label: format!("core within ε = {eps:e}"),
                 points: pts.clone(),
-                color: COLORS[0],
+                color: series_color(0),
                 stroke: Stroke::Solid,
                 width: 2,
             })
             .chain(tol.as_ref().map(|t| Series {
                 label: "required".into(),
                 points: vec![(1.0, t.value), (pts.len().max(1) as f64, t.value)],
-                color: COLORS[1],
+                color: series_color(1),
                 stroke: Stroke::Dashed,
                 width: 2,
             }))

@@ -13,9 +13,9 @@
 //! penetration are reported too. Its families need finer meshes (32 to 256 around; measured in
 //! crates/fem/tests/manufactured.rs).
 
-use super::{plot, KindResult, COLORS};
+use super::{plot, KindResult};
 use crate::case::Case;
-use crate::figures::{Figure, Series, Stroke};
+use crate::figures::{series_color, Figure, Series, Stroke};
 use crate::verify::suite::Check;
 use crate::verify::{vary, CheckResult, Measure, VerifyOptions};
 use std::path::Path;
@@ -261,7 +261,7 @@ fn manufactured(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResul
                 .iter()
                 .map(|e| ((e.around as f64).log10(), m(e).log10()))
                 .collect(),
-            color: COLORS[i % COLORS.len()],
+            color: series_color(i),
             stroke: Stroke::Solid,
             width: 2,
         })

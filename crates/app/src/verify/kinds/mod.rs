@@ -100,8 +100,6 @@ fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
 }
 
-pub(crate) use crate::figures::PALETTE as COLORS;
-
 /// Draw a small figure to PNG bytes (for the HTML report).
 fn plot(fig: &Figure, r: &mut CheckResult) {
     r.figure = Some(crate::figures::audit(fig));

@@ -7,9 +7,9 @@
 //! law without relaxation, which carries the compression); their orders and the smallest hoop
 //! resultant reported.
 
-use super::{plot, KindResult, COLORS};
+use super::{plot, KindResult};
 use crate::case::Case;
-use crate::figures::{Figure, Markers, Series, Stroke};
+use crate::figures::{series_color, Figure, Markers, Series, Stroke};
 use crate::verify::suite::Check;
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use std::path::Path;
@@ -144,21 +144,21 @@ fn tension_field(c: &Check, _dir: &Path, _opts: &VerifyOptions, r: &mut CheckRes
             Annulus::tension_field,
             0,
             "N_rr, tension field",
-            COLORS[0],
+            series_color(0),
             Stroke::Solid,
         ),
         fine(
             Annulus::tension_field,
             1,
             "N_θθ, tension field",
-            COLORS[1],
+            series_color(1),
             Stroke::Solid,
         ),
         fine(
             Annulus::lame,
             1,
             "N_θθ, Lamé (no wrinkles)",
-            COLORS[5],
+            series_color(5),
             Stroke::Dashed,
         ),
     ];
@@ -171,7 +171,7 @@ fn tension_field(c: &Check, _dir: &Path, _opts: &VerifyOptions, r: &mut CheckRes
                 .step_by(7)
                 .map(|p| (p.r, p.n_rr / a.t_out))
                 .collect(),
-            color: COLORS[0],
+            color: series_color(0),
             hollow: true,
         },
         Markers {
@@ -182,7 +182,7 @@ fn tension_field(c: &Check, _dir: &Path, _opts: &VerifyOptions, r: &mut CheckRes
                 .step_by(7)
                 .map(|p| (p.r, p.n_tt / a.t_out))
                 .collect(),
-            color: COLORS[1],
+            color: series_color(1),
             hollow: true,
         },
     ];
