@@ -27,6 +27,7 @@
 pub mod atlas;
 pub mod case;
 pub mod checkpoint;
+pub mod columns;
 pub mod curves;
 pub mod edge_fit;
 pub mod edge_track;

@@ -19,6 +19,10 @@
 //! overwrite it, so frames of an earlier run can never mix with a new one.
 
 use crate::checkpoint::{read_checkpoint, write_checkpoint, Checkpoint};
+pub use crate::columns::{
+    CRITICAL_HEADER, FRONTS_HEADER, ITERATIONS_HEADER, PROFILES_HEADER, PROFILE_HEADER, SI_HEADER,
+    STEPS_HEADER, WALLS_HEADER,
+};
 use crate::observer::{BoxError, Observer, StepView};
 use crate::report::{RunReport, StepRecord};
 use crate::{AppError, Result};
@@ -28,13 +32,6 @@ use std::path::{Path, PathBuf};
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::post::{cell_contact_pressure, cell_values, regime_code, RingValues};
 use tubemem_mesh::vtu::{write_pvd, write_vtu, Field, FieldValue};
-
-/// The columns of steps.csv. New columns are only ever appended.
-pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volume,newton_iterations,negative_pivots,rho,chi,chi_geometric,force,displacement,contact_pressure,penetration,\
-gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
-arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
-augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,\
-mesh_refits";
 
 /// The `critical` column of steps.csv: the kind of a critical point located between the
 /// previous step and this one (empty: none).
@@ -99,16 +96,6 @@ pub fn front_rows(row: usize, r: &StepRecord) -> Vec<[f64; 7]> {
         })
         .collect()
 }
-
-/// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
-/// bifurcation, as steps.csv's `critical`).
-/// iterations.csv (`[output] iterations = true`): one row per Newton linearization (the
-/// iterations and each solve's converged check), seconds; `row` is the steps.csv row of the
-/// step they led to (a resumed run trims the rows past its checkpoint).
-pub const ITERATIONS_HEADER: &str =
-    "row,stage,step,iteration,assembly_s,line_search_s,factorization_s,solve_s,residual,negative_pivots";
-
-pub const CRITICAL_HEADER: &str = "stage,step,kind,arc_length,bracket,w,lambda_s,lambda_z,volume,negative_pivots_before,negative_pivots_after,reference_w,reference_lambda_s,polygon_factor,w_error_over_polygon,mode_eigenvalue";
 
 /// The values of one steps.csv row, `None` for an empty field.
 pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
@@ -179,16 +166,6 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
     v.push(r.edge_tracking.as_ref().map(|t| t.refits as f64));
     v
 }
-
-/// The columns of fronts.csv: one line per bulge front per step (`row` is the step's row in
-/// steps.csv; `front` counts from the lowest Z).
-pub const FRONTS_HEADER: &str = "row,stage,step,w,volume,front,z_ref";
-
-/// One steps.csv line of a step (integers as integers, empty fields for what it lacks).
-/// The SI columns steps.csv adds after [`STEPS_HEADER`] with `[units] system = "SI"`: the
-/// mid-span pressure p = ϖ μH/R, the resultants n μH, and in a squeeze the plate force per
-/// length force · πμH and the plates' half-gap ρR.
-pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m";
 
 /// steps.csv's header: [`STEPS_HEADER`], and [`SI_HEADER`] with units.
 pub(crate) fn steps_header(units: bool) -> String {
@@ -938,18 +915,6 @@ impl Mirror {
         self.signs.iter().flat_map(|_| v.iter().copied()).collect()
     }
 }
-
-/// The columns of a stage-end profile (one row per ring).
-pub const PROFILE_HEADER: &str =
-    "z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width,contact_force";
-/// The columns of profiles.csv: the step's row in steps.csv, its stage and step, then
-/// [`PROFILE_HEADER`].
-/// The columns of walls.csv (confine stages): the step's row in steps.csv, stage, step, the
-/// wall (1-based, the case's order), the FE's mid-span contact length, force per length over π
-/// and penetration, then GPS for the same walls and GPS under the FE's pressure.
-pub const WALLS_HEADER: &str = "row,stage,step,wall,contact_length,force,penetration,gps_contact_length,gps_force,local_contact_length,local_force";
-pub const PROFILES_HEADER: &str =
-    "row,stage,step,z_ref,z,radius,lambda_s,lambda_z,n_s,n_z,n_sz,contact_width,contact_force";
 
 /// The values of one ring, in [`PROFILE_HEADER`]'s order.
 pub fn ring_row(r: &RingValues) -> [f64; 10] {

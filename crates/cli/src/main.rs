@@ -115,6 +115,9 @@ enum Command {
     /// Print the JSON Schema of case files (for editors: Taplo and Even Better TOML complete
     /// and check a case file with `#:schema ./case.schema.json` on its first line).
     Schema,
+    /// Print the column dictionary of the CSV files a run writes (steps.csv, profiles,
+    /// walls.csv, critical_points.csv, fronts.csv, iterations.csv) as Markdown tables.
+    Columns,
     /// Print the shell completion script for bash, zsh, fish, elvish or PowerShell, generated
     /// from these options (bash: `source <(tubemem completions bash)`).
     Completions {
@@ -306,6 +309,10 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Schema) => {
             let text = serde_json::to_string_pretty(&tubemem_app::case::schema())?;
             tubemem_cli::say!("{text}")?;
+            Ok(())
+        }
+        Some(Command::Columns) => {
+            tubemem_cli::say!("{}", tubemem_app::columns::markdown().trim_end())?;
             Ok(())
         }
         Some(Command::Completions { shell }) => {

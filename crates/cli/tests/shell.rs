@@ -1,5 +1,6 @@
 //! `tubemem completions` and `tubemem man`: the generated completion scripts complete what the
-//! program takes, and the man pages cover every subcommand and render without a warning.
+//! program takes, and the man pages cover every subcommand and render without a warning;
+//! `tubemem columns` documents every column a real run writes.
 
 mod common;
 use common::{tmp, tubemem};
@@ -22,6 +23,7 @@ const PAGES: &[&str] = &[
     "tubemem-export",
     "tubemem-figures",
     "tubemem-schema",
+    "tubemem-columns",
     "tubemem-completions",
     "tubemem-man",
 ];
@@ -160,4 +162,40 @@ fn the_man_pages_cover_every_subcommand_and_render_without_warnings() {
     );
     assert!(!dir.join("tubemem-run.1").exists(), "nothing was written");
     let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn the_column_dictionary_documents_every_column_a_run_writes() {
+    let dir = tmp("columns");
+    let _ = std::fs::remove_dir_all(&dir);
+    let case = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../cases/small_abb30_ls1.2.toml"
+    );
+    let out = tubemem(&["run", case, "--out", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dictionary = String::from_utf8(tubemem(&["columns"]).stdout).unwrap();
+    for (file, name) in [
+        ("steps.csv", "steps.csv"),
+        ("profiles/profiles.csv", "profiles/profiles.csv"),
+        ("profiles/stage1_final.csv", "profiles/stageN_final.csv"),
+    ] {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let header = text.lines().next().unwrap();
+        for column in header.split(',') {
+            assert!(
+                dictionary.contains(&format!("| `{column}` |")),
+                "{file}: column {column} is not in `tubemem columns`"
+            );
+        }
+        assert!(
+            dictionary.contains(&format!("## `{name}`")),
+            "no section for {name}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
