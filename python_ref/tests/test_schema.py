@@ -86,3 +86,37 @@ def test_a_count_beyond_any_integer_is_refused(validator):
     case["mesh"]["around"] = 1e308
     e = _refused_at(validator, case)
     assert list(e.absolute_path) == ["mesh", "around"]
+
+
+# --- summary.json: `tubemem schema --summary` ----------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def summary_validator(tubemem_exe):
+    out = subprocess.run(
+        [tubemem_exe, "schema", "--summary"], capture_output=True, text=True, check=True
+    )
+    schema = json.loads(out.stdout)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    return jsonschema.Draft202012Validator(schema)
+
+
+@pytest.mark.parametrize("name", ["small_abb30_ls1.2", "channel_abb30_ls1.3"])
+def test_a_runs_summary_validates_and_a_damaged_one_is_refused(
+    summary_validator, tubemem_exe, tmp_path, name
+):
+    out = tmp_path / name
+    subprocess.run(
+        [tubemem_exe, "run", str(ROOT / "cases" / f"{name}.toml"), "--out", str(out)],
+        capture_output=True,
+        check=True,
+    )
+    summary = json.loads((out / "summary.json").read_text())
+    errors = [f"{list(e.absolute_path)}: {e.message}" for e in summary_validator.iter_errors(summary)]
+    assert not errors, errors
+    damaged = json.loads(json.dumps(summary))
+    damaged["stages"][0]["final"]["w"] = "high"
+    assert list(summary_validator.iter_errors(damaged)), "a string for ϖ was taken"
+    damaged = json.loads(json.dumps(summary))
+    del damaged["stages"]
+    assert list(summary_validator.iter_errors(damaged)), "a summary without stages was taken"

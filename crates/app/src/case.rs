@@ -445,7 +445,9 @@ pub struct PlaneSpec {
     #[serde(deserialize_with = "two_components")]
     #[schemars(with = "[f64; 2]")]
     pub normal: [f64; 2],
+    /// d at the stage's start
     pub offset: f64,
+    /// d at the stage's end
     pub target: f64,
 }
 
@@ -562,7 +564,7 @@ fn default_steps() -> usize {
 /// What a stage drives, once validated. Written (summary.json) under the case file's own key,
 /// `{"key": "target_stretch", "value": 1.3}` (it had been `{"control": "stretch", …}`, which
 /// read as a control the case never named: issue #24 item 11; the old names are read too).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "key", content = "value")]
 pub enum Target {
     /// reduced pressure ϖ, pressure control
@@ -636,7 +638,7 @@ impl StagePlan {
 }
 
 /// How the contact penalty of a squeeze is set.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PenaltySpec {
     /// κ given
@@ -646,7 +648,7 @@ pub enum PenaltySpec {
 }
 
 /// A stage resolved once by validation: what the run executes.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StagePlan {
     /// 1-based
     pub index: usize,

@@ -11,11 +11,15 @@ use tubemem_gps::{FlatteningState, InflationState, SectionState};
 use tubemem_material::MaterialSpec;
 
 /// What the mesh and model are.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct MeshInfo {
+    /// nodes of the mesh
     pub nodes: usize,
+    /// elements of the mesh
     pub elements: usize,
+    /// equations (free degrees of freedom)
     pub equations: usize,
+    /// the symmetry reduction: "none", "half", "quarter" or "eighth"
     pub symmetry: String,
     /// "quad4" or "quad9"
     #[serde(default)]
@@ -31,13 +35,16 @@ pub struct MeshInfo {
     pub contact_edge_fit: Option<ContactEdgeFit>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct GeometryInfo {
+    /// the reference radius R (the case's units; 1 when dimensionless)
     pub radius: f64,
+    /// the cylinder's length L between the cap junctions
     pub length: f64,
     /// as the case gave it (no value is made up when it did not)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness: Option<f64>,
+    /// "hemisphere" or "rigid-plug"
     pub caps: String,
 }
 
@@ -46,7 +53,7 @@ pub struct GeometryInfo {
 /// mid-span pressure (eq. 76 without the gas law: the local mechanics, free of the end effect
 /// that acts through the shared gas). A closed form without a solution is `None` (the run goes
 /// on; the stage summary says why).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct StepClosedForm {
     pub gps_inflation: Option<InflationState>,
     pub gps_flattening: Option<FlatteningState>,
@@ -61,7 +68,7 @@ pub struct StepClosedForm {
 }
 
 /// Contact values of a squeeze step (mid-span, [`ContactValues`]) with the displacement λs* − ρ.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct ContactRecord {
     #[serde(flatten)]
     pub values: ContactValues,
@@ -73,7 +80,7 @@ pub struct ContactRecord {
 }
 
 /// One converged step.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct StepRecord {
     pub stage: usize,
     pub step: usize,
@@ -130,7 +137,7 @@ pub struct StepRecord {
 
 /// Where the mesh of a step with `[mesh] track_contact_edge` was fitted
 /// ([`crate::edge_track`]).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, schemars::JsonSchema, serde::Deserialize)]
 pub struct EdgeTracking {
     /// the contact edges the hoop node lines lie on (reference angles from the x axis,
     /// radians; empty: the uniform mesh, no contact)
@@ -227,7 +234,7 @@ pub fn nonuniformity(rings: &[RingValues], half: f64) -> Option<f64> {
 pub const RIPPLE: f64 = 1e-4;
 
 /// The closed-form value a located limit point is compared with.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct CriticalReference {
     /// "GPS limit point (maximum)", "GPS limit point (minimum)" or "Maxwell pressure"
     pub what: String,
@@ -237,26 +244,30 @@ pub struct CriticalReference {
 }
 
 /// Where an arc-length step is on its path.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct ArcValues {
     pub arc_length: f64,
     pub dw_ds: f64,
 }
 
 /// The final state of a stage (the `final` entry of summary.json).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct StageFinal {
     #[serde(flatten)]
     pub midspan: MidSpan,
+    /// Newton iterations of the stage's last step
     pub newton_iterations: usize,
+    /// converged steps of the stage
     pub stage_steps: usize,
+    /// Newton iterations of the whole stage
     pub stage_newton_iterations: usize,
+    /// negative pivots of the stiffness at the stage's end (0: stable)
     pub negative_pivots: usize,
     #[serde(skip_serializing_if = "Option::is_none", flatten)]
     pub contact: Option<FinalContact>,
 }
 
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct FinalContact {
     pub rho: f64,
     pub chi: f64,
@@ -265,13 +276,16 @@ pub struct FinalContact {
     pub displacement: f64,
     pub contact_pressure: f64,
     pub penetration: f64,
+    /// the total force on one plate (all symmetry copies, caps included), over μH R
     pub total_plate_force: f64,
+    /// the contact penalty κ the stage used
     pub penalty: f64,
+    /// the mid-span λs* at the start of the squeeze
     pub initial_stretch: f64,
 }
 
 /// Relative errors FE − closed form (inflation: w, λz, N_s, N_z; squeeze: w, λs, λz, χ, force).
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, schemars::JsonSchema, Deserialize)]
 #[serde(default)]
 pub struct RelativeErrors {
     pub w: Option<f64>,
@@ -290,7 +304,7 @@ pub struct RelativeErrors {
 }
 
 /// A closed-form state of either kind.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 #[serde(untagged)]
 pub enum ClosedFormState {
     // (untagged: deserialization tries the variants in order, so the larger one comes first)
@@ -300,7 +314,7 @@ pub enum ClosedFormState {
 }
 
 /// The section at the FE's pressure, or why it has no solution.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 #[serde(untagged)]
 pub enum LocalSection {
     Solved(SectionState),
@@ -308,40 +322,55 @@ pub enum LocalSection {
 }
 
 /// Elements in one regime at a stage end, with the range of reference height they occupy.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct RegimeExtent {
+    /// how many elements are in the regime
     pub elements: usize,
+    /// the lowest reference height Z they reach
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_ref_min: Option<f64>,
+    /// the highest reference height Z they reach
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_ref_max: Option<f64>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct Wrinkling {
+    /// elements wrinkled at the stage end (N1 > 0 ≥ N2)
     pub wrinkled: RegimeExtent,
+    /// elements slack at the stage end (N1 ≤ 0)
     pub slack: RegimeExtent,
 }
 
 /// The summary of a finished stage (one entry of summary.json's `stages`).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct StageSummary {
+    /// the stage, from 1 in the case file's order
     pub index: usize,
+    /// "inflate", "squeeze" or "confine"
     pub kind: String,
     /// the case file's `control` ([`crate::case::StagePlan::control`])
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<String>,
+    /// the stage's target in the case file's words: `{key, value}`
     pub target: Target,
+    /// the FE mid-span state at the stage's end
     #[serde(rename = "final")]
     pub final_state: StageFinal,
+    /// the distance from the cap junction beyond which λs stays within 0.1 % of its mid-span value (R)
     #[serde(rename = "cap_boundary_layer_0.1pct")]
     pub cap_boundary_layer: Option<f64>,
+    /// the elements wrinkled and slack at the stage end
     pub wrinkling: Wrinkling,
     /// the profile CSV, relative to the run folder
     pub profile: String,
+    /// the GPS closed form at the same λs (inflation) or ρ from the run's λs* (squeeze, eqs. 76–77), or in the same walls (confine)
     pub gps: ClosedFormState,
+    /// the plane-strain closed form (λz = 1) at the same λs or ρ (eqs. 70, 78–79)
     pub ps: ClosedFormState,
+    /// FE/GPS − 1 of each quantity
     pub relative_error_vs_gps: RelativeErrors,
+    /// FE/PS − 1 of each quantity
     pub relative_error_vs_ps: RelativeErrors,
     /// the GPS section under the FE's own mid-span pressure: `local` as in steps.csv's
     /// `local_*` columns (the old key `gps_at_fe_pressure` is read too)
@@ -356,6 +385,7 @@ pub struct StageSummary {
         alias = "relative_error_vs_gps_at_fe_pressure",
         skip_serializing_if = "Option::is_none"
     )]
+    /// FE/local − 1: against the GPS section under the FE's own pressure
     pub relative_error_vs_gps_at_fe_pressure: Option<RelativeErrors>,
     /// a confine stage: each wall at the end, FE against GPS and the section at the FE's
     /// pressure
@@ -376,15 +406,19 @@ pub struct StageSummary {
     /// `gps_not_applicable` says why
     pub nonuniformity: Option<f64>,
     pub gps_applicable: bool,
+    /// why the comparison with the closed form does not apply (absent when it does)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gps_not_applicable: Option<String>,
 }
 
 /// One wall at the end of a confine stage.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct WallSummary {
+    /// the FE's mid-span contact on the wall
     pub fe: WallValues,
+    /// GPS for the same walls from the run's λs*
     pub gps: Option<tubemem_gps::confine::WallContact>,
+    /// GPS in the same walls under the FE's own pressure
     pub local: Option<tubemem_gps::confine::WallContact>,
     /// FE/GPS − 1 of the force per unit length
     pub force_error_vs_gps: Option<f64>,
@@ -392,14 +426,18 @@ pub struct WallSummary {
         rename = "force_error_vs_local",
         alias = "force_error_vs_gps_at_fe_pressure"
     )]
+    /// FE/local − 1 of the force per unit length
     pub force_error_vs_gps_at_fe_pressure: Option<f64>,
 }
 
 /// A stage that failed: its error and the last converged mid-span state.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct StageFailure {
+    /// the stage, from 1
     pub index: usize,
+    /// the error, with its stage, step and cause
     pub error: String,
+    /// the last converged mid-span state (absent: none converged)
     pub last_converged: Option<MidSpan>,
     /// the critical points an arc-length stage located before it failed
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -408,11 +446,13 @@ pub struct StageFailure {
 
 /// A critical point located on an arc-length stage's path
 /// ([`tubemem_fem::continuation`]): a limit point of the pressure or a bifurcation.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct CriticalRecord {
+    /// the stage, from 1
     pub stage: usize,
     /// it lies between the stage's converged steps `step − 1` and `step`
     pub step: usize,
+    /// "limit-max", "limit-min", "bifurcation" or "neutral"
     pub kind: tubemem_fem::continuation::CriticalKind,
     /// the path's arc length from the stage start (scaled norm: RMS displacement in R, ϖ)
     pub arc_length: f64,
@@ -423,6 +463,7 @@ pub struct CriticalRecord {
     pub midspan: MidSpan,
     /// negative pivots of the pressure-control stiffness before and after the point
     pub negative_pivots_before: usize,
+    /// negative pivots of the pressure-control stiffness after the point
     pub negative_pivots_after: usize,
     /// a limit point: the closed form it is compared with — the Maxwell pressure when the
     /// mid-span λs is beyond the uniform curve's minimum (the mid-span then sits in the upper
@@ -432,8 +473,10 @@ pub struct CriticalRecord {
     /// the end effect plus the discretization error beyond the facets'
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<CriticalReference>,
+    /// the mesh's polygon factor 1/cos(π/n)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polygon_factor: Option<f64>,
+    /// ϖ over the reference ϖ divided by the polygon factor, minus one
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub w_error_over_polygon: Option<f64>,
     /// a limit point within [`RIPPLE`] (relative, in ϖ) of the stage's previous one: the
@@ -444,6 +487,7 @@ pub struct CriticalRecord {
     /// VTU holding its mode (field `mode`), relative to the run folder
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mode_eigenvalue: Option<f64>,
+    /// the VTU holding the mode (point field `mode`), relative to the run folder
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mode_vtu: Option<String>,
     /// the same mode along the tube as a PNG (the ring means of its radial and axial
@@ -453,7 +497,7 @@ pub struct CriticalRecord {
 }
 
 /// One stage of the report: its plan, its steps and how it ended.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct StageReport {
     pub plan: StagePlan,
     pub steps: Vec<StepRecord>,
@@ -462,7 +506,7 @@ pub struct StageReport {
     pub profile: Vec<RingValues>,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 #[serde(untagged)]
 pub enum StageOutcome {
     Finished(Box<StageSummary>),
@@ -470,7 +514,7 @@ pub enum StageOutcome {
 }
 
 /// A whole run.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, schemars::JsonSchema, Deserialize)]
 pub struct RunReport {
     pub case: String,
     pub mesh: MeshInfo,
@@ -493,20 +537,28 @@ pub struct RunReport {
 }
 
 /// summary.json: the report without the steps and profiles.
-#[derive(Serialize)]
+#[derive(Serialize, schemars::JsonSchema)]
 pub struct Summary<'a> {
+    /// what the run noticed that a user should know, in order (absent: nothing)
     #[serde(skip_serializing_if = "<[String]>::is_empty")]
     pub warnings: &'a [String],
     /// the tubemem version that ran the case, and the case text's hash (as run.json)
     pub tubemem_version: &'static str,
+    /// the hash of the case text, as in run.json and the VTU field data
     pub case_hash: &'a str,
+    /// the case file's path as given to the run
     pub case: &'a str,
+    /// the mesh and its factorization
     pub mesh: &'a MeshInfo,
+    /// the law's name with its parameters, in words
     pub material: &'a str,
+    /// the law as the case file's `[material]` table
     pub material_spec: &'a MaterialSpec,
+    /// the tube: radius, length, thickness and caps as run
     pub geometry: &'a GeometryInfo,
     /// the text of [`UNITS`] without `[units]`; with it, the scales and the SI factors
     pub units: serde_json::Value,
+    /// each stage in order: its summary when it finished, its failure otherwise
     pub stages: Vec<&'a StageOutcome>,
     /// with `[units]`: each finished stage's final state in SI
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -515,7 +567,7 @@ pub struct Summary<'a> {
 
 /// A state in SI units (`[units] system = "SI"`): p = ϖ μH/R (eq. 67), N = n μH, the plate
 /// force per length F = force · πμH (eq. 80), lengths times R.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Serialize, schemars::JsonSchema, Deserialize, PartialEq)]
 pub struct SiValues {
     pub pressure_pa: f64,
     pub n_s_n_per_m: f64,
@@ -607,7 +659,7 @@ pub fn rel(fe: f64, cf: f64) -> f64 {
 }
 
 /// Where the fitted node lines go (`[mesh] fit_contact_edge`, [`crate::edge_fit`]).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, schemars::JsonSchema, serde::Deserialize)]
 pub struct ContactEdgeFit {
     /// the contact edges' reference angles, from the x axis, in [0, 2π) (radians)
     pub edges: Vec<f64>,
@@ -631,4 +683,15 @@ impl RunOutcome {
             Some(e) => Err(e),
         }
     }
+}
+
+/// The JSON Schema of summary.json, with each key's meaning from the doc comments of the types
+/// it is written from ([`Summary`]): the book's summary.json reference is generated from it.
+pub fn summary_schema() -> serde_json::Value {
+    // the schema of what is written (a key skipped when empty is optional), not of what is read
+    let generator = schemars::generate::SchemaSettings::draft2020_12()
+        .for_serialize()
+        .into_generator();
+    serde_json::to_value(generator.into_root_schema_for::<Summary<'static>>())
+        .expect("a schema is JSON")
 }

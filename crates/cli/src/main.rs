@@ -114,7 +114,11 @@ enum Command {
     },
     /// Print the JSON Schema of case files (for editors: Taplo and Even Better TOML complete
     /// and check a case file with `#:schema ./case.schema.json` on its first line).
-    Schema,
+    Schema {
+        /// Print the schema of a run's summary.json instead, each key with its meaning.
+        #[arg(long)]
+        summary: bool,
+    },
     /// Print the column dictionary of the CSV files a run writes (steps.csv, profiles,
     /// walls.csv, critical_points.csv, fronts.csv, iterations.csv) as Markdown tables.
     Columns,
@@ -306,8 +310,13 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Atlas(_)) => anyhow::bail!("internal: `atlas` is dispatched in main"),
         Some(Command::Gps { command }) => gps_cmd::run(command),
         Some(Command::Fit(a)) => tubemem_cli::fit_cmd::run(a),
-        Some(Command::Schema) => {
-            let text = serde_json::to_string_pretty(&tubemem_app::case::schema())?;
+        Some(Command::Schema { summary }) => {
+            let schema = if summary {
+                tubemem_app::report::summary_schema()
+            } else {
+                tubemem_app::case::schema()
+            };
+            let text = serde_json::to_string_pretty(&schema)?;
             tubemem_cli::say!("{text}")?;
             Ok(())
         }

@@ -42,7 +42,7 @@ impl Plane {
 }
 
 /// How the planes are enforced.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 #[serde(tag = "method", rename_all = "kebab-case")]
 pub enum Enforcement {
     /// the penalty alone: the membrane sits about p J/κ inside each plane that presses it

@@ -187,7 +187,9 @@ pub struct Target<'a, S> {
 }
 
 /// The kind of a critical point.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum CriticalKind {
     /// a maximum of the load along the path

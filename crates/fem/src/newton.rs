@@ -142,7 +142,16 @@ impl NewtonReport {
 
 /// The Uzawa updates of the contact multipliers in one solve
 /// ([`crate::contact::Enforcement::Augmented`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    schemars::JsonSchema,
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 pub struct Augmentation {
     /// multiplier updates, each followed by a Newton re-solve
     pub updates: usize,

@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 pub use tubemem_material::relaxed::Regime;
 
 /// Mid-span values, dimensionless (resultants per μH).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MidSpan {
     pub w: f64,
     pub lambda_s: f64,
@@ -392,7 +392,7 @@ pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemE
 }
 
 /// One ring of the cylinder at reference height Z: the [`ring_state`] values there.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RingValues {
     /// reference height Z (in R)
     pub z_ref: f64,
@@ -701,7 +701,7 @@ fn ring_force_per_length(
 }
 
 /// Mid-span contact of one wall of the whole tube.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WallValues {
     /// flat contact length on the wall (zero crossings of the nodal gap, O(h)), per R
     pub contact_length: f64,
@@ -793,7 +793,7 @@ fn element_contact_force(
 }
 
 /// Mid-span contact values of a squeeze, dimensionless.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactValues {
     /// ρ = h/R
     pub rho: f64,

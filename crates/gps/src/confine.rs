@@ -57,7 +57,7 @@ impl Wall {
 }
 
 /// What a wall carries in a state.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WallContact {
     /// flat contact length on the wall, per R
     pub contact_length: f64,
@@ -66,7 +66,7 @@ pub struct WallContact {
 }
 
 /// Which regime the section is in.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Regime {
     Free,
@@ -75,7 +75,7 @@ pub enum Regime {
 }
 
 /// A confined state (dimensionless, R = μH = 1).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ConfineState {
     pub w: f64,
     pub lambda_s: f64,
@@ -86,6 +86,7 @@ pub struct ConfineState {
     pub r: f64,
     /// enclosed area of the section per R²
     pub area: f64,
+    /// "free" (a circle), "stadium" (two parallel walls) or "polygon" (a rounded polygon)
     pub regime: Regime,
     /// the walls in the order given
     pub walls: Vec<WallContact>,

@@ -65,7 +65,7 @@ impl Hypothesis {
 }
 
 /// A free-inflation state (dimensionless).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InflationState {
     /// ϖ = pR/(μH)
     pub w: f64,
@@ -78,7 +78,7 @@ pub struct InflationState {
 }
 
 /// A flattening state (dimensionless).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FlatteningState {
     pub w: f64,
     pub lambda_s: f64,
@@ -96,7 +96,7 @@ pub struct FlatteningState {
 }
 
 /// A GPS cross-section squeezed under a given pressure ([`section_at_pressure`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SectionState {
     pub w: f64,
     pub rho: f64,

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// Reference radius R, undeformed thickness H and shear modulus μ, in any consistent units
 /// (e.g. m, m, Pa → pressures in Pa and forces per length in N/m).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Scales {
     pub radius: f64,
     pub thickness: f64,

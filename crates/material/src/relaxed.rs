@@ -34,7 +34,7 @@ pub struct Relaxed<L> {
 }
 
 /// Which regime a state is in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(schemars::JsonSchema, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Regime {
     Taut,
     Wrinkled,
