@@ -60,3 +60,18 @@ WHEEL_VENV=$(mktemp -d)
 rm -rf "$WHEEL_VENV"
 echo "== pytest: crates/py/tests (the Python API)"
 .venv/bin/python -m pytest crates/py/tests -q
+echo "== the book (docs/): generated pages current, one verification page rerun, mdBook build, links, examples"
+MDBOOK_VERSION=0.5.4
+TOOLS="${TUBEMEM_TOOLS:-$HOME/.cache/tubemem/tools}"
+if ! "$TOOLS/bin/mdbook" --version 2>/dev/null | grep -qx "mdbook v$MDBOOK_VERSION"; then
+  echo "   installing mdbook $MDBOOK_VERSION into $TOOLS (once; several minutes on 2 cores)"
+  cargo install --locked --quiet mdbook --version "$MDBOOK_VERSION" --no-default-features \
+    --features search --root "$TOOLS"
+fi
+export TUBEMEM="$PWD/target/release/tubemem" PYTHON="$PWD/.venv/bin/python"
+python3 scripts/docs.py check
+python3 scripts/docs.py refresh-one invariance
+rm -rf docs/book
+"$TOOLS/bin/mdbook" build docs
+python3 scripts/docs.py linkcheck docs/book
+python3 scripts/docs.py examples
