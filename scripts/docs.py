@@ -603,8 +603,8 @@ FENCE = re.compile(r"^```(\w+)([^\n]*)\n(.*?)^```", re.S | re.M)
 
 def examples():
     """Run every `sh` and `python` block of the user guide (docs/src/guide) and the README, each
-    in a fresh folder holding the repository's cases, verify, examples and python_ref folders as
-    links. A block marked `<!-- example: skip (reason) -->` on the line before it is listed with
+    in a fresh folder holding the repository's cases, verify, examples, python_ref and atlas
+    folders as links. A block marked `<!-- example: skip (reason) -->` on the line before it is listed with
     its reason; one marked `<!-- example: file NAME -->` is written to NAME for the page's other
     blocks."""
     ran, skipped = 0, []
@@ -627,7 +627,7 @@ def examples():
                 skipped.append(f"{where}: {skip}")
                 continue
             with tempfile.TemporaryDirectory() as tmp:
-                for d in ("cases", "verify", "examples", "python_ref"):
+                for d in ("cases", "verify", "examples", "python_ref", "atlas"):
                     os.symlink(ROOT / d, Path(tmp) / d)
                 for name, content in files.items():
                     (Path(tmp) / name).write_text(content)
