@@ -116,7 +116,7 @@ def schema_type(node, defs):
 
 
 def one_line(text):
-    return " ".join((text or "").split()).replace("|", "\\|")
+    return " ".join((text or "").split()).replace("|", "\\|").replace("*", "\\*")
 
 
 CASE_INTRO = (
@@ -369,7 +369,7 @@ def family_page(kind, results):
         spec = checks.get(r["name"], {})
         s += f"## {r['name']}\n\n"
         if spec.get("_group"):
-            s += f"*{spec['_group']}.* "
+            s += f"*{one_line(spec['_group'])}.* "
         s += f"**{r['status'].upper()}**: {one_line(r['message'])}\n\n"
         path, inline = case_text(spec) if spec else (None, None)
         if path:
