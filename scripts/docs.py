@@ -98,7 +98,8 @@ def cli_page():
 
 def schema_type(node, defs):
     if "$ref" in node:
-        return node["$ref"].rsplit("/", 1)[1]
+        name = node["$ref"].rsplit("/", 1)[1]
+        return f"[{name}](#{anchor(name)})" if name in defs else name
     if "enum" in node:
         return " \\| ".join(f"`{json.dumps(v)}`" for v in node["enum"])
     if "const" in node:
@@ -116,7 +117,8 @@ def schema_type(node, defs):
 
 
 def one_line(text):
-    return " ".join((text or "").split()).replace("|", "\\|").replace("*", "\\*")
+    text = re.sub(r"\[(`[^`]+`)\](?!\()", r"\1", text or "")  # rustdoc's intra-doc links
+    return " ".join(text.split()).replace("|", "\\|").replace("*", "\\*")
 
 
 CASE_INTRO = (

@@ -542,7 +542,7 @@ pub struct Summary<'a> {
     /// what the run noticed that a user should know, in order (absent: nothing)
     #[serde(skip_serializing_if = "<[String]>::is_empty")]
     pub warnings: &'a [String],
-    /// the tubemem version that ran the case, and the case text's hash (as run.json)
+    /// the tubemem version that ran the case (as run.json)
     pub tubemem_version: &'static str,
     /// the hash of the case text, as in run.json and the VTU field data
     pub case_hash: &'a str,
