@@ -8,6 +8,7 @@
 #
 #   bash scripts/bench-million.sh                  # factorization on 1 thread
 #   THREADS=2 bash scripts/bench-million.sh        # … on 2
+#   ORDERING=nested-dissection bash scripts/bench-million.sh   # METIS instead of AMD
 #   AROUND=224 ALONG=280 bash scripts/bench-million.sh   # a quarter of the size
 #
 # Prints: the dense peak of this machine (faer's matmul, crates/fem/examples/dense_peak.rs), the
@@ -22,7 +23,8 @@ cd "$(dirname "$0")/.."
 AROUND=${AROUND:-448}
 ALONG=${ALONG:-560}
 THREADS=${THREADS:-1}
-OUT=${OUT:-runs/bench-million-$THREADS}
+ORDERING=${ORDERING:-amd}
+OUT=${OUT:-runs/bench-million-$THREADS-$ORDERING}
 cargo build --release -q -p tubemem-cli
 peak=$(cargo run --release -q -p tubemem-fem --example dense_peak | tail -1)
 echo "dense peak (faer matmul): $peak"
@@ -49,6 +51,7 @@ symmetry = "none"
 [solver]
 checkpoint_every = 0
 factor_threads = $THREADS
+ordering = "$ORDERING"
 
 [output]
 vtu = "stage-end"

@@ -34,6 +34,7 @@
 //! max_iterations = 30
 //! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
 //! factor_threads = 1    # threads of the sparse factorization (0: all); results do not change
+//! ordering = "amd"      # or "nested-dissection" (METIS); results do not change
 //!
 //! [output]              # optional
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
@@ -311,6 +312,11 @@ pub struct SolverSpec {
     /// the results do not depend on it
     #[serde(default = "default_factor_threads")]
     pub factor_threads: usize,
+    /// the sparse factorization's fill-reducing ordering: "amd" (default) or
+    /// "nested-dissection" (METIS on the node graph); the results do not depend on it beyond
+    /// round-off, the factorization's cost does
+    #[serde(default)]
+    pub ordering: tubemem_fem::ordering::Ordering,
 }
 
 fn default_factor_threads() -> usize {
@@ -329,6 +335,7 @@ impl Default for SolverSpec {
             max_iterations: default_max_iterations(),
             checkpoint_every: default_checkpoint_every(),
             factor_threads: default_factor_threads(),
+            ordering: tubemem_fem::ordering::Ordering::default(),
         }
     }
 }

@@ -154,6 +154,9 @@ pub(crate) fn model_of(
         ..tubemem_fem::NewtonSettings::default()
     });
     model.set_factor_threads(case.solver.factor_threads);
+    model
+        .set_ordering(case.solver.ordering)
+        .map_err(AppError::Model)?;
     model.set_iteration_log(case.output.iterations);
     Ok(model)
 }

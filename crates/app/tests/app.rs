@@ -469,6 +469,49 @@ fn an_arc_length_stage_reports_its_critical_points_in_every_output() {
     assert!(!s.gps_applicable, "{:?}", s.nonuniformity);
 }
 
+/// `[solver] ordering`: nested dissection (METIS) and AMD run the same arc-length path through
+/// the pressure maximum to the same states: the located maximum and the end agree to the Newton
+/// tolerance (1e-9 relative residual), and every step's negative-pivot count, the stiffness's
+/// inertia, which no ordering changes, is the same.
+#[test]
+fn the_ordering_changes_neither_the_path_nor_its_inertia() {
+    let text = SMALL
+        .replace("control = \"volume\"", "control = \"arc-length\"")
+        .replace("target_stretch = 1.2", "target_stretch = 2.0");
+    let run_with = |ordering: &str| {
+        let case = Case::parse(&format!("{text}\n[solver]\nordering = \"{ordering}\"\n")).unwrap();
+        let report = run(&case, "small", &mut []).into_result().unwrap();
+        let StageOutcome::Finished(s) = &report.stages[0].outcome else {
+            panic!("the stage failed with {ordering}")
+        };
+        let pivots: Vec<usize> = report.stages[0]
+            .steps
+            .iter()
+            .map(|r| r.negative_pivots)
+            .collect();
+        (
+            s.critical_points[0].midspan.w,
+            s.final_state.midspan.w,
+            pivots,
+        )
+    };
+    let (max_amd, end_amd, pivots_amd) = run_with("amd");
+    let (max_nd, end_nd, pivots_nd) = run_with("nested-dissection");
+    assert!(
+        (max_nd / max_amd - 1.0).abs() < 1e-8,
+        "{max_nd} against {max_amd}"
+    );
+    assert!(
+        (end_nd / end_amd - 1.0).abs() < 1e-8,
+        "{end_nd} against {end_amd}"
+    );
+    assert_eq!(pivots_nd, pivots_amd);
+    assert!(
+        pivots_amd.iter().any(|&p| p > 0),
+        "the path passes no unstable state"
+    );
+}
+
 /// Pressure control to a pressure above the tube's maximum: the stage fails, and the error says
 /// that there is no equilibrium beyond the limit point, with the maximum located by arc length
 /// from the last converged step (the same maximum the arc-length stage locates, to its

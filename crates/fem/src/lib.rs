@@ -40,6 +40,7 @@ pub mod linsolve;
 pub mod manufactured;
 pub mod model;
 pub mod newton;
+pub mod ordering;
 pub mod pattern;
 pub mod post;
 pub mod slide;

@@ -9,10 +9,13 @@
 //! used. faer's LDLᵀ does not pivot; a zero pivot is reported as an error and the Newton driver
 //! reacts (shift, cut-back).
 
+use crate::ordering::Ordering;
 use crate::FemError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltError;
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::SymmetricOrdering;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
     SymbolicCholeskyRaw,
@@ -43,6 +46,8 @@ pub enum FactorizationError {
     Fill(#[source] FaerError),
     #[error("no memory for the factorization's workspace")]
     Workspace(#[source] FaerError),
+    #[error("cannot compute the fill-reducing ordering")]
+    Ordering(#[source] crate::ordering::OrderingError),
 }
 
 /// A symmetric sparse matrix pattern (lower triangle) with its symbolic factorization.
@@ -71,6 +76,16 @@ impl SparseLdlt {
         pairs: &[(usize, usize)],
         layout: Layout,
     ) -> Result<Self, FemError> {
+        Self::with_options(n, pairs, layout, Ordering::Amd)
+    }
+
+    /// As [`SparseLdlt::new`], with the factor layout and the fill-reducing ordering chosen.
+    pub fn with_options(
+        n: usize,
+        pairs: &[(usize, usize)],
+        layout: Layout,
+        ordering: Ordering,
+    ) -> Result<Self, FemError> {
         let idx: Vec<Pair<usize, usize>> = pairs
             .iter()
             .map(|&(r, c)| Pair::new(r.max(c), r.min(c)))
@@ -85,9 +100,29 @@ impl SparseLdlt {
             },
             ..Default::default()
         };
-        let symbolic =
-            factorize_symbolic_cholesky(pattern.as_ref(), Side::Lower, Default::default(), params)
-                .map_err(FactorizationError::Symbolic)?;
+        let symbolic = match ordering {
+            Ordering::Amd => factorize_symbolic_cholesky(
+                pattern.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                params,
+            ),
+            Ordering::NestedDissection => {
+                let perm = crate::ordering::nested_dissection(n, pairs)
+                    .map_err(FactorizationError::Ordering)?;
+                let mut inverse = vec![0usize; n];
+                for (k, &p) in perm.iter().enumerate() {
+                    inverse[p] = k;
+                }
+                factorize_symbolic_cholesky(
+                    pattern.as_ref(),
+                    Side::Lower,
+                    SymmetricOrdering::Custom(PermRef::new_checked(&perm, &inverse, n)),
+                    params,
+                )
+            }
+        }
+        .map_err(FactorizationError::Symbolic)?;
         let l_values = vec![0.0; symbolic.len_val()];
         Ok(Self {
             n,
@@ -113,6 +148,14 @@ impl SparseLdlt {
         } else {
             Par::rayon(threads)
         };
+    }
+
+    /// The threads of the numeric factorization, as [`SparseLdlt::set_threads`] takes them.
+    pub fn threads(&self) -> usize {
+        match self.par {
+            Par::Seq => 1,
+            Par::Rayon(n) => n.get(),
+        }
     }
 
     /// The floating-point operations of one numeric factorization, from the symbolic structure:
@@ -290,6 +333,76 @@ mod tests {
                 assert!((b[i] - x[i]).abs() < 1e-12, "x[{i}]");
             }
         }
+    }
+
+    /// The ordering changes the factor, not what it says: on a 2D grid of nodes with 3 unknowns
+    /// each (bilinear coupling), an indefinite matrix whose eigenvalue signs are those of its
+    /// diagonal (Gershgorin: |d| ≥ 2 against off-diagonal row sums ≤ 35 × 0.05) factorized with
+    /// AMD and with nested dissection gives the inertia of the diagonal and the same solution.
+    #[test]
+    fn the_ordering_changes_the_factor_not_the_inertia_or_the_solution() {
+        let k = 20usize;
+        let node = |i: usize, j: usize| i * k + j;
+        let n = 3 * k * k;
+        let mut set = std::collections::BTreeSet::new();
+        for i in 0..k - 1 {
+            for j in 0..k - 1 {
+                let q = [
+                    node(i, j),
+                    node(i + 1, j),
+                    node(i + 1, j + 1),
+                    node(i, j + 1),
+                ];
+                for &a in &q {
+                    for &b in &q {
+                        for ca in 0..3 {
+                            for cb in 0..3 {
+                                let (r, c) = (3 * a + ca, 3 * b + cb);
+                                if r > c {
+                                    set.insert((r, c));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let d: Vec<f64> = (0..n)
+            .map(|i| {
+                if i % 7 == 3 {
+                    -2.0 - 0.001 * i as f64
+                } else {
+                    2.0 + 0.001 * i as f64
+                }
+            })
+            .collect();
+        let off = |r: usize, c: usize| 0.05 * (((r * 31 + c * 17) % 11) as f64 / 10.0 - 0.5);
+        let mut pairs: Vec<(usize, usize)> = (0..n).map(|i| (i, i)).collect();
+        let mut vals = d.clone();
+        for &(r, c) in &set {
+            pairs.push((r, c));
+            vals.push(off(r, c));
+        }
+        let x: Vec<f64> = (0..n).map(|i| (0.3 * i as f64).cos()).collect();
+        let mut b: Vec<f64> = (0..n).map(|i| d[i] * x[i]).collect();
+        for &(r, c) in &set {
+            b[r] += off(r, c) * x[c];
+            b[c] += off(r, c) * x[r];
+        }
+        let expected = d.iter().filter(|&&v| v < 0.0).count();
+        let mut flops = Vec::new();
+        for ordering in [Ordering::Amd, Ordering::NestedDissection] {
+            let mut s = SparseLdlt::with_options(n, &pairs, Layout::Auto, ordering).unwrap();
+            assert_eq!(s.factorize(&vals).unwrap(), expected, "{ordering:?}");
+            let mut y = b.clone();
+            s.solve(&mut y);
+            for i in 0..n {
+                assert!((y[i] - x[i]).abs() < 1e-12, "{ordering:?}: x[{i}]");
+            }
+            flops.push(s.factor_flops());
+        }
+        // the two orderings are different factorizations
+        assert_ne!(flops[0], flops[1]);
     }
 
     /// A wide-band matrix makes faer choose the supernodal layout, whose pivots are read from

@@ -77,6 +77,8 @@ pub struct Model {
     dofs: DofMap,
     pattern: Pattern,
     ldlt: SparseLdlt,
+    /// the fill-reducing ordering of `ldlt`'s symbolic analysis
+    ordering: crate::ordering::Ordering,
     settings: NewtonSettings,
     /// per-Newton-iteration timings, when asked for ([`Model::set_iteration_log`])
     iteration_log: Option<std::sync::Mutex<Vec<IterationRecord>>>,
@@ -106,7 +108,8 @@ impl Model {
         mesh.check()?;
         let dofs = DofMap::new(&mesh);
         let elements = Self::reference_elements(&mesh)?;
-        let (pattern, ldlt) = Self::numbering(&mesh, &elements, &dofs)?;
+        let ordering = crate::ordering::Ordering::default();
+        let (pattern, ldlt) = Self::numbering(&mesh, &elements, &dofs, ordering)?;
         Ok(Self {
             interrupt: None,
             mesh,
@@ -117,6 +120,7 @@ impl Model {
             dofs,
             pattern,
             ldlt,
+            ordering,
             settings: NewtonSettings::default(),
             iteration_log: None,
         })
@@ -129,11 +133,37 @@ impl Model {
     /// the symbolic factorization. Call it before solving.
     pub fn soften_rigid_pins(&mut self, soft: [bool; 2], stiffness: f64) -> Result<(), FemError> {
         let dofs = DofMap::with_soft_pins(&self.mesh, soft, stiffness);
-        let (pattern, ldlt) = Self::numbering(&self.mesh, &self.elements, &dofs)?;
+        let (pattern, ldlt) = Self::numbering(&self.mesh, &self.elements, &dofs, self.ordering)?;
+        let par = self.ldlt.threads();
         self.dofs = dofs;
         self.pattern = pattern;
         self.ldlt = ldlt;
+        self.ldlt.set_threads(par);
         Ok(())
+    }
+
+    /// The fill-reducing ordering of the factorization ([`crate::ordering`]): redoes the
+    /// symbolic analysis (keeping the factorization's threads). The results do not depend on
+    /// it beyond round-off; the factor's flops and memory do.
+    pub fn set_ordering(&mut self, ordering: crate::ordering::Ordering) -> Result<(), FemError> {
+        if ordering == self.ordering {
+            return Ok(());
+        }
+        let threads = self.ldlt.threads();
+        self.ldlt = SparseLdlt::with_options(
+            self.dofs.len(),
+            self.pattern.pairs(),
+            crate::linsolve::Layout::Auto,
+            ordering,
+        )?;
+        self.ldlt.set_threads(threads);
+        self.ordering = ordering;
+        Ok(())
+    }
+
+    /// The fill-reducing ordering in use.
+    pub fn ordering(&self) -> crate::ordering::Ordering {
+        self.ordering
     }
 
     /// The reference elements of `mesh`.
@@ -163,6 +193,7 @@ impl Model {
         mesh: &Mesh,
         elements: &Elements,
         dofs: &DofMap,
+        ordering: crate::ordering::Ordering,
     ) -> Result<(Pattern, SparseLdlt), FemError> {
         let pattern = Pattern::new(dofs, (0..elements.len()).map(|e| elements.nodes(e)));
         if let Some(k) = pattern.diagonal().iter().position(|&d| d == usize::MAX) {
@@ -171,7 +202,12 @@ impl Model {
                 .unwrap_or(usize::MAX);
             return Err(FemError::UnusedNode { node });
         }
-        let ldlt = SparseLdlt::new(dofs.len(), pattern.pairs())?;
+        let ldlt = SparseLdlt::with_options(
+            dofs.len(),
+            pattern.pairs(),
+            crate::linsolve::Layout::Auto,
+            ordering,
+        )?;
         Ok((pattern, ldlt))
     }
 
