@@ -34,7 +34,7 @@
 //! max_iterations = 30
 //! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
 //! factor_threads = 1    # threads of the sparse factorization (0: all); results do not change
-//! ordering = "amd"      # or "nested-dissection" (METIS); results do not change
+//! ordering = "auto"     # or "amd", "nested-dissection" (METIS); results do not change
 //!
 //! [output]              # optional
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
@@ -312,9 +312,10 @@ pub struct SolverSpec {
     /// the results do not depend on it
     #[serde(default = "default_factor_threads")]
     pub factor_threads: usize,
-    /// the sparse factorization's fill-reducing ordering: "amd" (default) or
-    /// "nested-dissection" (METIS on the node graph); the results do not depend on it beyond
-    /// round-off, the factorization's cost does
+    /// the sparse factorization's fill-reducing ordering: "auto" (default: AMD and nested
+    /// dissection both analysed, the one with fewer flops kept), "amd" or "nested-dissection"
+    /// (METIS on the node graph); the results do not depend on it beyond round-off, the
+    /// factorization's cost does
     #[serde(default)]
     pub ordering: tubemem_fem::ordering::Ordering,
 }

@@ -50,6 +50,29 @@ pub enum FactorizationError {
     Ordering(#[source] crate::ordering::OrderingError),
 }
 
+/// The flops of one numeric factorization with the symbolic structure `symbolic` of an `n` × `n`
+/// matrix ([`SparseLdlt::factor_flops`]).
+fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f64 {
+    let col = |c: f64| c * (c + 2.0);
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let p = s.col_ptr();
+            (0..n).map(|k| col((p[k + 1] - p[k]) as f64 - 1.0)).sum()
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let (begin, end) = (s.supernode_begin(), s.supernode_end());
+            let val = s.col_ptr_for_val();
+            (0..s.n_supernodes())
+                .map(|k| {
+                    let ncols = end[k] - begin[k];
+                    let nrows = (val[k + 1] - val[k]) / ncols;
+                    (0..ncols).map(|j| col((nrows - j - 1) as f64)).sum::<f64>()
+                })
+                .sum()
+        }
+    }
+}
+
 /// A symmetric sparse matrix pattern (lower triangle) with its symbolic factorization.
 pub struct SparseLdlt {
     n: usize,
@@ -100,29 +123,44 @@ impl SparseLdlt {
             },
             ..Default::default()
         };
-        let symbolic = match ordering {
-            Ordering::Amd => factorize_symbolic_cholesky(
+        let amd = || {
+            factorize_symbolic_cholesky(
                 pattern.as_ref(),
                 Side::Lower,
                 SymmetricOrdering::Amd,
                 params,
-            ),
-            Ordering::NestedDissection => {
-                let perm = crate::ordering::nested_dissection(n, pairs)
-                    .map_err(FactorizationError::Ordering)?;
-                let mut inverse = vec![0usize; n];
-                for (k, &p) in perm.iter().enumerate() {
-                    inverse[p] = k;
-                }
-                factorize_symbolic_cholesky(
-                    pattern.as_ref(),
-                    Side::Lower,
-                    SymmetricOrdering::Custom(PermRef::new_checked(&perm, &inverse, n)),
-                    params,
-                )
+            )
+            .map_err(FactorizationError::Symbolic)
+        };
+        let nested = || -> Result<SymbolicCholesky<usize>, FactorizationError> {
+            let perm = crate::ordering::nested_dissection(n, pairs)
+                .map_err(FactorizationError::Ordering)?;
+            let mut inverse = vec![0usize; n];
+            for (k, &p) in perm.iter().enumerate() {
+                inverse[p] = k;
             }
-        }
-        .map_err(FactorizationError::Symbolic)?;
+            factorize_symbolic_cholesky(
+                pattern.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Custom(PermRef::new_checked(&perm, &inverse, n)),
+                params,
+            )
+            .map_err(FactorizationError::Symbolic)
+        };
+        let symbolic = match ordering {
+            Ordering::Amd => amd()?,
+            Ordering::NestedDissection => nested()?,
+            Ordering::Auto => {
+                // both analyses, and the one whose factorization costs fewer flops (AMD on a
+                // tie, so a pattern where nested dissection gains nothing keeps AMD's factor)
+                let (a, d) = (amd()?, nested()?);
+                if symbolic_flops(&d, n) < symbolic_flops(&a, n) {
+                    d
+                } else {
+                    a
+                }
+            }
+        };
         let l_values = vec![0.0; symbolic.len_val()];
         Ok(Self {
             n,
@@ -164,26 +202,7 @@ impl SparseLdlt {
     /// additions counted apart, plus its c_k scalings and c_k products with D). The usual count
     /// of sparse Cholesky (George & Liu), the one dense LDLᵀ's n³/3 comes from.
     pub fn factor_flops(&self) -> f64 {
-        let col = |c: f64| c * (c + 2.0);
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => {
-                let p = s.col_ptr();
-                (0..self.n)
-                    .map(|k| col((p[k + 1] - p[k]) as f64 - 1.0))
-                    .sum()
-            }
-            SymbolicCholeskyRaw::Supernodal(s) => {
-                let (begin, end) = (s.supernode_begin(), s.supernode_end());
-                let val = s.col_ptr_for_val();
-                (0..s.n_supernodes())
-                    .map(|k| {
-                        let ncols = end[k] - begin[k];
-                        let nrows = (val[k + 1] - val[k]) / ncols;
-                        (0..ncols).map(|j| col((nrows - j - 1) as f64)).sum::<f64>()
-                    })
-                    .sum()
-            }
-        }
+        symbolic_flops(&self.symbolic, self.n)
     }
 
     pub fn dim(&self) -> usize {
@@ -391,7 +410,7 @@ mod tests {
         }
         let expected = d.iter().filter(|&&v| v < 0.0).count();
         let mut flops = Vec::new();
-        for ordering in [Ordering::Amd, Ordering::NestedDissection] {
+        for ordering in [Ordering::Amd, Ordering::NestedDissection, Ordering::Auto] {
             let mut s = SparseLdlt::with_options(n, &pairs, Layout::Auto, ordering).unwrap();
             assert_eq!(s.factorize(&vals).unwrap(), expected, "{ordering:?}");
             let mut y = b.clone();
@@ -401,8 +420,9 @@ mod tests {
             }
             flops.push(s.factor_flops());
         }
-        // the two orderings are different factorizations
+        // the two orderings are different factorizations, and `auto` keeps the cheaper
         assert_ne!(flops[0], flops[1]);
+        assert_eq!(flops[2], flops[0].min(flops[1]));
     }
 
     /// A wide-band matrix makes faer choose the supernodal layout, whose pivots are read from

@@ -1,5 +1,11 @@
-//! The fill-reducing ordering of the sparse LDLᵀ: faer's AMD (the default), or METIS's nested
-//! dissection.
+//! The fill-reducing ordering of the sparse LDLᵀ: faer's AMD, METIS's nested dissection, or
+//! (the default) whichever of the two gives the factorization fewer flops.
+//!
+//! Measured (`mesh.factor_flops` of summary.json, and `scripts/bench-million.sh`): on the
+//! shipped cases, long eighth and quarter models whose graphs are strips, nested dissection's
+//! factor costs 20–56 % more flops than AMD's; on the whole capped tube of 244,608 equations
+//! (`AROUND=224 ALONG=280`) it costs 34 % fewer. So neither is the better default, and the
+//! symbolic analyses are cheap beside one numeric factorization: `auto` runs both.
 //!
 //! Nested dissection runs on the quotient graph of the matrix: the unknowns whose closed
 //! neighbourhoods are equal (a node's three displacements, which every element couples together)
@@ -29,8 +35,11 @@ use std::collections::HashMap;
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum Ordering {
-    /// approximate minimum degree (faer's)
+    /// both, and the one whose factorization costs fewer flops (the default: AMD on the long,
+    /// strip-like symmetric models, nested dissection on whole tubes)
     #[default]
+    Auto,
+    /// approximate minimum degree (faer's)
     Amd,
     /// METIS nested dissection on the node graph
     NestedDissection,
