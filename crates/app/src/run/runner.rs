@@ -45,6 +45,28 @@ pub(super) struct StageStart {
     pub criticals: Vec<CriticalRecord>,
 }
 
+/// The GPS limit points of the case's law, computed once per law in a process: they depend on
+/// the law alone, and a sweep or an atlas runs many cases of one law (on `small_abb30_ls1.2` the
+/// scan is about a quarter of a run's time). Keyed by the law's table as the case gives it.
+fn gps_limits(
+    spec: &tubemem_material::MaterialSpec,
+    law: &dyn tubemem_material::MembraneLaw,
+) -> Option<Limits> {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static MEMO: OnceLock<Mutex<HashMap<String, Option<Limits>>>> = OnceLock::new();
+    let memo = MEMO.get_or_init(Default::default);
+    let key = serde_json::to_string(spec).ok()?;
+    if let Some(l) = memo.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return *l;
+    }
+    let limits = tubemem_gps::limits::limit_points(law, Hypothesis::Gps).ok();
+    memo.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(key, limits);
+    limits
+}
+
 impl<'a> Runner<'a> {
     /// The memory guard, the mesh (fitted to the contact edge if the case asks), the law and
     /// the model in its reference state; with where the mesh was fitted.
@@ -58,7 +80,7 @@ impl<'a> Runner<'a> {
             check_memory(3 * mesh.nodes.len(), options.force)?;
         }
         let law = case.material.build()?;
-        let limits = tubemem_gps::limits::limit_points(law.as_ref(), Hypothesis::Gps).ok();
+        let limits = gps_limits(&case.material, law.as_ref());
         let model = model_of(case, mesh, options.interrupt.clone())?;
         let state = model.reference_state();
         let v0 = model.multiplicity() * model.mesh().volume();
