@@ -360,32 +360,8 @@ mod tests {
     /// AMD and with nested dissection gives the inertia of the diagonal and the same solution.
     #[test]
     fn the_ordering_changes_the_factor_not_the_inertia_or_the_solution() {
-        let k = 20usize;
-        let node = |i: usize, j: usize| i * k + j;
-        let n = 3 * k * k;
-        let mut set = std::collections::BTreeSet::new();
-        for i in 0..k - 1 {
-            for j in 0..k - 1 {
-                let q = [
-                    node(i, j),
-                    node(i + 1, j),
-                    node(i + 1, j + 1),
-                    node(i, j + 1),
-                ];
-                for &a in &q {
-                    for &b in &q {
-                        for ca in 0..3 {
-                            for cb in 0..3 {
-                                let (r, c) = (3 * a + ca, 3 * b + cb);
-                                if r > c {
-                                    set.insert((r, c));
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let (n, grid) = crate::ordering::grid(20);
+        let set: Vec<(usize, usize)> = grid.into_iter().filter(|&(r, c)| r > c).collect();
         let d: Vec<f64> = (0..n)
             .map(|i| {
                 if i % 7 == 3 {

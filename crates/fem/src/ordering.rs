@@ -152,38 +152,40 @@ pub fn nested_dissection(n: usize, pairs: &[(usize, usize)]) -> Result<Vec<usize
         .collect())
 }
 
+/// A 2D grid of `k` × `k` nodes with 3 unknowns each, coupled like bilinear elements: the
+/// unknowns and the (row, col) pairs, row ≥ col (for the tests of orderings and factors).
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A 2D grid of `k` × `k` nodes with 3 unknowns each, coupled like bilinear elements.
-    fn grid(k: usize) -> (usize, Vec<(usize, usize)>) {
-        let node = |i: usize, j: usize| i * k + j;
-        let mut pairs = Vec::new();
-        for i in 0..k - 1 {
-            for j in 0..k - 1 {
-                let q = [
-                    node(i, j),
-                    node(i + 1, j),
-                    node(i + 1, j + 1),
-                    node(i, j + 1),
-                ];
-                for &a in &q {
-                    for &b in &q {
-                        for ca in 0..3 {
-                            for cb in 0..3 {
-                                let (r, c) = (3 * a + ca, 3 * b + cb);
-                                if r >= c {
-                                    pairs.push((r, c));
-                                }
+pub(crate) fn grid(k: usize) -> (usize, Vec<(usize, usize)>) {
+    let node = |i: usize, j: usize| i * k + j;
+    let mut pairs = std::collections::BTreeSet::new();
+    for i in 0..k - 1 {
+        for j in 0..k - 1 {
+            let q = [
+                node(i, j),
+                node(i + 1, j),
+                node(i + 1, j + 1),
+                node(i, j + 1),
+            ];
+            for &a in &q {
+                for &b in &q {
+                    for ca in 0..3 {
+                        for cb in 0..3 {
+                            let (r, c) = (3 * a + ca, 3 * b + cb);
+                            if r >= c {
+                                pairs.insert((r, c));
                             }
                         }
                     }
                 }
             }
         }
-        (3 * k * k, pairs)
     }
+    (3 * k * k, pairs.into_iter().collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
 
     #[test]
     fn nested_dissection_is_a_permutation_that_keeps_a_nodes_unknowns_together() {
