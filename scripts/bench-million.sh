@@ -92,6 +92,13 @@ for k in ["assembly_s", "line_search_s", "factorization_s", "solve_s"]:
     v = col(k)
     print(f"  {k[:-2]:14s} {statistics.median(v):8.3f} [{min(v):.3f}, {max(v):.3f}]   total {sum(v):8.1f} s")
 g = flops / statistics.median(fact) / 1e9
-print(f"factor: {nnz / 1e6:.1f} M nonzeros ({nnz * 8 / 2**30:.2f} GiB), {flops / 1e9:.1f} GFLOP per factorization; "
+print(f"factor ({s['mesh'].get('ordering') or '?'}): {nnz / 1e6:.1f} M nonzeros ({nnz * 8 / 2**30:.2f} GiB), {flops / 1e9:.1f} GFLOP per factorization; "
       f"achieved {g:.1f} GFLOP/s = {100 * g / dense:.0f} % of the dense peak on {threads} thread(s) ({dense:.1f} GFLOP/s)")
+print("per phase: factorizations, their seconds, achieved GFLOP/s (median), share of the dense peak")
+for st in s["stages"]:
+    ft = [float(r["factorization_s"]) for r in rows if int(r["stage"]) == st["index"]]
+    if ft:
+        gp = flops / statistics.median(ft) / 1e9
+        print(f"  stage {st['index']} ({st['kind']}): {len(ft)} factorizations, {sum(ft):.1f} s, "
+              f"{gp:.1f} GFLOP/s = {100 * gp / dense:.0f} %")
 PY

@@ -30,6 +30,10 @@ pub struct MeshInfo {
     /// floating-point operations of one numeric factorization
     #[serde(default)]
     pub factor_flops: f64,
+    /// the fill-reducing ordering of the factorization, "amd" or "nested-dissection" (with
+    /// `[solver] ordering = "auto"`, the one whose factorization has fewer flops)
+    #[serde(default)]
+    pub ordering: String,
     /// where the hoop node line was fitted to the contact edge (`[mesh] fit_contact_edge`)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_edge_fit: Option<ContactEdgeFit>,

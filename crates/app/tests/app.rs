@@ -481,6 +481,10 @@ fn the_ordering_changes_neither_the_path_nor_its_inertia() {
     let run_with = |ordering: &str| {
         let case = Case::parse(&format!("{text}\n[solver]\nordering = \"{ordering}\"\n")).unwrap();
         let report = run(&case, "small", &mut []).into_result().unwrap();
+        assert_eq!(
+            report.mesh.ordering, ordering,
+            "summary.json names the ordering used"
+        );
         let StageOutcome::Finished(s) = &report.stages[0].outcome else {
             panic!("the stage failed with {ordering}")
         };

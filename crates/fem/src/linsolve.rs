@@ -84,6 +84,8 @@ pub struct SparseLdlt {
     factorized: bool,
     /// the parallelism of the numeric factorization and the solves
     par: Par,
+    /// the ordering the symbolic analysis used (`Auto` resolved to the one it kept)
+    ordering: Ordering,
 }
 
 impl SparseLdlt {
@@ -147,17 +149,17 @@ impl SparseLdlt {
             )
             .map_err(FactorizationError::Symbolic)
         };
-        let symbolic = match ordering {
-            Ordering::Amd => amd()?,
-            Ordering::NestedDissection => nested()?,
+        let (symbolic, ordering) = match ordering {
+            Ordering::Amd => (amd()?, Ordering::Amd),
+            Ordering::NestedDissection => (nested()?, Ordering::NestedDissection),
             Ordering::Auto => {
                 // both analyses, and the one whose factorization costs fewer flops (AMD on a
                 // tie, so a pattern where nested dissection gains nothing keeps AMD's factor)
                 let (a, d) = (amd()?, nested()?);
                 if symbolic_flops(&d, n) < symbolic_flops(&a, n) {
-                    d
+                    (d, Ordering::NestedDissection)
                 } else {
-                    a
+                    (a, Ordering::Amd)
                 }
             }
         };
@@ -171,6 +173,7 @@ impl SparseLdlt {
             l_values,
             factorized: false,
             par: Par::Seq,
+            ordering,
         })
     }
 
@@ -186,6 +189,11 @@ impl SparseLdlt {
         } else {
             Par::rayon(threads)
         };
+    }
+
+    /// The ordering the symbolic analysis used: `Amd` or `NestedDissection` (what `Auto` kept).
+    pub fn ordering(&self) -> Ordering {
+        self.ordering
     }
 
     /// The threads of the numeric factorization, as [`SparseLdlt::set_threads`] takes them.
@@ -386,8 +394,10 @@ mod tests {
         }
         let expected = d.iter().filter(|&&v| v < 0.0).count();
         let mut flops = Vec::new();
+        let mut kept = Vec::new();
         for ordering in [Ordering::Amd, Ordering::NestedDissection, Ordering::Auto] {
             let mut s = SparseLdlt::with_options(n, &pairs, Layout::Auto, ordering).unwrap();
+            kept.push(s.ordering());
             assert_eq!(s.factorize(&vals).unwrap(), expected, "{ordering:?}");
             let mut y = b.clone();
             s.solve(&mut y);
@@ -399,6 +409,12 @@ mod tests {
         // the two orderings are different factorizations, and `auto` keeps the cheaper
         assert_ne!(flops[0], flops[1]);
         assert_eq!(flops[2], flops[0].min(flops[1]));
+        let cheaper = if flops[1] < flops[0] {
+            Ordering::NestedDissection
+        } else {
+            Ordering::Amd
+        };
+        assert_eq!(kept, [Ordering::Amd, Ordering::NestedDissection, cheaper]);
     }
 
     /// A wide-band matrix makes faer choose the supernodal layout, whose pivots are read from

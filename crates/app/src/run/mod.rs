@@ -78,6 +78,7 @@ pub fn run_with(
             element: String::new(),
             factor_nnz: 0,
             factor_flops: 0.0,
+            ordering: String::new(),
             contact_edge_fit: None,
         },
         material: String::new(),

@@ -114,6 +114,10 @@ impl<'a> Runner<'a> {
                 element: model.mesh().element().name().into(),
                 factor_nnz: model.factor_nnz(),
                 factor_flops: model.factor_flops(),
+                ordering: serde_json::to_value(model.factor_ordering())
+                    .ok()
+                    .and_then(|v| v.as_str().map(String::from))
+                    .unwrap_or_default(),
                 contact_edge_fit: fit,
             },
             material: model.law().name(),

@@ -161,9 +161,14 @@ impl Model {
         Ok(())
     }
 
-    /// The fill-reducing ordering in use.
+    /// The fill-reducing ordering asked for ([`Model::set_ordering`]).
     pub fn ordering(&self) -> crate::ordering::Ordering {
         self.ordering
+    }
+
+    /// The ordering the factorization uses: what `Auto` chose, or the one asked for.
+    pub fn factor_ordering(&self) -> crate::ordering::Ordering {
+        self.ldlt.ordering()
     }
 
     /// The reference elements of `mesh`.
