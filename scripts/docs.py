@@ -1,13 +1,13 @@
 """The book's generated pages, and the checks that keep them current.
 
-    python3 scripts/docs.py generate            # write every generated page
-    python3 scripts/docs.py check               # regenerate in memory, diff with the files
+    python3 scripts/docs.py generate            # write every generated page (before mdbook build)
+    python3 scripts/docs.py check               # the README's headline against a regeneration
     python3 scripts/docs.py import-verification RUN   # RUN: `tubemem verify verify/paper.toml --out RUN`
     python3 scripts/docs.py refresh-one FAMILY  # rerun one family's checks and diff its page
     python3 scripts/docs.py linkcheck BOOK_HTML # every internal link and anchor of a built book
     python3 scripts/docs.py examples            # run the user guide's shell and Python examples
 
-Generated (never edit them by hand; `generate` rewrites them, `check` fails when they differ):
+Generated, not tracked (git ignores them; `generate` writes them before the book is built):
   docs/src/reference/cli.md          every command's --help, from clap
   docs/src/reference/case-schema.md  the case file's keys, from `tubemem schema`
   docs/src/reference/case.schema.json
@@ -16,7 +16,10 @@ Generated (never edit them by hand; `generate` rewrites them, `check` fails when
                                      written from, crates/app/src/report.rs)
   docs/src/reference/python.md       from the module's docstrings and tubemem.pyi
   docs/src/verification/*.md         from docs/verification/results.json
-  README.md, between the headline markers: the verification headline
+Tracked: README.md's verification headline, between its markers (`check` diffs it with a
+regeneration), and the paper suite's run that the manual shows: docs/verification/results.json
+and docs/src/verification/plots/ (`import-verification` replaces them, as `--update-gold` does
+for gold files).
 
 The environment: $TUBEMEM (default target/release/tubemem) and $PYTHON (the interpreter with the
 built `tubemem` module, for the Python page; default the checkout's .venv).
@@ -435,12 +438,13 @@ def headline(results, prefix=""):
         ]
         worst = f"{max(ratios):.2f}" if ratios else "—"
         passed = sum(c["status"] == "pass" for c in cs)
-        s += f"| [{title}]({prefix}{kind}.md) | {len(cs)} | {passed} | {worst} |\n"
+        name = title if prefix is None else f"[{title}]({prefix}{kind}.md)"
+        s += f"| {name} | {len(cs)} | {passed} | {worst} |\n"
     return s
 
 
 def readme_headline(results):
-    h = headline(results, "docs/src/verification/")
+    h = headline(results, None)  # the pages it would link are built, not tracked
     n = len(results["checks"])
     p = sum(c["status"] == "pass" for c in results["checks"])
     return (
@@ -475,11 +479,19 @@ def pages():
     for kind in FAMILIES:
         if any(c["kind"] == kind for c in results["checks"]):
             out[VPAGES / f"{kind}.md"] = family_page(kind, results)
+    readme = readme_with_headline(results)
+    if readme is not None:
+        out[ROOT / "README.md"] = readme
+    return out
+
+
+def readme_with_headline(results):
+    """README.md with its headline regenerated (None: it has no headline markers)."""
     readme = (ROOT / "README.md").read_text()
     i, j = readme.find(HEAD_BEGIN), readme.find(HEAD_END)
-    if i >= 0 and j > i:
-        out[ROOT / "README.md"] = readme[:i] + readme_headline(results) + readme[j + len(HEAD_END):]
-    return out
+    if i < 0 or j < i:
+        return None
+    return readme[:i] + readme_headline(results) + readme[j + len(HEAD_END):]
 
 
 def generate():
@@ -500,10 +512,14 @@ def diff(path, text):
 
 
 def check():
-    bad = sum(diff(p, t) for p, t in pages().items())
-    if bad:
-        sys.exit(f"{bad} generated file(s) are stale: run `python3 scripts/docs.py generate`")
-    print("every generated page is current")
+    """The README's headline is tracked: it must equal its regeneration."""
+    readme = ROOT / "README.md"
+    text = readme_with_headline(json.loads(VDATA.read_text()))
+    if text is None:
+        sys.exit("README.md has no verification headline markers")
+    if diff(readme, text):
+        sys.exit("README.md's verification headline is stale: run `python3 scripts/docs.py generate`")
+    print("the README's verification headline is current")
 
 
 def strip_times(results):
@@ -540,10 +556,14 @@ def refresh_one(kind):
             )
             fresh["checks"] += [c for c in json.loads((out / "results.json").read_text())["checks"] if c["name"] == name]
     page = VPAGES / f"{kind}.md"
+    committed = family_page(kind, results)
     text = family_page(kind, strip_times(fresh))
-    if diff(page, text):
-        sys.exit(f"{page.relative_to(ROOT)} differs from a fresh run of its checks")
-    print(f"{page.relative_to(ROOT)}: a fresh run of its {len(names)} checks regenerates it exactly")
+    if committed != text:
+        sys.stdout.writelines(
+            difflib.unified_diff(committed.splitlines(True), text.splitlines(True), "committed results", "fresh run", n=1)
+        )
+        sys.exit(f"{page.relative_to(ROOT)}: a fresh run of its checks gives another page")
+    print(f"{page.relative_to(ROOT)}: a fresh run of its {len(names)} checks gives the page of the committed results exactly")
 
 
 # --- link check ------------------------------------------------------------------------------

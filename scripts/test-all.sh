@@ -60,7 +60,7 @@ WHEEL_VENV=$(mktemp -d)
 rm -rf "$WHEEL_VENV"
 echo "== pytest: crates/py/tests (the Python API)"
 .venv/bin/python -m pytest crates/py/tests -q
-echo "== the book (docs/): generated pages current, one verification page rerun, mdBook build, links, examples"
+echo "== the book (docs/): pages generated, README headline current, one verification family rerun, mdBook build, links, examples"
 MDBOOK_VERSION=0.5.4
 TOOLS="${TUBEMEM_TOOLS:-$HOME/.cache/tubemem/tools}"
 if ! "$TOOLS/bin/mdbook" --version 2>/dev/null | grep -qx "mdbook v$MDBOOK_VERSION"; then
@@ -69,6 +69,7 @@ if ! "$TOOLS/bin/mdbook" --version 2>/dev/null | grep -qx "mdbook v$MDBOOK_VERSI
     --features search --root "$TOOLS"
 fi
 export TUBEMEM="$PWD/target/release/tubemem" PYTHON="$PWD/.venv/bin/python"
+python3 scripts/docs.py generate
 python3 scripts/docs.py check
 python3 scripts/docs.py refresh-one invariance
 rm -rf docs/book

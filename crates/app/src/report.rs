@@ -696,6 +696,7 @@ pub fn summary_schema() -> serde_json::Value {
     let generator = schemars::generate::SchemaSettings::draft2020_12()
         .for_serialize()
         .into_generator();
-    serde_json::to_value(generator.into_root_schema_for::<Summary<'static>>())
-        .expect("a schema is JSON")
+    generator
+        .into_root_schema_for::<Summary<'static>>()
+        .to_value()
 }
