@@ -138,7 +138,8 @@ pub(crate) fn model_of(
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 ) -> Result<tubemem_fem::model::Model> {
     let law = case.material.build_with(case.solver.wrinkling)?;
-    let mut model = tubemem_fem::model::Model::new(mesh, law).map_err(AppError::Model)?;
+    let mut model = tubemem_fem::model::Model::with_ordering(mesh, law, case.solver.ordering)
+        .map_err(AppError::Model)?;
     // planes that move the tube sideways: the rigid-mode pins on the axis would hold the caps'
     // poles against them, so springs hold those modes instead
     let soft = sideways_planes(case);
@@ -154,9 +155,6 @@ pub(crate) fn model_of(
         ..tubemem_fem::NewtonSettings::default()
     });
     model.set_factor_threads(case.solver.factor_threads);
-    model
-        .set_ordering(case.solver.ordering)
-        .map_err(AppError::Model)?;
     model.set_iteration_log(case.output.iterations);
     Ok(model)
 }

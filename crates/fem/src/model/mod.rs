@@ -105,10 +105,19 @@ impl Model {
     /// Check the mesh, number the dofs ([`DofMap`]), build the reference elements, the pattern
     /// and its symbolic factorization.
     pub fn new(mesh: Mesh, law: Box<dyn MembraneLaw>) -> Result<Self, FemError> {
+        Self::with_ordering(mesh, law, crate::ordering::Ordering::default())
+    }
+
+    /// As [`Model::new`], with the factorization's fill-reducing ordering
+    /// ([`crate::ordering`]) chosen.
+    pub fn with_ordering(
+        mesh: Mesh,
+        law: Box<dyn MembraneLaw>,
+        ordering: crate::ordering::Ordering,
+    ) -> Result<Self, FemError> {
         mesh.check()?;
         let dofs = DofMap::new(&mesh);
         let elements = Self::reference_elements(&mesh)?;
-        let ordering = crate::ordering::Ordering::default();
         let (pattern, ldlt) = Self::numbering(&mesh, &elements, &dofs, ordering)?;
         Ok(Self {
             interrupt: None,
@@ -142,26 +151,7 @@ impl Model {
         Ok(())
     }
 
-    /// The fill-reducing ordering of the factorization ([`crate::ordering`]): redoes the
-    /// symbolic analysis (keeping the factorization's threads). The results do not depend on
-    /// it beyond round-off; the factor's flops and memory do.
-    pub fn set_ordering(&mut self, ordering: crate::ordering::Ordering) -> Result<(), FemError> {
-        if ordering == self.ordering {
-            return Ok(());
-        }
-        let threads = self.ldlt.threads();
-        self.ldlt = SparseLdlt::with_options(
-            self.dofs.len(),
-            self.pattern.pairs(),
-            crate::linsolve::Layout::Auto,
-            ordering,
-        )?;
-        self.ldlt.set_threads(threads);
-        self.ordering = ordering;
-        Ok(())
-    }
-
-    /// The fill-reducing ordering asked for ([`Model::set_ordering`]).
+    /// The fill-reducing ordering asked for ([`Model::with_ordering`]).
     pub fn ordering(&self) -> crate::ordering::Ordering {
         self.ordering
     }
