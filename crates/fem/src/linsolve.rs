@@ -401,6 +401,8 @@ mod tests {
             assert_eq!(s.factorize(&vals).unwrap(), expected, "{ordering:?}");
             let mut y = b.clone();
             s.solve(&mut y);
+            // |d| ≥ 2 against row sums ≤ 1.75 bound the condition number by 3.75/0.25 = 15, so
+            // the backward-stable solve is exact to about 15 × 1e-16
             for i in 0..n {
                 assert!((y[i] - x[i]).abs() < 1e-12, "{ordering:?}: x[{i}]");
             }
