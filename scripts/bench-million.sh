@@ -10,6 +10,7 @@
 #   THREADS=2 bash scripts/bench-million.sh        # … on 2
 #   ORDERING=nested-dissection bash scripts/bench-million.sh   # METIS instead of AMD
 #   AROUND=224 ALONG=280 bash scripts/bench-million.sh   # a quarter of the size
+#   REFACTORIZE=always bash scripts/bench-million.sh      # factorize at every Newton iteration
 #
 # Prints: the dense peak of this machine (faer's matmul, crates/fem/examples/dense_peak.rs), the
 # run's wall time and peak memory (GNU time's maximum RSS), and from the run's iterations.csv
@@ -24,7 +25,8 @@ AROUND=${AROUND:-448}
 ALONG=${ALONG:-560}
 THREADS=${THREADS:-1}
 ORDERING=${ORDERING:-amd}
-OUT=${OUT:-runs/bench-million-$THREADS-$ORDERING}
+REFACTORIZE=${REFACTORIZE:-auto}
+OUT=${OUT:-runs/bench-million-$THREADS-$ORDERING-$REFACTORIZE}
 cargo build --release -q -p tubemem-cli
 peak=$(cargo run --release -q -p tubemem-fem --example dense_peak | tail -1)
 echo "dense peak (faer matmul): $peak"
@@ -52,6 +54,7 @@ symmetry = "none"
 checkpoint_every = 0
 factor_threads = $THREADS
 ordering = "$ORDERING"
+refactorize = "$REFACTORIZE"
 
 [output]
 vtu = "stage-end"
@@ -80,7 +83,8 @@ wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", time
 rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", time).group(1)) / 1048576
 col = lambda k: [float(r[k]) for r in rows]
 flops, nnz = s["mesh"]["factor_flops"], s["mesh"]["factor_nnz"]
-fact = col("factorization_s")
+factorized = [r for r in rows if r.get("factorized", "1") != "0"]
+fact = [float(r["factorization_s"]) for r in factorized]
 dense = peak["gflops"]["1" if threads == 1 else "all"]
 print(f"\n{s['mesh']['equations']} equations, {s['mesh']['elements']} elements; wall {wall}, peak RSS {rss:.2f} GiB")
 for st in s["stages"]:
@@ -88,15 +92,18 @@ for st in s["stages"]:
     print(f"stage {st['index']} ({st['kind']}): {f['stage_steps']} steps, {f['stage_newton_iterations']} Newton iterations; "
           f"mid-span ϖ {f['w']:.6f}, λs {f['lambda_s']:.6f}, λz {f['lambda_z']:.6f}")
 print(f"{len(rows)} linearizations (iterations.csv: the Newton iterations and each solve's converged check); per linearization, median [min, max] seconds:")
-for k in ["assembly_s", "line_search_s", "factorization_s", "solve_s"]:
+for k in ["assembly_s", "line_search_s", "solve_s"]:
     v = col(k)
     print(f"  {k[:-2]:14s} {statistics.median(v):8.3f} [{min(v):.3f}, {max(v):.3f}]   total {sum(v):8.1f} s")
+krylov = sum(int(float(r.get("krylov_iterations", 0))) for r in rows)
+print(f"{len(factorized)} factorizations ({fact and statistics.median(fact):.3f} s median), {len(rows) - len(factorized)} linearizations on a reused factor "
+      f"with {krylov} GMRES iterations (reuse: {s['mesh'].get('reuses_factor')}); factorization total {sum(fact):.1f} s")
 g = flops / statistics.median(fact) / 1e9
 print(f"factor ({s['mesh'].get('ordering') or '?'}): {nnz / 1e6:.1f} M nonzeros ({nnz * 8 / 2**30:.2f} GiB), {flops / 1e9:.1f} GFLOP per factorization; "
       f"achieved {g:.1f} GFLOP/s = {100 * g / dense:.0f} % of the dense peak on {threads} thread(s) ({dense:.1f} GFLOP/s)")
 print("per phase: factorizations, their seconds, achieved GFLOP/s (median), share of the dense peak")
 for st in s["stages"]:
-    ft = [float(r["factorization_s"]) for r in rows if int(r["stage"]) == st["index"]]
+    ft = [float(r["factorization_s"]) for r in factorized if int(r["stage"]) == st["index"]]
     if ft:
         gp = flops / statistics.median(ft) / 1e9
         print(f"  stage {st['index']} ({st['kind']}): {len(ft)} factorizations, {sum(ft):.1f} s, "

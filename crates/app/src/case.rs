@@ -35,6 +35,8 @@
 //! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
 //! factor_threads = 1    # threads of the sparse factorization (0: all); results do not change
 //! ordering = "auto"     # or "amd", "nested-dissection" (METIS); results do not change
+//! refactorize = "auto"  # or "always", "on-demand": the last factor preconditions GMRES until
+//!                       # it stops paying; results agree within the Newton tolerance
 //!
 //! [output]              # optional
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
@@ -318,6 +320,14 @@ pub struct SolverSpec {
     /// factorization's cost does
     #[serde(default)]
     pub ordering: tubemem_fem::ordering::Ordering,
+    /// when Newton factorizes its tangent: "auto" (default: "on-demand" where a factorization
+    /// costs at least 50 substitutions in flops, "always" otherwise), "always" (every
+    /// iteration, the exact Newton method) or "on-demand" (the last factor preconditions GMRES
+    /// on the current tangent, to an inexact-Newton tolerance, and the solve refactorizes when
+    /// GMRES or the contraction of the residual says so); convergence is judged on the true
+    /// residual, so the results agree within the Newton tolerance
+    #[serde(default)]
+    pub refactorize: tubemem_fem::model::Refactorization,
 }
 
 fn default_factor_threads() -> usize {
@@ -337,6 +347,7 @@ impl Default for SolverSpec {
             checkpoint_every: default_checkpoint_every(),
             factor_threads: default_factor_threads(),
             ordering: tubemem_fem::ordering::Ordering::default(),
+            refactorize: tubemem_fem::model::Refactorization::default(),
         }
     }
 }

@@ -49,7 +49,7 @@ pub const CRITICAL_HEADER: &str = "stage,step,kind,arc_length,bracket,w,lambda_s
 /// The columns of iterations.csv (`[output] iterations = true`): one row per Newton
 /// linearization; `row` is the steps.csv row of the step they led to.
 pub const ITERATIONS_HEADER: &str =
-    "row,stage,step,iteration,assembly_s,line_search_s,factorization_s,solve_s,residual,negative_pivots";
+    "row,stage,step,iteration,assembly_s,line_search_s,factorization_s,solve_s,residual,negative_pivots,factorized,krylov_iterations";
 
 /// The columns of fronts.csv: one line per bulge front per step.
 pub const FRONTS_HEADER: &str = "row,stage,step,w,volume,front,z_ref";
@@ -205,7 +205,7 @@ const CRITICAL_COLUMNS: [Column; 16] = [
     c("mode_eigenvalue", "a bifurcation: the eigenvalue of K nearest zero at the point"),
 ];
 
-const ITERATIONS_COLUMNS: [Column; 10] = [
+const ITERATIONS_COLUMNS: [Column; 12] = [
     ROW,
     STAGE,
     STEP,
@@ -214,13 +214,21 @@ const ITERATIONS_COLUMNS: [Column; 10] = [
     c("line_search_s", "seconds in the line search"),
     c(
         "factorization_s",
-        "seconds in the sparse LDLᵀ factorization",
+        "seconds in the sparse LDLᵀ factorization (0 where the factor was reused)",
     ),
-    c("solve_s", "seconds in the triangular solves"),
+    c("solve_s", "seconds in the triangular solves (or the GMRES solves with a reused factor)"),
     c("residual", "the relative residual after the iteration"),
     c(
         "negative_pivots",
-        "negative pivots of the factorized tangent",
+        "negative pivots of the factorized tangent (where the factor was reused: of the tangent it was made from)",
+    ),
+    c(
+        "factorized",
+        "1 where the iteration factorized its tangent, 0 where it reused an earlier factor ([solver] refactorize)",
+    ),
+    c(
+        "krylov_iterations",
+        "GMRES iterations of the solves with a reused factor (0 where it factorized)",
     ),
 ];
 

@@ -155,6 +155,7 @@ pub(crate) fn model_of(
         ..tubemem_fem::NewtonSettings::default()
     });
     model.set_factor_threads(case.solver.factor_threads);
+    model.set_refactorization(case.solver.refactorize);
     model.set_iteration_log(case.output.iterations);
     Ok(model)
 }

@@ -1094,7 +1094,7 @@ impl RunWriter {
             // the iterations since the last converged step (a cut-back's failed attempts
             // included), under this step's number
             let path = self.dir.join("iterations.csv");
-            let rows: Vec<[f64; 10]> = iterations
+            let rows: Vec<[f64; 12]> = iterations
                 .iter()
                 .enumerate()
                 .map(|(k, it)| {
@@ -1109,6 +1109,8 @@ impl RunWriter {
                         it.solve,
                         it.residual,
                         it.negative_pivots as f64,
+                        f64::from(u8::from(it.factorized)),
+                        it.krylov as f64,
                     ]
                 })
                 .collect();

@@ -34,6 +34,10 @@ pub struct MeshInfo {
     /// `[solver] ordering = "auto"`, the one whose factorization has fewer flops)
     #[serde(default)]
     pub ordering: String,
+    /// whether Newton reuses the factor across linearizations (`[solver] refactorize`, with
+    /// "auto" resolved by the factorization's cost)
+    #[serde(default)]
+    pub reuses_factor: bool,
     /// where the hoop node line was fitted to the contact edge (`[mesh] fit_contact_edge`)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_edge_fit: Option<ContactEdgeFit>,

@@ -1230,6 +1230,40 @@ fn a_killed_run_resumes_bit_identical() {
     );
 }
 
+/// Restart with a reused factor (`refactorize = "on-demand"`): every solve factorizes at its
+/// first iteration, so a resumed run, whose first solve has no factor from before, repeats the
+/// uninterrupted one bit for bit (steps.csv, summary.json, the PVD index and every VTU frame).
+/// Killed in the inflation, where no contact status forces a factorization at a step's start
+/// (in the squeeze the plates' move does, and the test would pass without the rule).
+#[test]
+fn a_killed_run_that_reuses_its_factor_resumes_bit_identical() {
+    let text = include_str!("../../../cases/squeeze_abb30_ls1.3.toml");
+    assert!(!text.contains("[solver]"));
+    let d = tmp("resume-reuse");
+    let case = d.join("case.toml");
+    std::fs::write(
+        &case,
+        format!("{text}\n[solver]\nrefactorize = \"on-demand\"\n"),
+    )
+    .unwrap();
+    let (reference, killed) = (d.join("ref"), d.join("killed"));
+    assert!(run_in(&case, &reference, &[]).status.success());
+    run_and_kill(&case, &killed, |steps| {
+        steps.lines().filter(|l| l.starts_with("1,")).count() >= 2
+    });
+    run_ok(&case, &killed, &["--resume"]);
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["mesh"]["reuses_factor"], Value::Bool(true));
+    assert_same_run(
+        &reference,
+        &killed,
+        &["steps.csv", "summary.json", "tube.pvd"],
+        true,
+    );
+}
+
 /// Issue #25, class 5: a confine stage whose walls never touch the tube prints no `NaN%` (the
 /// relative errors of a wall that carries nothing in GPS read "none in GPS").
 #[test]

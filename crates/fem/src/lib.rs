@@ -11,6 +11,7 @@
 //! | [`dofs`] | equation numbering: symmetry planes, rigid-body pins, rigid plugs |
 //! | [`pattern`] | the sparsity pattern, built once |
 //! | [`linsolve`] | sparse LDLᵀ on faer (symbolic once, numeric per iteration), inertia |
+//! | [`krylov`] | right-preconditioned GMRES, for a factor reused across linearizations |
 //! | [`term`] | force terms: the public [`term::Term`] / [`term::ElementTerm`] interface, the membrane and contact terms |
 //! | [`model`] | the model: assembly of the terms plus the enclosed volume, loads, solves, stability, the membrane problem |
 //! | [`continuation`] | arc-length continuation with located critical points |
@@ -36,6 +37,7 @@ pub mod dofs;
 pub mod edge_load;
 pub mod element;
 pub mod geometry;
+pub mod krylov;
 pub mod linsolve;
 pub mod manufactured;
 pub mod model;
@@ -56,6 +58,8 @@ mod tests;
 mod tests_quad9;
 #[cfg(test)]
 mod tests_remap;
+#[cfg(test)]
+mod tests_reuse;
 
 use thiserror::Error;
 use tubemem_material::MaterialError;

@@ -291,6 +291,23 @@ impl SparseLdlt {
         }
     }
 
+    /// Whether the last numeric factorization succeeded (a solve may follow).
+    pub fn is_factorized(&self) -> bool {
+        self.factorized
+    }
+
+    /// The symmetric matrix whose values (one per pair given to `new`, duplicates summed)
+    /// are `values`, as an operator ([`SymmetricMatrix::apply`]).
+    pub fn matrix(&self, values: &[f64]) -> Result<SymmetricMatrix, FemError> {
+        assert_eq!(values.len(), self.entries, "one value per pattern entry");
+        if let Some(entry) = values.iter().position(|v| !v.is_finite()) {
+            return Err(FemError::NonFiniteEntry { entry });
+        }
+        let lower = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
+            .map_err(FactorizationError::Fill)?;
+        Ok(SymmetricMatrix { lower })
+    }
+
     /// Solve A y = rhs in place with the last factorization.
     pub fn solve(&self, rhs: &mut [f64]) {
         assert!(self.factorized, "solve after a successful factorize");
@@ -308,6 +325,33 @@ impl SparseLdlt {
             par,
             MemStack::new(&mut mem),
         );
+    }
+}
+
+/// A symmetric sparse matrix stored by its lower triangle ([`SparseLdlt::matrix`]).
+pub struct SymmetricMatrix {
+    lower: SparseColMat<usize, f64>,
+}
+
+impl SymmetricMatrix {
+    /// out = A x, column by column in a fixed order (sequential: the sums do not depend on the
+    /// number of threads).
+    pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        let m = self.lower.as_ref();
+        let (ptr, rows, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
+        for j in 0..x.len() {
+            let xj = x[j];
+            let mut yj = 0.0;
+            for k in ptr[j]..ptr[j + 1] {
+                let (i, a) = (rows[k], vals[k]);
+                out[i] += a * xj;
+                if i != j {
+                    yj += a * x[i];
+                }
+            }
+            out[j] += yj;
+        }
     }
 }
 
@@ -355,6 +399,12 @@ mod tests {
                         + if i + 1 < n { 0.1 * x[i + 1] } else { 0.0 }
                 })
                 .collect();
+            // the operator of the same values (duplicates summed, both triangles) gives b
+            let mut ax = vec![0.0; n];
+            s.matrix(&vals).unwrap().apply(&x, &mut ax);
+            for i in 0..n {
+                assert!((ax[i] - b[i]).abs() < 1e-14, "(Ax)[{i}]");
+            }
             s.solve(&mut b);
             for i in 0..n {
                 assert!((b[i] - x[i]).abs() < 1e-12, "x[{i}]");

@@ -72,6 +72,8 @@ pub struct Inertia {
     pub negative_pivots: usize,
     /// the diagonal shift that had to be added to factorize (0 in regular states)
     pub shift: f64,
+    /// the count is an earlier linearization's (the factor was reused, not made here)
+    pub stale: bool,
 }
 
 /// A trial state's residual and potential.

@@ -12,6 +12,7 @@
 //! | `problem` | the membrane equilibrium as a [`newton::Problem`], [`ArcConstraint`] |
 //! | `diagnostics` | [`LockingProximity`], [`IterationTiming`] |
 //! | `remap` | [`Model::move_reference`]: states carried to a refitted mesh |
+//! | `reuse` | factorizing less often: the last factor preconditions GMRES ([`Refactorization`]) |
 //!
 //! Loading (all per unit μH, lengths in R; p is the reduced pressure ϖ):
 //! ```text
@@ -52,6 +53,7 @@ mod elements;
 mod load;
 mod problem;
 mod remap;
+mod reuse;
 mod solve;
 mod stability;
 
@@ -60,6 +62,9 @@ pub use diagnostics::{IterationTiming, LockingProximity, NEAR_LOCKING};
 pub use elements::Elements;
 pub use load::{Load, Loading, State};
 pub use problem::{ArcConstraint, PRESSURE_FLOOR};
+pub use reuse::{
+    Refactorization, AUTO_FLOP_RATIO, CONTRACTION, MAX_FORCING, MAX_KRYLOV, MAX_STATUS_CHANGES,
+};
 pub use solve::{Held, MAX_UPDATE_HALVINGS};
 pub use stability::{ModeReport, NEUTRAL};
 
@@ -80,6 +85,8 @@ pub struct Model {
     /// the fill-reducing ordering of `ldlt`'s symbolic analysis
     ordering: crate::ordering::Ordering,
     settings: NewtonSettings,
+    /// when the linearizations factorize, and the factor's state across them
+    reuse: reuse::FactorReuse,
     /// per-Newton-iteration timings, when asked for ([`Model::set_iteration_log`])
     iteration_log: Option<std::sync::Mutex<Vec<IterationRecord>>>,
 }
@@ -92,9 +99,14 @@ pub struct IterationRecord {
     pub assembly: f64,
     /// the assemblies of rejected line-search trials before this iterate
     pub line_search: f64,
-    /// the numeric factorization (and its shifted retries)
+    /// the numeric factorization (and its shifted retries); 0 where the factor was reused
     pub factorization: f64,
-    /// the triangular solves of the correction (and of the bordered or gas term)
+    /// whether this linearization factorized its tangent (false: it reused an earlier factor)
+    pub factorized: bool,
+    /// the GMRES iterations of its solves with a reused factor (0 when it factorized)
+    pub krylov: usize,
+    /// the triangular solves of the correction (and of the bordered or gas term), or the GMRES
+    /// solves with a reused factor
     pub solve: f64,
     /// the scaled residual at the iterate
     pub residual: f64,
@@ -131,6 +143,7 @@ impl Model {
             ldlt,
             ordering,
             settings: NewtonSettings::default(),
+            reuse: Default::default(),
             iteration_log: None,
         })
     }

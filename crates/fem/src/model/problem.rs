@@ -1,6 +1,7 @@
 //! The membrane equilibrium under one load as a [`newton::Problem`] ([`MembraneProblem`]), its
 //! convergence scale and potential, and the arc-length constraint ([`ArcConstraint`]).
 
+use super::reuse::{self, CONTRACTION};
 use super::*;
 
 /// The pressure below which forces count as zero in the convergence test: ϖ = 1e-6 (six
@@ -85,6 +86,9 @@ pub(super) struct MembraneProblem<'a> {
     pub(super) branch: Option<Vec<[f64; 3]>>,
     /// the residual R = f_int − ϖg of the last linearization on its own branch
     pub(super) residual: Vec<f64>,
+    /// the scaled residual of the last linearization on its own branch, and whether it reused
+    /// the factor ([`super::reuse::CONTRACTION`])
+    pub(super) previous: Option<(f64, bool)>,
 }
 
 impl MembraneProblem<'_> {
@@ -104,6 +108,7 @@ impl MembraneProblem<'_> {
             rejected_seconds: std::cell::Cell::new(0.0),
             branch: None,
             residual: Vec::new(),
+            previous: None,
         }
     }
 
@@ -246,17 +251,95 @@ impl newton::Problem for MembraneProblem<'_> {
             _ => 1.0,
         };
         let merit = res + c.abs() / cscale;
+        let mut converged = res <= self.model.settings.rtol && c.abs() <= 1e-12 * cscale;
+        let gas_newton = self.load.gas().is_some() && self.arc.is_none();
+        // the last factor reused ([`super::reuse`]): plain solves only, where the last
+        // correction contracted the residual well, at the first linearization of a re-solve
+        // (after a multiplier update) and at a semi-smooth re-linearization (the same state)
+        let eligible = self.arc.is_none() && self.hold.is_none() && self.planes.is_none();
+        let contracted = match (&self.branch, self.previous) {
+            (None, Some((r0, _))) => res <= CONTRACTION * r0,
+            _ => true,
+        };
+        let mut failed = (0, 0.0);
+        let positions = self.branch.as_deref().unwrap_or(&state.x);
+        if eligible
+            && contracted
+            && self.model.may_reuse()
+            && self.model.contact_branches_kept(
+                positions,
+                self.contact(state).as_deref(),
+                &state.multipliers,
+            )
+        {
+            let t_solve = std::time::Instant::now();
+            let krylov_before = self.model.krylov_iterations();
+            let correction = if converged {
+                // no correction is needed; the converged state's inertia comes from one
+                // factorization there at the end of the solve (`Model::refresh_inertia`)
+                Some((vec![0.0; r.len()], 0.0))
+            } else {
+                let eta = reuse::forcing(res, self.model.settings.rtol);
+                let minus_r: Vec<f64> = r.iter().map(|v| -v).collect();
+                self.model.reused_correction(
+                    &a,
+                    p,
+                    gas_newton,
+                    minus_r,
+                    h.as_deref().map(|h| (h, c, cp)),
+                    eta,
+                )?
+            };
+            let krylov = self.model.krylov_iterations() - krylov_before;
+            if let Some((dx, dp)) = correction {
+                let negative = self.model.last_negative_pivots();
+                let slope = dot(&r, &dx);
+                if self.branch.is_none() {
+                    self.residual = r;
+                    self.previous = Some((res, true));
+                }
+                self.model.log_iteration(IterationRecord {
+                    assembly: assembly_seconds,
+                    line_search: self.rejected_seconds.replace(0.0),
+                    factorization: 0.0,
+                    factorized: false,
+                    krylov,
+                    solve: t_solve.elapsed().as_secs_f64(),
+                    residual: res,
+                    negative_pivots: negative,
+                });
+                return Ok(Linearization {
+                    residual: res,
+                    merit,
+                    converged,
+                    potential: potential(self.load.loading, a.energy, a.volume, p),
+                    slope,
+                    step: (dx, dp),
+                    bordered: h.is_some(),
+                    inertia: Inertia {
+                        negative_pivots: negative,
+                        shift: 0.0,
+                        stale: true,
+                    },
+                });
+            }
+            // GMRES did not reach its tolerance: factorize here and solve directly (the
+            // record keeps the iterations and seconds it spent)
+            failed = (krylov, t_solve.elapsed().as_secs_f64());
+        }
         let t_factor = std::time::Instant::now();
         let (neg, shift) = self.model.factorize(&a, p)?;
+        if eligible && self.model.reuses_factor() {
+            let positions = self.branch.as_deref().unwrap_or(&state.x).to_vec();
+            self.model.factorized_at(&positions);
+        }
         let factorization_seconds = t_factor.elapsed().as_secs_f64();
         let t_solve = std::time::Instant::now();
-        let mut converged = res <= self.model.settings.rtol && c.abs() <= 1e-12 * cscale;
         // the Newton correction
         let ldlt = &self.model.ldlt;
         let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
         let moving = self.planes.zip(self.arc);
         // closed gas: K_gas = K + (ϖ/V) g gᵀ, applied by Sherman–Morrison (`solve_gas`)
-        let gas_newton = self.load.gas().is_some() && self.arc.is_none();
         if moving.is_none() && !gas_newton {
             ldlt.solve(&mut dx);
         }
@@ -328,12 +411,15 @@ impl newton::Problem for MembraneProblem<'_> {
         let slope = dot(&r, &dx);
         if self.branch.is_none() {
             self.residual = r;
+            self.previous = Some((res, false));
         }
         self.model.log_iteration(IterationRecord {
             assembly: assembly_seconds,
             line_search: self.rejected_seconds.replace(0.0),
             factorization: factorization_seconds,
-            solve: t_solve.elapsed().as_secs_f64(),
+            factorized: true,
+            krylov: failed.0,
+            solve: t_solve.elapsed().as_secs_f64() + failed.1,
             residual: res,
             negative_pivots: negative,
         });
@@ -348,6 +434,7 @@ impl newton::Problem for MembraneProblem<'_> {
             inertia: Inertia {
                 negative_pivots: negative,
                 shift,
+                stale: false,
             },
         })
     }

@@ -27,14 +27,23 @@ impl Model {
     /// Factorize K = K_int − p H; if K is singular, retry with diagonal shifts of 1e-10 …
     /// 1e-4 of its largest diagonal entry. Returns (#neg, shift).
     pub(super) fn factorize(&mut self, a: &Assembled, p: f64) -> Result<(usize, f64), FemError> {
-        const SHIFTS: [f64; 4] = [1e-10, 1e-8, 1e-6, 1e-4];
         let mut vals: Vec<f64> = a
             .k_int
             .iter()
             .zip(&a.k_vol)
             .map(|(k, h)| k - p * h)
             .collect();
-        match self.ldlt.factorize(&vals) {
+        let result = self.factorize_shifted(&mut vals);
+        if let Ok((neg, shift)) = result {
+            self.factorized(neg, shift);
+        }
+        result
+    }
+
+    /// The factorization of `vals`, shifted where singular ([`Model::factorize`]).
+    fn factorize_shifted(&mut self, vals: &mut [f64]) -> Result<(usize, f64), FemError> {
+        const SHIFTS: [f64; 4] = [1e-10, 1e-8, 1e-6, 1e-4];
+        match self.ldlt.factorize(vals) {
             Ok(neg) => Ok((neg, 0.0)),
             Err(first) => {
                 let diag = self.pattern.diagonal();
@@ -50,7 +59,7 @@ impl Model {
                         vals[d] += s - applied;
                     }
                     applied = s;
-                    if let Ok(neg) = self.ldlt.factorize(&vals) {
+                    if let Ok(neg) = self.ldlt.factorize(vals) {
                         return Ok((neg, s));
                     }
                 }
@@ -94,7 +103,11 @@ impl Model {
         }
         let settings = self.settings;
         let contact = load.contact.clone();
-        self.augmented(
+        // every solve starts from a factorization at its first iterate, so that what it
+        // computes does not depend on the solves before it (a restarted run repeats the
+        // uninterrupted one bit for bit)
+        self.require_factorization();
+        let mut report = self.augmented(
             state,
             |_| contact.clone(),
             |model, state| {
@@ -104,7 +117,30 @@ impl Model {
                     &settings,
                 )
             },
-        )
+        )?;
+        if report.inertia.stale {
+            report.inertia =
+                self.refresh_inertia(state, load, arc)
+                    .map_err(|source| NewtonError::Problem {
+                        iteration: report.iterations,
+                        source,
+                    })?;
+        }
+        Ok(report)
+    }
+
+    /// The inertia of the tangent at the converged `state` of a solve whose last linearization
+    /// reused an earlier factor ([`super::reuse`]): one more linearization there, which
+    /// factorizes.
+    fn refresh_inertia(
+        &mut self,
+        state: &mut State,
+        load: &Load,
+        arc: Option<&ArcConstraint<'_>>,
+    ) -> Result<Inertia, FemError> {
+        self.require_factorization();
+        let lin = newton::Problem::linearize(&mut MembraneProblem::new(self, load, arc), state)?;
+        Ok(lin.inertia)
     }
 
     /// The Uzawa update of `state`'s contact history under `contact`
