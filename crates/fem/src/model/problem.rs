@@ -262,6 +262,7 @@ impl newton::Problem for MembraneProblem<'_> {
             _ => true,
         };
         let mut failed = (0, 0.0);
+        let mut reused = None;
         let positions = self.branch.as_deref().unwrap_or(&state.x);
         if eligible
             && contracted
@@ -291,135 +292,124 @@ impl newton::Problem for MembraneProblem<'_> {
                 )?
             };
             let krylov = self.model.krylov_iterations() - krylov_before;
-            if let Some((dx, dp)) = correction {
+            match correction {
+                Some((dx, dp)) => reused = Some((dx, dp, krylov, t_solve.elapsed().as_secs_f64())),
+                // GMRES did not reach its tolerance: factorize here and solve directly (the
+                // record keeps the iterations and seconds it spent)
+                None => failed = (krylov, t_solve.elapsed().as_secs_f64()),
+            }
+        }
+        // (correction, negative pivots, shift, factorization seconds, solve seconds, GMRES
+        // iterations, whether this linearization factorized)
+        let (dx, dp, negative, shift, factorization_seconds, solve_seconds, krylov, fresh) =
+            if let Some((dx, dp, krylov, seconds)) = reused {
                 let negative = self.model.last_negative_pivots();
-                let slope = dot(&r, &dx);
-                if self.branch.is_none() {
-                    self.residual = r;
-                    self.previous = Some((res, true));
+                (dx, dp, negative, 0.0, 0.0, seconds, krylov, false)
+            } else {
+                let t_factor = std::time::Instant::now();
+                let (neg, shift) = self.model.factorize(&a, p)?;
+                if eligible && self.model.reuses_factor() {
+                    let positions = self.branch.as_deref().unwrap_or(&state.x).to_vec();
+                    self.model.factorized_at(&positions);
                 }
-                self.model.log_iteration(IterationRecord {
-                    assembly: assembly_seconds,
-                    line_search: self.rejected_seconds.replace(0.0),
-                    factorization: 0.0,
-                    factorized: false,
-                    krylov,
-                    solve: t_solve.elapsed().as_secs_f64(),
-                    residual: res,
-                    negative_pivots: negative,
-                });
-                return Ok(Linearization {
-                    residual: res,
-                    merit,
-                    converged,
-                    potential: potential(self.load.loading, a.energy, a.volume, p),
-                    slope,
-                    step: (dx, dp),
-                    bordered: h.is_some(),
-                    inertia: Inertia {
-                        negative_pivots: negative,
-                        shift: 0.0,
-                        stale: true,
-                    },
-                });
-            }
-            // GMRES did not reach its tolerance: factorize here and solve directly (the
-            // record keeps the iterations and seconds it spent)
-            failed = (krylov, t_solve.elapsed().as_secs_f64());
-        }
-        let t_factor = std::time::Instant::now();
-        let (neg, shift) = self.model.factorize(&a, p)?;
-        if eligible && self.model.reuses_factor() {
-            let positions = self.branch.as_deref().unwrap_or(&state.x).to_vec();
-            self.model.factorized_at(&positions);
-        }
-        let factorization_seconds = t_factor.elapsed().as_secs_f64();
-        let t_solve = std::time::Instant::now();
-        // the Newton correction
-        let ldlt = &self.model.ldlt;
-        let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
-        let moving = self.planes.zip(self.arc);
-        // closed gas: K_gas = K + (ϖ/V) g gᵀ, applied by Sherman–Morrison (`solve_gas`)
-        if moving.is_none() && !gas_newton {
-            ldlt.solve(&mut dx);
-        }
-        let mut dp = 0.0;
-        let mut negative = neg;
-        if let Some((planes, arc)) = moving {
-            // closed gas with moving planes: K_gas [dx; dλ] bordered by ∂R/∂λ and the arc
-            // constraint, K_gas⁻¹ by Sherman–Morrison on the factor of K
-            negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
-            let mut bq: Vec<f64> = self
-                .model
-                .plane_rate(state, planes, state.planes)
-                .into_iter()
-                .map(|v| -v)
-                .collect();
-            self.model.solve_gas(&a, p, &mut bq);
-            let h: Vec<f64> = arc.tx.iter().map(|t| arc.w * t).collect();
-            let hb = dot(&h, &bq) + cp;
-            dp = (-c - dot(&h, &dx)) / hb;
-            for (d, bb) in dx.iter_mut().zip(&bq) {
-                *d += dp * bb;
-            }
-        } else if gas_newton {
-            negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
-        } else if let Some(h) = &h {
-            let mut b = a.g.clone();
-            ldlt.solve(&mut b);
-            if let Some(phi0) = self.hold {
-                // the held mode out of the load column and the correction, and its force out of
-                // the convergence test (it is the reaction of the hold)
-                let (phi, mu) = self.model.inverse_iteration(phi0);
-                project_out(&mut b, &phi);
-                project_out(&mut dx, &phi);
-                negative -= usize::from(mu < 0.0 && negative > 0);
-                // deflating from φ0 makes Kφ lie along φ0 (one inverse iteration), so at the
-                // fixed point R is along φ0: the reaction
-                let mut r_off = r.clone();
-                project_out(&mut r_off, phi0);
-                converged = norm(&r_off) / reference <= self.model.settings.rtol
-                    && c.abs() <= 1e-12 * cscale;
-                if converged {
-                    self.held = Some(Held {
-                        force: dot(phi0, &r),
-                        relative_eigenvalue: mu / self.model.largest_diagonal(&a, p),
-                        energy: a.energy,
-                        mode: phi,
-                    });
+                let factorization_seconds = t_factor.elapsed().as_secs_f64();
+                let t_solve = std::time::Instant::now();
+                // the Newton correction
+                let ldlt = &self.model.ldlt;
+                let mut dx: Vec<f64> = r.iter().map(|v| -v).collect();
+                let moving = self.planes.zip(self.arc);
+                // closed gas: K_gas = K + (ϖ/V) g gᵀ, applied by Sherman–Morrison (`solve_gas`)
+                if moving.is_none() && !gas_newton {
+                    ldlt.solve(&mut dx);
                 }
-            } else if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
-                // the neutral mode out of the load column (not out of the correction: the
-                // residual along it must still go); its pivot out of the count (its sign is
-                // round-off)
-                let (phi, mu) = self.model.deflate(phi0, &a.g, &b);
-                project_out(&mut b, &phi);
-                negative -= usize::from(mu < 0.0 && negative > 0);
-            }
-            let hb = dot(h, &b) + cp;
-            let ha = dot(h, &dx);
-            // the bordered operator's inertia (volume or stretch control); an arc-length step
-            // reports the pressure-control stiffness K itself
-            if hb < 0.0 && self.arc.is_none() {
-                negative = negative.saturating_sub(1);
-            }
-            dp = (-c - ha) / hb;
-            for (d, bb) in dx.iter_mut().zip(&b) {
-                *d += dp * bb;
-            }
-        }
+                let mut dp = 0.0;
+                let mut negative = neg;
+                if let Some((planes, arc)) = moving {
+                    // closed gas with moving planes: K_gas [dx; dλ] bordered by ∂R/∂λ and the arc
+                    // constraint, K_gas⁻¹ by Sherman–Morrison on the factor of K
+                    negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
+                    let mut bq: Vec<f64> = self
+                        .model
+                        .plane_rate(state, planes, state.planes)
+                        .into_iter()
+                        .map(|v| -v)
+                        .collect();
+                    self.model.solve_gas(&a, p, &mut bq);
+                    let h: Vec<f64> = arc.tx.iter().map(|t| arc.w * t).collect();
+                    let hb = dot(&h, &bq) + cp;
+                    dp = (-c - dot(&h, &dx)) / hb;
+                    for (d, bb) in dx.iter_mut().zip(&bq) {
+                        *d += dp * bb;
+                    }
+                } else if gas_newton {
+                    negative = negative.saturating_sub(self.model.solve_gas(&a, p, &mut dx));
+                } else if let Some(h) = &h {
+                    let mut b = a.g.clone();
+                    ldlt.solve(&mut b);
+                    if let Some(phi0) = self.hold {
+                        // the held mode out of the load column and the correction, and its force out of
+                        // the convergence test (it is the reaction of the hold)
+                        let (phi, mu) = self.model.inverse_iteration(phi0);
+                        project_out(&mut b, &phi);
+                        project_out(&mut dx, &phi);
+                        negative -= usize::from(mu < 0.0 && negative > 0);
+                        // deflating from φ0 makes Kφ lie along φ0 (one inverse iteration), so at the
+                        // fixed point R is along φ0: the reaction
+                        let mut r_off = r.clone();
+                        project_out(&mut r_off, phi0);
+                        converged = norm(&r_off) / reference <= self.model.settings.rtol
+                            && c.abs() <= 1e-12 * cscale;
+                        if converged {
+                            self.held = Some(Held {
+                                force: dot(phi0, &r),
+                                relative_eigenvalue: mu / self.model.largest_diagonal(&a, p),
+                                energy: a.energy,
+                                mode: phi,
+                            });
+                        }
+                    } else if let Some(phi0) = self.arc.and_then(|arc| arc.neutral) {
+                        // the neutral mode out of the load column (not out of the correction: the
+                        // residual along it must still go); its pivot out of the count (its sign is
+                        // round-off)
+                        let (phi, mu) = self.model.deflate(phi0, &a.g, &b);
+                        project_out(&mut b, &phi);
+                        negative -= usize::from(mu < 0.0 && negative > 0);
+                    }
+                    let hb = dot(h, &b) + cp;
+                    let ha = dot(h, &dx);
+                    // the bordered operator's inertia (volume or stretch control); an arc-length step
+                    // reports the pressure-control stiffness K itself
+                    if hb < 0.0 && self.arc.is_none() {
+                        negative = negative.saturating_sub(1);
+                    }
+                    dp = (-c - ha) / hb;
+                    for (d, bb) in dx.iter_mut().zip(&b) {
+                        *d += dp * bb;
+                    }
+                }
+                (
+                    dx,
+                    dp,
+                    negative,
+                    shift,
+                    factorization_seconds,
+                    t_solve.elapsed().as_secs_f64() + failed.1,
+                    failed.0,
+                    true,
+                )
+            };
         let slope = dot(&r, &dx);
         if self.branch.is_none() {
             self.residual = r;
-            self.previous = Some((res, false));
+            self.previous = Some((res, !fresh));
         }
         self.model.log_iteration(IterationRecord {
             assembly: assembly_seconds,
             line_search: self.rejected_seconds.replace(0.0),
             factorization: factorization_seconds,
-            factorized: true,
-            krylov: failed.0,
-            solve: t_solve.elapsed().as_secs_f64() + failed.1,
+            factorized: fresh,
+            krylov,
+            solve: solve_seconds,
             residual: res,
             negative_pivots: negative,
         });
@@ -434,7 +424,7 @@ impl newton::Problem for MembraneProblem<'_> {
             inertia: Inertia {
                 negative_pivots: negative,
                 shift,
-                stale: false,
+                stale: !fresh,
             },
         })
     }
