@@ -17,9 +17,11 @@ Generated, not tracked (git ignores them; `generate` writes them before the book
   docs/src/reference/python.md       from the module's docstrings and tubemem.pyi
   docs/src/verification/*.md         from docs/verification/results.json
 Tracked: README.md's verification headline, between its markers (`check` diffs it with a
-regeneration), and the paper suite's run that the manual shows: docs/verification/results.json
-and docs/src/verification/plots/ (`import-verification` replaces them, as `--update-gold` does
-for gold files).
+regeneration), and the measured values of the paper suite's run that the manual shows,
+docs/verification/results.json (`import-verification RUN` replaces it, as `--update-gold` does
+for gold files). The run's plots are output, not tracked: `import-verification` copies them to
+docs/src/verification/plots/ on the machine that ran the suite, and a page shows a check's plot
+where that file is there (otherwise the command that draws it).
 
 The environment: $TUBEMEM (default target/release/tubemem) and $PYTHON (the interpreter with the
 built `tubemem` module, for the Python page; default the checkout's .venv).
@@ -384,7 +386,10 @@ def family_page(kind, results):
         if r["measures"]:
             s += measures_table(r) + "\n"
         if r.get("plot"):
-            s += f"![{r['name']}](plots/{r['name']}.png)\n\n"
+            if (VPAGES / "plots" / f"{r['name']}.png").is_file():
+                s += f"![{r['name']}](plots/{r['name']}.png)\n\n"
+            else:
+                s += f"Its plot is `{r['plot']}` in the folder of the rerun below (plots are not kept in the repository).\n\n"
         s += f"Rerun it: `tubemem verify verify/paper.toml --filter {r['name']} --out runs/{r['name']}`\n\n"
     return s.rstrip() + "\n"
 
