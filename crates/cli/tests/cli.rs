@@ -1171,13 +1171,19 @@ fn nonsense_is_refused_and_small_targets_work() {
 /// (`ref`) and again killed (SIGKILL) after its second squeeze step (`killed`); returns the
 /// case file and both run folders.
 fn killed_in_its_squeeze(name: &str, text: &str) -> (PathBuf, PathBuf, PathBuf) {
+    killed_after_two_steps(name, text, 2)
+}
+
+/// As [`killed_in_its_squeeze`], killed after the second step of stage `stage`.
+fn killed_after_two_steps(name: &str, text: &str, stage: usize) -> (PathBuf, PathBuf, PathBuf) {
     let d = tmp(name);
     let case = d.join("case.toml");
     std::fs::write(&case, text).unwrap();
     let (reference, killed) = (d.join("ref"), d.join("killed"));
     assert!(run_in(&case, &reference, &[]).status.success());
+    let prefix = format!("{stage},");
     run_and_kill(&case, &killed, |steps| {
-        steps.lines().filter(|l| l.starts_with("2,")).count() >= 2
+        steps.lines().filter(|l| l.starts_with(&prefix)).count() >= 2
     });
     (case, reference, killed)
 }
@@ -1239,18 +1245,11 @@ fn a_killed_run_resumes_bit_identical() {
 fn a_killed_run_that_reuses_its_factor_resumes_bit_identical() {
     let text = include_str!("../../../cases/squeeze_abb30_ls1.3.toml");
     assert!(!text.contains("[solver]"));
-    let d = tmp("resume-reuse");
-    let case = d.join("case.toml");
-    std::fs::write(
-        &case,
-        format!("{text}\n[solver]\nrefactorize = \"on-demand\"\n"),
-    )
-    .unwrap();
-    let (reference, killed) = (d.join("ref"), d.join("killed"));
-    assert!(run_in(&case, &reference, &[]).status.success());
-    run_and_kill(&case, &killed, |steps| {
-        steps.lines().filter(|l| l.starts_with("1,")).count() >= 2
-    });
+    let (case, reference, killed) = killed_after_two_steps(
+        "resume-reuse",
+        &format!("{text}\n[solver]\nrefactorize = \"on-demand\"\n"),
+        1,
+    );
     run_ok(&case, &killed, &["--resume"]);
     let s: Value =
         serde_json::from_str(&std::fs::read_to_string(killed.join("summary.json")).unwrap())

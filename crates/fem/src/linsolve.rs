@@ -225,13 +225,8 @@ impl SparseLdlt {
     /// Numeric LDLᵀ of the matrix whose values (one per pair given to `new`) are `values`.
     /// Returns the number of negative pivots.
     pub fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
-        assert_eq!(values.len(), self.entries, "one value per pattern entry");
         self.factorized = false;
-        if let Some(entry) = values.iter().position(|v| !v.is_finite()) {
-            return Err(FemError::NonFiniteEntry { entry });
-        }
-        let mat = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
-            .map_err(FactorizationError::Fill)?;
+        let mat = self.filled(values)?;
         let par = self.par;
         let req = self
             .symbolic
@@ -299,13 +294,22 @@ impl SparseLdlt {
     /// The symmetric matrix whose values (one per pair given to `new`, duplicates summed)
     /// are `values`, as an operator ([`SymmetricMatrix::apply`]).
     pub fn matrix(&self, values: &[f64]) -> Result<SymmetricMatrix, FemError> {
+        Ok(SymmetricMatrix {
+            lower: self.filled(values)?,
+        })
+    }
+
+    /// The lower triangle with `values` (one per pair given to `new`, duplicates summed),
+    /// refused where an entry is not finite.
+    fn filled(&self, values: &[f64]) -> Result<SparseColMat<usize, f64>, FemError> {
         assert_eq!(values.len(), self.entries, "one value per pattern entry");
         if let Some(entry) = values.iter().position(|v| !v.is_finite()) {
             return Err(FemError::NonFiniteEntry { entry });
         }
-        let lower = SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
-            .map_err(FactorizationError::Fill)?;
-        Ok(SymmetricMatrix { lower })
+        Ok(
+            SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
+                .map_err(FactorizationError::Fill)?,
+        )
     }
 
     /// Solve A y = rhs in place with the last factorization.
@@ -399,7 +403,8 @@ mod tests {
                         + if i + 1 < n { 0.1 * x[i + 1] } else { 0.0 }
                 })
                 .collect();
-            // the operator of the same values (duplicates summed, both triangles) gives b
+            // the operator of the same values (duplicates summed, both triangles) gives b, to
+            // the rounding of three products of size ≤ 7 (≈ 1e-15)
             let mut ax = vec![0.0; n];
             s.matrix(&vals).unwrap().apply(&x, &mut ax);
             for i in 0..n {

@@ -274,11 +274,10 @@ impl newton::Problem for MembraneProblem<'_> {
             )
         {
             let t_solve = std::time::Instant::now();
-            let krylov_before = self.model.krylov_iterations();
-            let correction = if converged {
+            let (correction, krylov) = if converged {
                 // no correction is needed; the converged state's inertia comes from one
                 // factorization there at the end of the solve (`Model::refresh_inertia`)
-                Some((vec![0.0; r.len()], 0.0))
+                (Some((vec![0.0; r.len()], 0.0)), 0)
             } else {
                 let eta = reuse::forcing(res, self.model.settings.rtol);
                 let minus_r: Vec<f64> = r.iter().map(|v| -v).collect();
@@ -291,7 +290,6 @@ impl newton::Problem for MembraneProblem<'_> {
                     eta,
                 )?
             };
-            let krylov = self.model.krylov_iterations() - krylov_before;
             match correction {
                 Some((dx, dp)) => reused = Some((dx, dp, krylov, t_solve.elapsed().as_secs_f64())),
                 // GMRES did not reach its tolerance: factorize here and solve directly (the

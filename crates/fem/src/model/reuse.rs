@@ -105,6 +105,9 @@ pub const CONTRACTION: f64 = 0.5;
 /// flops, 13 in time).
 pub const AUTO_FLOP_RATIO: f64 = 50.0;
 
+/// A Newton correction (Δx on the free dofs, Δϖ).
+pub(super) type Correction = (Vec<f64>, f64);
+
 /// The factor's state across linearizations.
 #[derive(Default)]
 pub(super) struct FactorReuse {
@@ -200,7 +203,7 @@ impl Model {
     /// current tangent K = K_int − ϖH (+ (ϖ/V) g gᵀ for closed gas): `minus_r` is −R, `border`
     /// the constraint's (h, c, ∂c/∂ϖ) of a bordered control. None where a solve did not reach
     /// `eta` within [`MAX_KRYLOV`] iterations (the caller refactorizes); Err where K cannot be
-    /// built.
+    /// built. Also returns the GMRES iterations it took.
     pub(super) fn reused_correction(
         &mut self,
         a: &Assembled,
@@ -209,14 +212,8 @@ impl Model {
         mut minus_r: Vec<f64>,
         border: Option<(&[f64], f64, f64)>,
         eta: f64,
-    ) -> Result<Option<(Vec<f64>, f64)>, FemError> {
-        let values: Vec<f64> = a
-            .k_int
-            .iter()
-            .zip(&a.k_vol)
-            .map(|(k, h)| k - p * h)
-            .collect();
-        let k = self.ldlt.matrix(&values)?;
+    ) -> Result<(Option<Correction>, usize), FemError> {
+        let k = self.ldlt.matrix(&super::solve::tangent_values(a, p))?;
         let cc = if gas { p / a.volume } else { 0.0 };
         let ldlt = &self.ldlt;
         let mut iterations = 0;
@@ -253,7 +250,7 @@ impl Model {
             }
         }
         self.reuse.krylov_iterations += iterations;
-        Ok(ok.then_some((minus_r, dp)))
+        Ok((ok.then_some((minus_r, dp)), iterations))
     }
 }
 

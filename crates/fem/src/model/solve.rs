@@ -23,16 +23,20 @@ pub struct Held {
     pub energy: f64,
 }
 
+/// The values of K = K_int − p H, one per pattern entry.
+pub(super) fn tangent_values(a: &Assembled, p: f64) -> Vec<f64> {
+    a.k_int
+        .iter()
+        .zip(&a.k_vol)
+        .map(|(k, h)| k - p * h)
+        .collect()
+}
+
 impl Model {
     /// Factorize K = K_int − p H; if K is singular, retry with diagonal shifts of 1e-10 …
     /// 1e-4 of its largest diagonal entry. Returns (#neg, shift).
     pub(super) fn factorize(&mut self, a: &Assembled, p: f64) -> Result<(usize, f64), FemError> {
-        let mut vals: Vec<f64> = a
-            .k_int
-            .iter()
-            .zip(&a.k_vol)
-            .map(|(k, h)| k - p * h)
-            .collect();
+        let mut vals = tangent_values(a, p);
         let result = self.factorize_shifted(&mut vals);
         if let Ok((neg, shift)) = result {
             self.factorized(neg, shift);
