@@ -1,0 +1,354 @@
+//! Measure first: what factorizing the elimination tree's independent subtrees on two threads
+//! would gain on the whole capped tube's pattern (parallelism across the elimination tree),
+//! before writing a layer over faer's supernodal kernels.
+//!
+//! ```text
+//! cargo run --release -p tubemem-fem --example subtree_split -- AROUND ALONG
+//! ORDER=ring cargo run --release -p tubemem-fem --example subtree_split -- AROUND ALONG
+//! ```
+//! (default 448 × 560: the million-unknown benchmark's 4-node mesh, 3 unknowns per node, no
+//! constraint taken out.) The pattern is the mesh's node graph expanded to 3 unknowns per node,
+//! ordered by the project's nested dissection ([`tubemem_fem::ordering::nested_dissection`]),
+//! or with `ORDER=ring` by the mid-span ring of nodes (z = 0) as the top separator and nested
+//! dissection inside each half. The values are a graph Laplacian plus 10⁻³ I: LDLᵀ without
+//! pivoting does the same flops whatever the values, but a strongly dominant diagonal would make
+//! the factor's far entries subnormal, and the dense kernels slow down many times on those.
+//! It prints:
+//!
+//! 1. from faer's supernodal symbolic factor: the supernodal elimination tree's top, the flops
+//!    of each subtree (Σ over columns of (entries below the diagonal)²), and the split a
+//!    subtree-to-thread mapping would make — the subtrees shared between two threads largest
+//!    first, the largest opened (its root to the sequential top) while that shortens
+//!    top + the longer share; the ideal speed-up is total / (top + longer share);
+//! 2. measured, each the second of two factorizations into storage the first touched (as the
+//!    solver's factor keeps its storage): the numeric LDLᵀ of the whole matrix on 1 thread and
+//!    on 2 (faer's parallelism inside supernodes), and of the two shares' principal submatrices
+//!    (each on one thread) one after the other and side by side (`rayon::join`). A share's
+//!    submatrix leaves out its updates of the rows above it (the top's), so its flops are
+//!    printed next to the share's.
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Par, Side};
+use std::time::Instant;
+use tubemem_mesh::{tube::capped_tube, Symmetry};
+
+fn symbolic(m: &SparseColMat<usize, f64>) -> SymbolicCholesky<usize> {
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    // the identity as a custom ordering (faer 0.24's `Identity` with the lower triangle
+    // analyses the diagonal alone)
+    let id: Vec<usize> = (0..m.ncols()).collect();
+    factorize_symbolic_cholesky(
+        m.symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&id, &id, m.ncols())),
+        params,
+    )
+    .expect("symbolic")
+}
+
+/// Seconds of a numeric LDLᵀ on `par` into a factor and a workspace that an earlier
+/// factorization has touched (as the solver's, which keeps its factor's storage from one
+/// factorization to the next): the second of two; also the workspace's bytes.
+fn factor_seconds(
+    m: &SparseColMat<usize, f64>,
+    s: &SymbolicCholesky<usize>,
+    par: Par,
+) -> (f64, usize) {
+    let mut l = vec![0.0; s.len_val()];
+    let req = s.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
+    let mut mem = MemBuffer::new(req);
+    let mut seconds = 0.0;
+    for _ in 0..2 {
+        let t = Instant::now();
+        s.factorize_numeric_ldlt::<f64>(
+            &mut l,
+            m.as_ref(),
+            Side::Lower,
+            LdltRegularization::default(),
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .expect("numeric");
+        seconds = t.elapsed().as_secs_f64();
+    }
+    (seconds, req.size_bytes())
+}
+
+/// Σ over columns of (entries below the diagonal)², faer's supernodal layout.
+fn flops_of(s: &SymbolicCholesky<usize>) -> f64 {
+    let SymbolicCholeskyRaw::Supernodal(sn) = s.raw() else {
+        panic!("supernodal layout forced")
+    };
+    let (b, e) = (sn.supernode_begin(), sn.supernode_end());
+    (0..sn.n_supernodes())
+        .map(|k| {
+            let (c, r) = (e[k] - b[k], sn.supernode(k).pattern().len());
+            (0..c)
+                .map(|j| ((c - 1 - j + r) as f64).powi(2))
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+/// The principal submatrix of `m` (lower triangle) on the columns `cols` (ascending).
+fn principal(m: &SparseColMat<usize, f64>, cols: &[usize]) -> SparseColMat<usize, f64> {
+    let mut at = vec![usize::MAX; m.ncols()];
+    for (k, &c) in cols.iter().enumerate() {
+        at[c] = k;
+    }
+    let mut t = Vec::new();
+    for &c in cols {
+        let rows = m.as_ref().row_idx_of_col_raw(c);
+        let vals = m.as_ref().val_of_col(c);
+        for (&r, &v) in rows.iter().zip(vals) {
+            if at[r] != usize::MAX {
+                t.push(Triplet::new(at[r], at[c], v));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(cols.len(), cols.len(), &t).expect("submatrix")
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("AROUND ALONG"))
+        .collect();
+    let (around, along) = (
+        args.first().copied().unwrap_or(448),
+        args.get(1).copied().unwrap_or(560),
+    );
+    let mesh = capped_tube(1.0, 20.0, around, along, Symmetry::None).expect("mesh");
+    let n = 3 * mesh.nodes.len();
+    let mut pairs = Vec::new();
+    for q in &mesh.quads {
+        for &a in q {
+            for &b in q {
+                for ca in 0..3 {
+                    for cb in 0..3 {
+                        let (r, c) = (3 * a + ca, 3 * b + cb);
+                        if r >= c {
+                            pairs.push((r, c));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    let nd = tubemem_fem::ordering::nested_dissection(n, &pairs).expect("ordering");
+    // the tube's own top separator: the ring of nodes at mid-length (z = 0), each half ordered
+    // by nested dissection, the ring last
+    let side = |k: usize| {
+        let z = mesh.nodes[k / 3][2];
+        if z.abs() < 1e-9 {
+            2
+        } else {
+            usize::from(z > 0.0)
+        }
+    };
+    let mut ring_split = Vec::with_capacity(n);
+    for half in 0..2 {
+        let members: Vec<usize> = (0..n).filter(|&k| side(k) == half).collect();
+        let mut local = vec![usize::MAX; n];
+        for (i, &k) in members.iter().enumerate() {
+            local[k] = i;
+        }
+        let sub: Vec<(usize, usize)> = pairs
+            .iter()
+            .filter(|&&(r, c)| local[r] != usize::MAX && local[c] != usize::MAX)
+            .map(|&(r, c)| (local[r], local[c]))
+            .collect();
+        let order =
+            tubemem_fem::ordering::nested_dissection(members.len(), &sub).expect("ordering");
+        ring_split.extend(order.iter().map(|&i| members[i]));
+    }
+    ring_split.extend((0..n).filter(|&k| side(k) == 2));
+    let which = std::env::var("ORDER").unwrap_or_default();
+    println!(
+        "ordering: {}",
+        if which == "ring" {
+            "ring split"
+        } else {
+            "nested dissection"
+        }
+    );
+    let perm = if which == "ring" { ring_split } else { nd };
+    let mut inv = vec![0usize; n];
+    for (k, &p) in perm.iter().enumerate() {
+        inv[p] = k;
+    }
+    // a graph Laplacian plus 1e-3 I on the pattern (SPD), in the nested-dissection order: its
+    // factor's entries decay slowly (a strongly dominant diagonal makes them decay to
+    // subnormal numbers, which the dense kernels process many times slower)
+    let mut degree = vec![0usize; n];
+    for &(r, c) in &pairs {
+        if r != c {
+            degree[r] += 1;
+            degree[c] += 1;
+        }
+    }
+    let triplets: Vec<Triplet<usize, usize, f64>> = pairs
+        .iter()
+        .map(|&(r, c)| {
+            let (pr, pc) = (inv[r], inv[c]);
+            let v = if r == c {
+                degree[r] as f64 + 1e-3
+            } else {
+                -1.0
+            };
+            Triplet::new(pr.max(pc), pr.min(pc), v)
+        })
+        .collect();
+    let m = SparseColMat::try_new_from_triplets(n, n, &triplets).expect("matrix");
+    let sym = symbolic(&m);
+    let SymbolicCholeskyRaw::Supernodal(sn) = sym.raw() else {
+        panic!("supernodal layout forced")
+    };
+    let (b, e) = (sn.supernode_begin(), sn.supernode_end());
+    let ns = sn.n_supernodes();
+    let mut of_col = vec![0usize; n];
+    for k in 0..ns {
+        of_col[b[k]..e[k]].fill(k);
+    }
+    let parent: Vec<Option<usize>> = (0..ns)
+        .map(|k| sn.supernode(k).pattern().first().map(|&r| of_col[r]))
+        .collect();
+    let own: Vec<f64> = (0..ns)
+        .map(|k| {
+            let (c, r) = (e[k] - b[k], sn.supernode(k).pattern().len());
+            (0..c)
+                .map(|j| ((c - 1 - j + r) as f64).powi(2))
+                .sum::<f64>()
+        })
+        .collect();
+    let mut children = vec![Vec::new(); ns];
+    let mut sub = own.clone();
+    let mut roots = Vec::new();
+    for k in 0..ns {
+        match parent[k] {
+            Some(p) => {
+                assert!(p > k, "postordered");
+                children[p].push(k);
+                let s = sub[k];
+                sub[p] += s;
+            }
+            None => roots.push(k),
+        }
+    }
+    let total: f64 = roots.iter().map(|&r| sub[r]).sum();
+    // the split: subtrees shared between two threads, largest first (LPT); the largest
+    // subtree is opened (its root joins the sequential top, its children the frontier) while
+    // that shortens top + the longer share
+    let lpt = |frontier: &[usize]| {
+        let mut f = frontier.to_vec();
+        f.sort_by(|a, b| sub[*b].total_cmp(&sub[*a]).then(a.cmp(b)));
+        let mut share = [Vec::new(), Vec::new()];
+        let mut load = [0.0f64; 2];
+        for &k in &f {
+            let t = usize::from(load[1] < load[0]);
+            load[t] += sub[k];
+            share[t].push(k);
+        }
+        (share, load)
+    };
+    let mut frontier = roots.clone();
+    let mut top = 0.0;
+    let mut top_nodes = Vec::new();
+    loop {
+        let (_, load) = lpt(&frontier);
+        let (i, &big) = frontier
+            .iter()
+            .enumerate()
+            .max_by(|a, b| sub[*a.1].total_cmp(&sub[*b.1]))
+            .expect("a subtree");
+        let mut opened = frontier.clone();
+        opened.swap_remove(i);
+        opened.extend(&children[big]);
+        let (_, after) = lpt(&opened);
+        if own[big] + after[0].max(after[1]) >= load[0].max(load[1]) {
+            break;
+        }
+        top += own[big];
+        top_nodes.push(big);
+        frontier = opened;
+    }
+    let (share, load) = lpt(&frontier);
+    for &k in &top_nodes {
+        println!("top supernode {k}: {} columns, pattern {}, own {:.2} GFLOP, children subtrees {:?} GFLOP", e[k] - b[k], sn.supernode(k).pattern().len(), own[k] / 1e9, children[k].iter().map(|&c| (sub[c] / 1e8).round() / 10.0).collect::<Vec<_>>());
+    }
+    let top_cols: usize = top_nodes.iter().map(|&k| e[k] - b[k]).sum();
+    println!(
+        "{n} unknowns, {ns} supernodes, {:.1} GFLOP (Σ col²); top: {} supernodes, {top_cols} columns, {:.2} GFLOP ({:.1} %); shares {:.1} + {:.1} GFLOP in {} + {} subtrees",
+        total / 1e9,
+        top_nodes.len(),
+        top / 1e9,
+        100.0 * top / total,
+        load[0] / 1e9,
+        load[1] / 1e9,
+        share[0].len(),
+        share[1].len()
+    );
+    println!(
+        "ideal speed-up on 2 threads: {:.2}",
+        total / (top + load[0].max(load[1]))
+    );
+    // the columns of each share
+    let cols: Vec<Vec<usize>> = share
+        .iter()
+        .map(|roots| {
+            let mut inside = vec![false; ns];
+            for &r in roots {
+                inside[r] = true;
+            }
+            for k in (0..ns).rev() {
+                if let Some(p) = parent[k] {
+                    if inside[p] {
+                        inside[k] = true;
+                    }
+                }
+            }
+            (0..n).filter(|&c| inside[of_col[c]]).collect()
+        })
+        .collect();
+    let subs: Vec<SparseColMat<usize, f64>> = cols.iter().map(|c| principal(&m, c)).collect();
+    let subsym: Vec<SymbolicCholesky<usize>> = subs.iter().map(symbolic).collect();
+    for (i, s) in subsym.iter().enumerate() {
+        println!(
+            "share {i}: {} columns, submatrix factor {:.1} GFLOP (the share's subtrees: {:.1})",
+            cols[i].len(),
+            flops_of(s) / 1e9,
+            load[i] / 1e9
+        );
+    }
+    for round in 0..2 {
+        let (whole1, bytes) = factor_seconds(&m, &sym, Par::Seq);
+        let (whole2, _) = factor_seconds(&m, &sym, Par::rayon(2));
+        let seq: Vec<f64> = (0..2)
+            .map(|i| factor_seconds(&subs[i], &subsym[i], Par::Seq).0)
+            .collect();
+        let (a, b) = rayon::join(
+            || factor_seconds(&subs[0], &subsym[0], Par::Seq).0,
+            || factor_seconds(&subs[1], &subsym[1], Par::Seq).0,
+        );
+        println!(
+            "round {round}: whole 1 thread {whole1:.3} s (workspace {:.0} MiB), whole 2 threads {whole2:.3} s; shares one after the other {:.3} + {:.3} = {:.3} s, side by side {a:.3} and {b:.3} s ({:.2}× the sequential shares)",
+            bytes as f64 / 1048576.0,
+            seq[0],
+            seq[1],
+            seq[0] + seq[1],
+            (seq[0] + seq[1]) / a.max(b)
+        );
+    }
+}
