@@ -10,9 +10,10 @@
 //! constraint taken out.) The pattern is the mesh's node graph expanded to 3 unknowns per node,
 //! ordered by the project's nested dissection ([`tubemem_fem::ordering::nested_dissection`]),
 //! or with `ORDER=ring` by the mid-span ring of nodes (z = 0) as the top separator and nested
-//! dissection inside each half. The values are a graph Laplacian plus 10⁻³ I: LDLᵀ without
-//! pivoting does the same flops whatever the values, but a strongly dominant diagonal would make
-//! the factor's far entries subnormal, and the dense kernels slow down many times on those.
+//! dissection inside each half. The values are symmetric and diagonally dominant by 10⁻³ only: LDLᵀ
+//! without pivoting does the same flops whatever the values, but a strongly dominant diagonal
+//! would make the factor's far entries subnormal, and the dense kernels slow down many times on
+//! those.
 //! It prints:
 //!
 //! 1. from faer's supernodal symbolic factor: the supernodal elimination tree's top, the flops
@@ -25,7 +26,13 @@
 //!    on 2 (faer's parallelism inside supernodes), and of the two shares' principal submatrices
 //!    (each on one thread) one after the other and side by side (`rayon::join`). A share's
 //!    submatrix leaves out its updates of the rows above it (the top's), so its flops are
-//!    printed next to the share's.
+//!    printed next to the share's;
+//! 3. with `ORDER=ring`, the layer itself, on the ring: the bordered matrices [A_i B_i; B_iᵀ 0]
+//!    of the two halves (the ring last) factorized side by side, each on one thread; the
+//!    ring's Schur complement S = C − Σ B_iᵀ A_i⁻¹ B_i from their factors' trailing blocks
+//!    (−B_iᵀ A_i⁻¹ B_i = (L D Lᵀ)_ring) and its dense Cholesky; ln det K = Σ ln det A_i +
+//!    ln det S against the whole factor's, which shows that the split factorizes the same
+//!    matrix.
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
@@ -98,6 +105,103 @@ fn flops_of(s: &SymbolicCholesky<usize>) -> f64 {
                 .sum::<f64>()
         })
         .sum()
+}
+
+/// The numeric LDLᵀ's values and seconds (the second of two, as in [`factor_seconds`]).
+fn factor_values(m: &SparseColMat<usize, f64>, s: &SymbolicCholesky<usize>) -> (Vec<f64>, f64) {
+    let mut l = vec![0.0; s.len_val()];
+    let req = s.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
+    let mut mem = MemBuffer::new(req);
+    let mut seconds = 0.0;
+    for _ in 0..2 {
+        let t = Instant::now();
+        s.factorize_numeric_ldlt::<f64>(
+            &mut l,
+            m.as_ref(),
+            Side::Lower,
+            LdltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .expect("numeric");
+        seconds = t.elapsed().as_secs_f64();
+    }
+    (l, seconds)
+}
+
+/// Σ ln D_jj over the first `upto` columns of a supernodal LDLᵀ factor (with the count of
+/// negative pivots).
+fn log_pivots(s: &SymbolicCholesky<usize>, l: &[f64], upto: usize) -> (f64, usize) {
+    let SymbolicCholeskyRaw::Supernodal(sn) = s.raw() else {
+        panic!("supernodal layout forced")
+    };
+    let ptr = sn.col_ptr_for_val();
+    let (mut sum, mut negative) = (0.0, 0);
+    for k in 0..sn.n_supernodes() {
+        let (b, e) = (sn.supernode_begin()[k], sn.supernode_end()[k]);
+        let rows = e - b + sn.supernode(k).pattern().len();
+        let val = faer::MatRef::from_column_major_slice(&l[ptr[k]..ptr[k + 1]], rows, e - b);
+        for j in 0..(e - b) {
+            if b + j < upto {
+                sum += val[(j, j)].abs().ln();
+                negative += usize::from(val[(j, j)] < 0.0);
+            }
+        }
+    }
+    (sum, negative)
+}
+
+/// The trailing `k` × `k` block of L D Lᵀ from a supernodal LDLᵀ factor whose last `k`
+/// columns lie in its last supernode (None otherwise): there L's diagonal block is unit lower
+/// with D on its diagonal.
+fn trailing_block(s: &SymbolicCholesky<usize>, l: &[f64], k: usize) -> Option<faer::Mat<f64>> {
+    let SymbolicCholeskyRaw::Supernodal(sn) = s.raw() else {
+        return None;
+    };
+    let last = sn.n_supernodes() - 1;
+    let (b, e) = (sn.supernode_begin()[last], sn.supernode_end()[last]);
+    if e - b < k || !sn.supernode(last).pattern().is_empty() {
+        return None;
+    }
+    let ptr = sn.col_ptr_for_val();
+    let c = e - b;
+    let val = faer::MatRef::from_column_major_slice(&l[ptr[last]..ptr[last + 1]], c, c);
+    let block = val.submatrix(c - k, c - k, k, k);
+    let mut unit = faer::Mat::<f64>::zeros(k, k);
+    let mut scaled = faer::Mat::<f64>::zeros(k, k);
+    for j in 0..k {
+        let d = block[(j, j)];
+        unit[(j, j)] = 1.0;
+        scaled[(j, j)] = d;
+        for i in j + 1..k {
+            unit[(i, j)] = block[(i, j)];
+            scaled[(i, j)] = block[(i, j)] * d;
+        }
+    }
+    Some(&scaled * unit.transpose())
+}
+
+/// The principal submatrix of `m` on the columns `cols` (ascending) with the block of its
+/// last `k` columns set to zero: [A B; Bᵀ 0].
+fn bordered(m: &SparseColMat<usize, f64>, cols: &[usize], k: usize) -> SparseColMat<usize, f64> {
+    let mut at = vec![usize::MAX; m.ncols()];
+    for (j, &c) in cols.iter().enumerate() {
+        at[c] = j;
+    }
+    let first = cols.len() - k;
+    let mut t = Vec::new();
+    for &c in cols {
+        let rows = m.as_ref().row_idx_of_col_raw(c);
+        let vals = m.as_ref().val_of_col(c);
+        for (&r, &v) in rows.iter().zip(vals) {
+            if at[r] != usize::MAX {
+                let zero = at[r] >= first && at[c] >= first;
+                t.push(Triplet::new(at[r], at[c], if zero { 0.0 } else { v }));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(cols.len(), cols.len(), &t).expect("submatrix")
 }
 
 /// The principal submatrix of `m` (lower triangle) on the columns `cols` (ascending).
@@ -174,6 +278,10 @@ fn main() {
             tubemem_fem::ordering::nested_dissection(members.len(), &sub).expect("ordering");
         ring_split.extend(order.iter().map(|&i| members[i]));
     }
+    let halves = [
+        (0..n).filter(|&k| side(k) == 0).count(),
+        (0..n).filter(|&k| side(k) == 1).count(),
+    ];
     ring_split.extend((0..n).filter(|&k| side(k) == 2));
     let which = std::env::var("ORDER").unwrap_or_default();
     println!(
@@ -189,25 +297,32 @@ fn main() {
     for (k, &p) in perm.iter().enumerate() {
         inv[p] = k;
     }
-    // a graph Laplacian plus 1e-3 I on the pattern (SPD), in the nested-dissection order: its
+    // an SPD matrix on the pattern, diagonally dominant by 1e-3 only, in the nested-dissection order: its
     // factor's entries decay slowly (a strongly dominant diagonal makes them decay to
     // subnormal numbers, which the dense kernels process many times slower)
-    let mut degree = vec![0usize; n];
+    // off the diagonal −1 between equal components and −0.1 (1 + a b) between components a ≠ b
+    // (three unknowns of a node with equal couplings would make the ring's Schur complement
+    // singular); on it the sum of the row's magnitudes plus 10⁻³
+    let off = |r: usize, c: usize| {
+        let (a, b) = (r % 3, c % 3);
+        if a == b {
+            -1.0
+        } else {
+            -0.1 * (1 + a * b) as f64
+        }
+    };
+    let mut diagonal = vec![1e-3; n];
     for &(r, c) in &pairs {
         if r != c {
-            degree[r] += 1;
-            degree[c] += 1;
+            diagonal[r] -= off(r, c);
+            diagonal[c] -= off(r, c);
         }
     }
     let triplets: Vec<Triplet<usize, usize, f64>> = pairs
         .iter()
         .map(|&(r, c)| {
             let (pr, pc) = (inv[r], inv[c]);
-            let v = if r == c {
-                degree[r] as f64 + 1e-3
-            } else {
-                -1.0
-            };
+            let v = if r == c { diagonal[r] } else { off(r, c) };
             Triplet::new(pr.max(pc), pr.min(pc), v)
         })
         .collect();
@@ -350,5 +465,72 @@ fn main() {
             seq[0] + seq[1],
             (seq[0] + seq[1]) / a.max(b)
         );
+    }
+    if which == "ring" {
+        // the layer's factorization: [A_i B_i; B_iᵀ 0] (half i, the ring last) on a thread
+        // each, then the ring's Schur complement S = C − Σ B_iᵀ A_i⁻¹ B_i, whose terms are the
+        // trailing blocks −(L D Lᵀ)_ring of the two factors, and its dense Cholesky
+        let ring = n - halves[0] - halves[1];
+        let cols: Vec<Vec<usize>> = (0..2)
+            .map(|h| {
+                let start = if h == 0 { 0 } else { halves[0] };
+                (start..start + halves[h]).chain(n - ring..n).collect()
+            })
+            .collect();
+        let ms: Vec<SparseColMat<usize, f64>> =
+            cols.iter().map(|c| bordered(&m, c, ring)).collect();
+        let syms: Vec<SymbolicCholesky<usize>> = ms.iter().map(symbolic).collect();
+        let c = principal(&m, &(n - ring..n).collect::<Vec<_>>());
+        for round in 0..2 {
+            let t = Instant::now();
+            let ((l0, s0), (l1, s1)) = rayon::join(
+                || factor_values(&ms[0], &syms[0]),
+                || factor_values(&ms[1], &syms[1]),
+            );
+            let joined = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let (Some(t0), Some(t1)) = (
+                trailing_block(&syms[0], &l0, ring),
+                trailing_block(&syms[1], &l1, ring),
+            ) else {
+                println!("the ring's columns are not all in the last supernode");
+                return;
+            };
+            let mut schur = &t0 + &t1;
+            for j in 0..ring {
+                for (&r, &v) in c
+                    .as_ref()
+                    .row_idx_of_col_raw(j)
+                    .iter()
+                    .zip(c.as_ref().val_of_col(j))
+                {
+                    schur[(r, j)] += v;
+                    if r != j {
+                        schur[(j, r)] += v;
+                    }
+                }
+            }
+            let llt = schur.llt(Side::Lower);
+            let dense = t.elapsed().as_secs_f64();
+            let spd = llt.is_ok();
+            // ln det K = ln det A_0 + ln det A_1 + ln det S, against the whole factor's
+            let ring_log = llt.map_or(f64::NAN, |f| {
+                (0..ring).map(|j| 2.0 * f.L()[(j, j)].ln()).sum::<f64>()
+            });
+            let (whole_log, whole_negative) = log_pivots(&sym, &factor_values(&m, &sym).0, n);
+            let (a0, n0) = log_pivots(&syms[0], &l0, halves[0]);
+            let (a1, n1) = log_pivots(&syms[1], &l1, halves[1]);
+            let split_log = a0 + a1 + ring_log;
+            println!(
+                "split at the ring ({ring} columns), round {round}: halves [A B; Bᵀ 0] side by side {:.3} and {:.3} s (wall of both calls, two factorizations each and their allocations, {joined:.3} s), flops {:.1} + {:.1} GFLOP; the ring's Schur complement and its Cholesky {dense:.3} s (positive definite: {spd}); ln det K {split_log:.9e} against the whole factor's {whole_log:.9e} (relative {:.1e}), negative pivots {} against {whole_negative}; the split's factorization {:.3} s (the longer half and the ring's dense part)",
+                s0,
+                s1,
+                flops_of(&syms[0]) / 1e9,
+                flops_of(&syms[1]) / 1e9,
+                (split_log - whole_log).abs() / whole_log.abs(),
+                n0 + n1,
+                s0.max(s1) + dense,
+            );
+        }
     }
 }
