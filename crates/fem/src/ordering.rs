@@ -6,6 +6,9 @@
 //! factor costs 20–56 % more flops than AMD's; on the whole capped tube of 244,608 equations
 //! (`AROUND=224 ALONG=280`) it costs 34 % fewer. So neither is the better default, and the
 //! symbolic analyses are cheap beside one numeric factorization: `auto` runs both.
+//! On 100,000 unknowns or more, nested dissection's top split is taken apart
+//! ([`bisection`], [`crate::linsolve::tree_split`]): its two halves factorize side by side, and `auto`
+//! weighs that split against AMD.
 //!
 //! Nested dissection runs on the quotient graph of the matrix: the unknowns whose closed
 //! neighbourhoods are equal (a node's three displacements, which every element couples together)
@@ -53,6 +56,11 @@ pub const SEPARATORS: i32 = 3;
 /// The seed of METIS's randomized matching (`METIS_OPTION_SEED`): fixed, so the ordering is.
 pub const SEED: i32 = 7;
 
+/// METIS keeps global state (its random generator, its memory bookkeeping), so two calls at
+/// once on two threads would race, and the ordering, with every result, would depend on the
+/// timing: every call holds this lock.
+static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Why the ordering could not be computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum OrderingError {
@@ -62,80 +70,109 @@ pub enum OrderingError {
     Metis(i32),
 }
 
+/// The quotient graph of a symmetric pattern in METIS's CSR form: the unknowns with equal
+/// closed neighbourhoods (supervariables) are one vertex, weighted by their count.
+struct Quotient {
+    /// each vertex's unknowns, ascending, vertices in order of first appearance
+    groups: Vec<Vec<usize>>,
+    xadj: Vec<metis_sys::idx_t>,
+    adjncy: Vec<metis_sys::idx_t>,
+    vwgt: Vec<metis_sys::idx_t>,
+}
+
+impl Quotient {
+    /// The quotient graph of the pattern `pairs` (row, col) on `n` ≥ 1 unknowns.
+    fn new(n: usize, pairs: &[(usize, usize)]) -> Result<Self, OrderingError> {
+        // the adjacency of the unknowns (no self-loops), sorted
+        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for &(r, c) in pairs {
+            if r != c {
+                adj[r].push(c);
+                adj[c].push(r);
+            }
+        }
+        for a in &mut adj {
+            a.sort_unstable();
+            a.dedup();
+        }
+        let mut group_of = vec![0usize; n];
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut index: HashMap<Vec<usize>, usize> = HashMap::new();
+        for (i, a) in adj.iter().enumerate() {
+            let mut closed = a.clone();
+            let at = closed.partition_point(|&j| j < i);
+            closed.insert(at, i);
+            let g = *index.entry(closed).or_insert_with(|| {
+                groups.push(Vec::new());
+                groups.len() - 1
+            });
+            groups[g].push(i);
+            group_of[i] = g;
+        }
+        let too_large = |_| OrderingError::TooLarge(n);
+        let mut xadj: Vec<metis_sys::idx_t> = Vec::with_capacity(groups.len() + 1);
+        let mut adjncy: Vec<metis_sys::idx_t> = Vec::new();
+        let mut vwgt: Vec<metis_sys::idx_t> = Vec::with_capacity(groups.len());
+        xadj.push(0);
+        for members in &groups {
+            let mut nb: Vec<usize> = adj[members[0]]
+                .iter()
+                .map(|&j| group_of[j])
+                .filter(|&h| h != group_of[members[0]])
+                .collect();
+            nb.sort_unstable();
+            nb.dedup();
+            for h in nb {
+                adjncy.push(metis_sys::idx_t::try_from(h).map_err(too_large)?);
+            }
+            xadj.push(metis_sys::idx_t::try_from(adjncy.len()).map_err(too_large)?);
+            vwgt.push(metis_sys::idx_t::try_from(members.len()).map_err(too_large)?);
+        }
+        Ok(Self {
+            groups,
+            xadj,
+            adjncy,
+            vwgt,
+        })
+    }
+
+    /// METIS's options: [`SEPARATORS`] separators per split, the seed [`SEED`], 0-based.
+    fn options() -> [metis_sys::idx_t; metis_sys::METIS_NOPTIONS as usize] {
+        let mut options = [0 as metis_sys::idx_t; metis_sys::METIS_NOPTIONS as usize];
+        // SAFETY: `options` has the METIS_NOPTIONS entries METIS writes.
+        unsafe { metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr()) };
+        options[metis_sys::moptions_et_METIS_OPTION_NSEPS as usize] = SEPARATORS;
+        options[metis_sys::moptions_et_METIS_OPTION_SEED as usize] = SEED;
+        options[metis_sys::moptions_et_METIS_OPTION_NUMBERING as usize] = 0;
+        options
+    }
+}
+
 /// The nested-dissection permutation of the symmetric pattern `pairs` (row, col) on `n`
 /// unknowns: `perm[k]` is the unknown eliminated k-th.
 pub fn nested_dissection(n: usize, pairs: &[(usize, usize)]) -> Result<Vec<usize>, OrderingError> {
     if n == 0 {
         return Ok(Vec::new());
     }
-    // the adjacency of the unknowns (no self-loops), sorted
-    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for &(r, c) in pairs {
-        if r != c {
-            adj[r].push(c);
-            adj[c].push(r);
-        }
-    }
-    for a in &mut adj {
-        a.sort_unstable();
-        a.dedup();
-    }
-    // supervariables: unknowns with the same closed neighbourhood, in order of first appearance
-    let mut group_of = vec![0usize; n];
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut index: HashMap<Vec<usize>, usize> = HashMap::new();
-    for (i, a) in adj.iter().enumerate() {
-        let mut closed = a.clone();
-        let at = closed.partition_point(|&j| j < i);
-        closed.insert(at, i);
-        let g = *index.entry(closed).or_insert_with(|| {
-            groups.push(Vec::new());
-            groups.len() - 1
-        });
-        groups[g].push(i);
-        group_of[i] = g;
-    }
-    let m = groups.len();
+    let mut q = Quotient::new(n, pairs)?;
+    let m = q.groups.len();
     if m == 1 {
-        return Ok(groups.swap_remove(0));
+        return Ok(q.groups.swap_remove(0));
     }
-    // the quotient graph in METIS's CSR form, vertices weighted by their unknowns
-    let too_large = |_| OrderingError::TooLarge(n);
-    let mut xadj: Vec<i32> = Vec::with_capacity(m + 1);
-    let mut adjncy: Vec<i32> = Vec::new();
-    let mut vwgt: Vec<i32> = Vec::with_capacity(m);
-    xadj.push(0);
-    for members in &groups {
-        let mut nb: Vec<usize> = adj[members[0]]
-            .iter()
-            .map(|&j| group_of[j])
-            .filter(|&h| h != group_of[members[0]])
-            .collect();
-        nb.sort_unstable();
-        nb.dedup();
-        for h in nb {
-            adjncy.push(i32::try_from(h).map_err(too_large)?);
-        }
-        xadj.push(i32::try_from(adjncy.len()).map_err(too_large)?);
-        vwgt.push(i32::try_from(members.len()).map_err(too_large)?);
-    }
-    let mut nvtxs = i32::try_from(m).map_err(too_large)?;
-    let mut options = [0 as metis_sys::idx_t; metis_sys::METIS_NOPTIONS as usize];
+    let mut nvtxs = metis_sys::idx_t::try_from(m).map_err(|_| OrderingError::TooLarge(n))?;
+    let mut options = Quotient::options();
     let mut perm = vec![0 as metis_sys::idx_t; m];
     let mut iperm = vec![0 as metis_sys::idx_t; m];
     // SAFETY: every array has the length METIS reads (options METIS_NOPTIONS, xadj m + 1,
     // adjncy xadj[m], vwgt, perm and iperm m), the graph is symmetric without self-loops, and
     // METIS keeps no pointer past the call.
+    let _metis = METIS.lock().unwrap_or_else(|e| e.into_inner());
     let status = unsafe {
-        metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
-        options[metis_sys::moptions_et_METIS_OPTION_NSEPS as usize] = SEPARATORS;
-        options[metis_sys::moptions_et_METIS_OPTION_SEED as usize] = SEED;
-        options[metis_sys::moptions_et_METIS_OPTION_NUMBERING as usize] = 0;
         metis_sys::METIS_NodeND(
             &mut nvtxs,
-            xadj.as_mut_ptr(),
-            adjncy.as_mut_ptr(),
-            vwgt.as_mut_ptr(),
+            q.xadj.as_mut_ptr(),
+            q.adjncy.as_mut_ptr(),
+            q.vwgt.as_mut_ptr(),
             options.as_mut_ptr(),
             perm.as_mut_ptr(),
             iperm.as_mut_ptr(),
@@ -148,8 +185,52 @@ pub fn nested_dissection(n: usize, pairs: &[(usize, usize)]) -> Result<Vec<usize
     // perm[k] of the original); each vertex's unknowns in ascending order
     Ok(perm
         .iter()
-        .flat_map(|&g| groups[g as usize].iter().copied())
+        .flat_map(|&g| q.groups[g as usize].iter().copied())
         .collect())
+}
+
+/// METIS's vertex separator of the symmetric pattern `pairs` (row, col) on `n` unknowns (the
+/// top split of its nested dissection, on the same quotient graph, separators and seed): per
+/// unknown 0 or 1, the half it lies in, or 2, the separator. No pair couples the two halves;
+/// a node's unknowns stay together. `None` when the graph has fewer than two vertices.
+pub fn bisection(n: usize, pairs: &[(usize, usize)]) -> Result<Option<Vec<u8>>, OrderingError> {
+    if n == 0 {
+        return Ok(None);
+    }
+    let mut q = Quotient::new(n, pairs)?;
+    let m = q.groups.len();
+    if m < 2 {
+        return Ok(None);
+    }
+    let mut nvtxs = metis_sys::idx_t::try_from(m).map_err(|_| OrderingError::TooLarge(n))?;
+    let mut options = Quotient::options();
+    let mut sepsize: metis_sys::idx_t = 0;
+    let mut part = vec![0 as metis_sys::idx_t; m];
+    // SAFETY: as in `nested_dissection`; `part` has the m entries METIS writes.
+    let _metis = METIS.lock().unwrap_or_else(|e| e.into_inner());
+    let status = unsafe {
+        metis_sys::METIS_ComputeVertexSeparator(
+            &mut nvtxs,
+            q.xadj.as_mut_ptr(),
+            q.adjncy.as_mut_ptr(),
+            q.vwgt.as_mut_ptr(),
+            options.as_mut_ptr(),
+            &mut sepsize,
+            part.as_mut_ptr(),
+        )
+    };
+    if status != metis_sys::rstatus_et_METIS_OK {
+        return Err(OrderingError::Metis(status));
+    }
+    let mut side = vec![2u8; n];
+    for (g, members) in q.groups.iter().enumerate() {
+        let s = u8::try_from(part[g]).ok().filter(|&s| s <= 2);
+        let s = s.ok_or(OrderingError::Metis(metis_sys::rstatus_et_METIS_ERROR))?;
+        for &i in members {
+            side[i] = s;
+        }
+    }
+    Ok(Some(side))
 }
 
 /// A 2D grid of `k` × `k` nodes with 3 unknowns each, coupled like bilinear elements: the
@@ -207,5 +288,51 @@ mod tests {
         }
         // the same on a second call (a fixed seed)
         assert_eq!(perm, nested_dissection(n, &pairs).unwrap());
+    }
+
+    #[test]
+    fn metis_gives_the_same_ordering_when_two_threads_call_it_at_once() {
+        // METIS's random generator is global: without the lock, two calls at once interleave
+        // their draws and the orderings change from run to run
+        let (n, pairs) = grid(30);
+        let alone = nested_dissection(n, &pairs).unwrap();
+        let split = bisection(n, &pairs).unwrap();
+        for _ in 0..8 {
+            let (a, b) = std::thread::scope(|s| {
+                let a = s.spawn(|| nested_dissection(n, &pairs).unwrap());
+                let b = s.spawn(|| bisection(n, &pairs).unwrap());
+                (a.join().unwrap(), b.join().unwrap())
+            });
+            assert_eq!(a, alone);
+            assert_eq!(b, split);
+        }
+    }
+
+    #[test]
+    fn the_bisection_separates_the_halves() {
+        let (n, pairs) = grid(20);
+        let side = bisection(n, &pairs).unwrap().expect("a split");
+        for &(r, c) in &pairs {
+            assert!(
+                side[r] == 2 || side[c] == 2 || side[r] == side[c],
+                "{r} and {c} couple the halves"
+            );
+        }
+        let count = |h: u8| side.iter().filter(|&&s| s == h).count();
+        // balanced halves and a separator of about one line of the 20 × 20 grid's nodes
+        assert!(
+            count(0) > n / 4 && count(1) > n / 4,
+            "{} {}",
+            count(0),
+            count(1)
+        );
+        assert!(count(2) <= 3 * 2 * 20, "separator {}", count(2));
+        for k in (0..n).step_by(3) {
+            assert!(
+                side[k] == side[k + 1] && side[k] == side[k + 2],
+                "node {}",
+                k / 3
+            );
+        }
     }
 }
