@@ -6,9 +6,10 @@
 # answer's: at a quarter of the size, 6 + 10 initial steps end in the same state to 2.4e-13 and
 # take 103 Newton iterations instead of 66.
 #
-#   bash scripts/bench-million.sh                  # factorization on 1 thread
-#   THREADS=2 bash scripts/bench-million.sh        # … on 2
-#   ORDERING=nested-dissection bash scripts/bench-million.sh   # METIS instead of AMD
+#   bash scripts/bench-million.sh                  # factor_threads = 1
+#   THREADS=2 bash scripts/bench-million.sh        # … = 2 (faer's threads inside supernodes)
+#   RAYON_NUM_THREADS=1 bash scripts/bench-million.sh   # everything on one thread
+#   ORDERING=amd bash scripts/bench-million.sh     # AMD instead of the default "auto" (METIS here)
 #   AROUND=224 ALONG=280 bash scripts/bench-million.sh   # a quarter of the size
 #   REFACTORIZE=always bash scripts/bench-million.sh      # factorize at every Newton iteration
 #
@@ -24,7 +25,7 @@ cd "$(dirname "$0")/.."
 AROUND=${AROUND:-448}
 ALONG=${ALONG:-560}
 THREADS=${THREADS:-1}
-ORDERING=${ORDERING:-amd}
+ORDERING=${ORDERING:-auto}
 REFACTORIZE=${REFACTORIZE:-auto}
 OUT=${OUT:-runs/bench-million-$THREADS-$ORDERING-$REFACTORIZE}
 cargo build --release -q -p tubemem-cli
@@ -74,7 +75,7 @@ steps = 5
 EOF
 /usr/bin/time -v -o "$OUT.time" target/release/tubemem run "$case_file" --out "$OUT" --overwrite --force
 python3 - "$OUT" "$peak" "$THREADS" <<'PY'
-import csv, json, re, statistics, sys
+import csv, json, os, re, statistics, sys
 out, peak, threads = sys.argv[1], json.loads(sys.argv[2]), int(sys.argv[3])
 s = json.load(open(f"{out}/summary.json"))
 rows = list(csv.DictReader(open(f"{out}/iterations.csv")))
@@ -85,7 +86,12 @@ col = lambda k: [float(r[k]) for r in rows]
 flops, nnz = s["mesh"]["factor_flops"], s["mesh"]["factor_nnz"]
 factorized = [r for r in rows if r.get("factorized", "1") != "0"]
 fact = [float(r["factorization_s"]) for r in factorized]
-dense = peak["gflops"]["1" if threads == 1 else "all"]
+# the threads the factorization used: a split factor's halves run side by side on the rayon pool
+# (RAYON_NUM_THREADS, else all cores), a whole factor's supernodes on factor_threads
+pool = int(os.environ.get("RAYON_NUM_THREADS") or peak["threads"])
+used = min(2, pool) if s["mesh"].get("split_separator") else threads
+threads = used
+dense = peak["gflops"]["1" if used == 1 else "all"]
 print(f"\n{s['mesh']['equations']} equations, {s['mesh']['elements']} elements; wall {wall}, peak RSS {rss:.2f} GiB")
 for st in s["stages"]:
     f = st["final"]
@@ -99,7 +105,9 @@ krylov = sum(int(float(r.get("krylov_iterations", 0))) for r in rows)
 print(f"{len(factorized)} factorizations ({fact and statistics.median(fact):.3f} s median), {len(rows) - len(factorized)} linearizations on a reused factor "
       f"with {krylov} GMRES iterations (reuse: {s['mesh'].get('reuses_factor')}); factorization total {sum(fact):.1f} s")
 g = flops / statistics.median(fact) / 1e9
-print(f"factor ({s['mesh'].get('ordering') or '?'}): {nnz / 1e6:.1f} M nonzeros ({nnz * 8 / 2**30:.2f} GiB), {flops / 1e9:.1f} GFLOP per factorization; "
+split = s["mesh"].get("split_separator")
+layout = f", split at a separator of {split} unknowns" if split else ", whole"
+print(f"factor ({s['mesh'].get('ordering') or '?'}{layout}): {nnz / 1e6:.1f} M nonzeros ({nnz * 8 / 2**30:.2f} GiB), {flops / 1e9:.1f} GFLOP per factorization; "
       f"achieved {g:.1f} GFLOP/s = {100 * g / dense:.0f} % of the dense peak on {threads} thread(s) ({dense:.1f} GFLOP/s)")
 print("per phase: factorizations, their seconds, achieved GFLOP/s (median), share of the dense peak")
 for st in s["stages"]:

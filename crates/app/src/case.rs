@@ -33,7 +33,7 @@
 //! rtol = 1e-9           # Newton tolerance on ‖R‖/‖f‖
 //! max_iterations = 30
 //! checkpoint_every = 1  # restart checkpoints every N converged steps (0: none)
-//! factor_threads = 1    # threads of the sparse factorization (0: all); results do not change
+//! factor_threads = 1    # threads inside the factorization's supernodes (0: all); results do not change
 //! ordering = "auto"     # or "amd", "nested-dissection" (METIS); results do not change
 //! refactorize = "auto"  # or "always", "on-demand": the last factor preconditions GMRES until
 //!                       # it stops paying; results agree within the Newton tolerance
@@ -310,8 +310,10 @@ pub struct SolverSpec {
     /// kept, and `tubemem run --resume` continues from the newest
     #[serde(default = "default_checkpoint_every")]
     pub checkpoint_every: usize,
-    /// threads of the sparse factorization: 1 (default) sequential, 0 all of the machine's;
-    /// the results do not depend on it
+    /// threads of the sparse factorization inside its supernodes: 1 (default) sequential, 0
+    /// all of the machine's; the results do not depend on it. A factorization split at the top
+    /// separator (nested dissection, 100,000 unknowns or more) runs its two halves side by
+    /// side on the run's thread pool whatever this says
     #[serde(default = "default_factor_threads")]
     pub factor_threads: usize,
     /// the sparse factorization's fill-reducing ordering: "auto" (default: AMD and nested

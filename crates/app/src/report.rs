@@ -34,6 +34,10 @@ pub struct MeshInfo {
     /// `[solver] ordering = "auto"`, the one whose factorization has fewer flops)
     #[serde(default)]
     pub ordering: String,
+    /// the unknowns of the top separator when the factorization is split there, its two halves
+    /// factorized side by side (large nested-dissection factors); absent for a whole factor
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub split_separator: Option<usize>,
     /// whether Newton reuses the factor across linearizations (`[solver] refactorize`, with
     /// "auto" resolved by the factorization's cost)
     #[serde(default)]

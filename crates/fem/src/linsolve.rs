@@ -10,6 +10,7 @@
 //! reacts (shift, cut-back).
 
 use crate::ordering::Ordering;
+pub mod tree_split;
 use crate::FemError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltError;
@@ -22,6 +23,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{CreationError, FaerError};
+use tree_split::TreeSplit;
 
 /// Storage of the factor: faer's choice by flop ratio, or forced (for tests and benchmarks).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -52,7 +54,7 @@ pub enum FactorizationError {
 
 /// The flops of one numeric factorization with the symbolic structure `symbolic` of an `n` × `n`
 /// matrix ([`SparseLdlt::factor_flops`]).
-fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f64 {
+pub(crate) fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f64 {
     let col = |c: f64| c * (c + 2.0);
     match symbolic.raw() {
         SymbolicCholeskyRaw::Simplicial(s) => {
@@ -73,14 +75,31 @@ fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f64 {
     }
 }
 
+/// The factor: faer's supernodal or simplicial LDLᵀ of the whole matrix, or the split at the
+/// top separator ([`crate::linsolve::tree_split`]).
+enum Factor {
+    Whole {
+        symbolic: Box<SymbolicCholesky<usize>>,
+        l_values: Vec<f64>,
+    },
+    Split(Box<TreeSplit>),
+}
+
+/// The fewest unknowns for which a nested-dissection factorization is split at its top
+/// separator ([`crate::linsolve::tree_split`]); with `auto`, the split is kept when its flops are fewer
+/// than AMD's whole factor's. Below, a factorization takes under about 0.1 s (61,158 unknowns of
+/// the whole tube: 0.13 s on one thread, `examples/subtree_split.rs`) and the split's setup (a
+/// third METIS call and two more symbolic analyses) is not repaid; every shipped case is below
+/// it and keeps its whole factor bit for bit.
+pub const SPLIT_MIN_UNKNOWNS: usize = 100_000;
+
 /// A symmetric sparse matrix pattern (lower triangle) with its symbolic factorization.
 pub struct SparseLdlt {
     n: usize,
     pattern: SymbolicSparseColMat<usize>,
     argsort: Argsort<usize>,
     entries: usize,
-    symbolic: SymbolicCholesky<usize>,
-    l_values: Vec<f64>,
+    factor: Factor,
     factorized: bool,
     /// the parallelism of the numeric factorization and the solves
     par: Par,
@@ -149,46 +168,80 @@ impl SparseLdlt {
             )
             .map_err(FactorizationError::Symbolic)
         };
-        let (symbolic, ordering) = match ordering {
-            Ordering::Amd => (amd()?, Ordering::Amd),
-            Ordering::NestedDissection => (nested()?, Ordering::NestedDissection),
-            Ordering::Auto => {
+        let whole = |symbolic: SymbolicCholesky<usize>| Factor::Whole {
+            l_values: vec![0.0; symbolic.len_val()],
+            symbolic: Box::new(symbolic),
+        };
+        // nested dissection on a large matrix: its top split as two halves factorized side by
+        // side ([`crate::linsolve::tree_split`]); METIS's top separator is the one its nested dissection
+        // of the whole would start from, so the flops are the same within about 1 %
+        let split = if ordering != Ordering::Amd && n >= SPLIT_MIN_UNKNOWNS {
+            TreeSplit::new(n, pairs)?
+        } else {
+            None
+        };
+        let (factor, ordering) = match (ordering, split) {
+            (Ordering::Amd, _) => (whole(amd()?), Ordering::Amd),
+            (Ordering::NestedDissection, Some(t)) => {
+                (Factor::Split(Box::new(t)), Ordering::NestedDissection)
+            }
+            (Ordering::NestedDissection, None) => (whole(nested()?), Ordering::NestedDissection),
+            (Ordering::Auto, Some(t)) => {
+                // the split against AMD, by flops
+                let a = amd()?;
+                if t.flops() < symbolic_flops(&a, n) {
+                    (Factor::Split(Box::new(t)), Ordering::NestedDissection)
+                } else {
+                    (whole(a), Ordering::Amd)
+                }
+            }
+            (Ordering::Auto, None) => {
                 // both analyses, and the one whose factorization costs fewer flops (AMD on a
                 // tie, so a pattern where nested dissection gains nothing keeps AMD's factor)
                 let (a, d) = (amd()?, nested()?);
                 if symbolic_flops(&d, n) < symbolic_flops(&a, n) {
-                    (d, Ordering::NestedDissection)
+                    (whole(d), Ordering::NestedDissection)
                 } else {
-                    (a, Ordering::Amd)
+                    (whole(a), Ordering::Amd)
                 }
             }
         };
-        let l_values = vec![0.0; symbolic.len_val()];
         Ok(Self {
             n,
             pattern,
             argsort,
             entries: pairs.len(),
-            symbolic,
-            l_values,
+            factor,
             factorized: false,
             par: Par::Seq,
             ordering,
         })
     }
 
-    /// The threads of the numeric factorization: 1 sequential (the default), n on n threads of
-    /// the current rayon pool (0: all of them). faer parallelizes inside each supernode's dense
-    /// kernels (the supernodes are eliminated in a fixed order, and each output block of a
-    /// parallel product is summed by one thread in a fixed order), so the factor does not depend
-    /// on the thread count: `factor_is_bitwise_the_same_on_1_and_2_threads`. The solves stay
-    /// sequential (see [`SparseLdlt::solve`]).
+    /// The threads of the numeric factorization of a whole factor, inside its supernodes: 1
+    /// sequential (the default), n on n threads of the current rayon pool (0: all of them).
+    /// faer parallelizes inside each supernode's dense kernels (the supernodes are eliminated in
+    /// a fixed order, and each output block of a parallel product is summed by one thread in a
+    /// fixed order), so the factor does not depend on the thread count:
+    /// `factor_is_bitwise_the_same_on_1_and_2_threads`; its solves stay sequential (see
+    /// [`SparseLdlt::solve`]). A split factor ([`crate::linsolve::tree_split`]) factorizes and solves its
+    /// two halves side by side on the current rayon pool whatever this says (one after the other
+    /// on a pool of one thread), each half sequential inside, with the same bits either way.
     pub fn set_threads(&mut self, threads: usize) {
         self.par = if threads == 1 {
             Par::Seq
         } else {
             Par::rayon(threads)
         };
+    }
+
+    /// The separator's unknowns when the factorization is split at the top separator
+    /// ([`crate::linsolve::tree_split`]), `None` for a whole factor.
+    pub fn split_separator(&self) -> Option<usize> {
+        match &self.factor {
+            Factor::Split(t) => Some(t.separator_len()),
+            Factor::Whole { .. } => None,
+        }
     }
 
     /// The ordering the symbolic analysis used: `Amd` or `NestedDissection` (what `Auto` kept).
@@ -209,8 +262,13 @@ impl SparseLdlt {
     /// c_k(c_k + 1)/2 multiply–adds of the rank-one update of column k, multiplications and
     /// additions counted apart, plus its c_k scalings and c_k products with D). The usual count
     /// of sparse Cholesky (George & Liu), the one dense LDLᵀ's n³/3 comes from.
+    /// A split factor counts its halves, the trailing products and the separator's dense
+    /// LDLᵀ ([`crate::linsolve::tree_split`]).
     pub fn factor_flops(&self) -> f64 {
-        symbolic_flops(&self.symbolic, self.n)
+        match &self.factor {
+            Factor::Whole { symbolic, .. } => symbolic_flops(symbolic, self.n),
+            Factor::Split(t) => t.flops(),
+        }
     }
 
     pub fn dim(&self) -> usize {
@@ -219,56 +277,70 @@ impl SparseLdlt {
 
     /// Number of nonzeros in the factor (a memory measure).
     pub fn factor_nnz(&self) -> usize {
-        self.l_values.len()
+        match &self.factor {
+            Factor::Whole { l_values, .. } => l_values.len(),
+            Factor::Split(t) => t.nnz(),
+        }
     }
 
     /// Numeric LDLᵀ of the matrix whose values (one per pair given to `new`) are `values`.
     /// Returns the number of negative pivots.
     pub fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
         self.factorized = false;
-        let mat = self.filled(values)?;
-        let par = self.par;
-        let req = self
-            .symbolic
-            .factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
-        let mut mem = MemBuffer::try_new(req)
-            .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?;
-        let reg = LdltRegularization {
-            dynamic_regularization_signs: None,
-            dynamic_regularization_delta: 0.0,
-            dynamic_regularization_epsilon: 0.0,
+        let negative = match &mut self.factor {
+            Factor::Split(t) => {
+                Self::check_finite(values, self.entries)?;
+                t.factorize(values)?
+            }
+            Factor::Whole { symbolic, l_values } => {
+                let mat = Self::fill(&self.pattern, &self.argsort, self.entries, values)?;
+                let par = self.par;
+                let req = symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
+                let mut mem = MemBuffer::try_new(req)
+                    .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?;
+                let reg = LdltRegularization {
+                    dynamic_regularization_signs: None,
+                    dynamic_regularization_delta: 0.0,
+                    dynamic_regularization_epsilon: 0.0,
+                };
+                symbolic
+                    .factorize_numeric_ldlt::<f64>(
+                        l_values,
+                        mat.as_ref(),
+                        Side::Lower,
+                        reg,
+                        par,
+                        MemStack::new(&mut mem),
+                        Default::default(),
+                    )
+                    .map_err(|e| match e {
+                        LdltError::ZeroPivot { index } => FemError::ZeroPivot { index, value: 0.0 },
+                    })?;
+                let d = self.pivots();
+                if let Some(index) = d.iter().position(|v| !v.is_finite() || *v == 0.0) {
+                    return Err(FemError::ZeroPivot {
+                        index,
+                        value: d[index],
+                    });
+                }
+                d.iter().filter(|&&v| v < 0.0).count()
+            }
         };
-        self.symbolic
-            .factorize_numeric_ldlt::<f64>(
-                &mut self.l_values,
-                mat.as_ref(),
-                Side::Lower,
-                reg,
-                par,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| match e {
-                LdltError::ZeroPivot { index } => FemError::ZeroPivot { index, value: 0.0 },
-            })?;
-        let d = self.pivots();
-        if let Some(index) = d.iter().position(|v| !v.is_finite() || *v == 0.0) {
-            return Err(FemError::ZeroPivot {
-                index,
-                value: d[index],
-            });
-        }
         self.factorized = true;
-        Ok(d.iter().filter(|&&v| v < 0.0).count())
+        Ok(negative)
     }
 
-    /// The pivots D_kk of the last factorization (in elimination order).
+    /// The pivots D_kk of the last factorization (in elimination order; a split factor's: the
+    /// two halves', then the separator's).
     pub fn pivots(&self) -> Vec<f64> {
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..self.n]
-                .iter()
-                .map(|&p| self.l_values[p])
-                .collect(),
+        let (symbolic, l_values) = match &self.factor {
+            Factor::Whole { symbolic, l_values } => (symbolic, l_values),
+            Factor::Split(t) => return t.pivots(),
+        };
+        match symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                s.col_ptr()[..self.n].iter().map(|&p| l_values[p]).collect()
+            }
             SymbolicCholeskyRaw::Supernodal(s) => {
                 let begin = s.supernode_begin();
                 let end = s.supernode_end();
@@ -278,7 +350,7 @@ impl SparseLdlt {
                     let ncols = end[k] - begin[k];
                     let nrows = (val[k + 1] - val[k]) / ncols;
                     for j in 0..ncols {
-                        d.push(self.l_values[val[k] + j * nrows + j]);
+                        d.push(l_values[val[k] + j * nrows + j]);
                     }
                 }
                 d
@@ -302,27 +374,47 @@ impl SparseLdlt {
     /// The lower triangle with `values` (one per pair given to `new`, duplicates summed),
     /// refused where an entry is not finite.
     fn filled(&self, values: &[f64]) -> Result<SparseColMat<usize, f64>, FemError> {
-        assert_eq!(values.len(), self.entries, "one value per pattern entry");
-        if let Some(entry) = values.iter().position(|v| !v.is_finite()) {
-            return Err(FemError::NonFiniteEntry { entry });
-        }
+        Self::fill(&self.pattern, &self.argsort, self.entries, values)
+    }
+
+    /// [`SparseLdlt::filled`] from the pattern's parts.
+    fn fill(
+        pattern: &SymbolicSparseColMat<usize>,
+        argsort: &Argsort<usize>,
+        entries: usize,
+        values: &[f64],
+    ) -> Result<SparseColMat<usize, f64>, FemError> {
+        Self::check_finite(values, entries)?;
         Ok(
-            SparseColMat::new_from_argsort(self.pattern.clone(), &self.argsort, values)
+            SparseColMat::new_from_argsort(pattern.clone(), argsort, values)
                 .map_err(FactorizationError::Fill)?,
         )
+    }
+
+    /// One value per pattern entry, each finite.
+    fn check_finite(values: &[f64], entries: usize) -> Result<(), FemError> {
+        assert_eq!(values.len(), entries, "one value per pattern entry");
+        match values.iter().position(|v| !v.is_finite()) {
+            Some(entry) => Err(FemError::NonFiniteEntry { entry }),
+            None => Ok(()),
+        }
     }
 
     /// Solve A y = rhs in place with the last factorization.
     pub fn solve(&self, rhs: &mut [f64]) {
         assert!(self.factorized, "solve after a successful factorize");
+        let (symbolic, l_values) = match &self.factor {
+            Factor::Whole { symbolic, l_values } => (symbolic, l_values),
+            Factor::Split(t) => return t.solve(rhs),
+        };
         // sequential whatever the factorization's threads: faer's parallel triangular solve
         // sums in an order that depends on the thread count (measured: the solution differs in
         // the last bits on 2 threads), and a solve is O(nnz(L)), a small part of an iteration
         let par = Par::Seq;
-        let req = self.symbolic.solve_in_place_scratch::<f64>(1, par);
+        let req = symbolic.solve_in_place_scratch::<f64>(1, par);
         let mut mem = MemBuffer::new(req);
         let n = self.n;
-        let ldlt = LdltRef::<'_, usize, f64>::new(&self.symbolic, &self.l_values);
+        let ldlt = LdltRef::<'_, usize, f64>::new(symbolic, l_values);
         ldlt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(rhs, n, 1),
@@ -496,7 +588,7 @@ mod tests {
         }
         let mut s = SparseLdlt::with_layout(n, &pairs, Layout::Supernodal).unwrap();
         assert!(
-            matches!(s.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_)),
+            matches!(&s.factor, Factor::Whole { symbolic, .. } if matches!(symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))),
             "expected a supernodal factor"
         );
         // Off-diagonal row sums < 2·Σ 0.5/k ≈ 4.4 ≪ 100: eigenvalue signs follow d (Gershgorin).
@@ -534,7 +626,10 @@ mod tests {
                     s.factorize(&vals).unwrap();
                     let mut b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
                     s.solve(&mut b);
-                    (s.l_values.clone(), b, s.factor_flops())
+                    let Factor::Whole { l_values, .. } = &s.factor else {
+                        unreachable!("AMD's factor is whole")
+                    };
+                    (l_values.clone(), b, s.factor_flops())
                 })
         };
         let (l1, b1, f1) = run(1);

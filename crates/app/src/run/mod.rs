@@ -79,6 +79,7 @@ pub fn run_with(
             factor_nnz: 0,
             factor_flops: 0.0,
             ordering: String::new(),
+            split_separator: None,
             reuses_factor: false,
             contact_edge_fit: None,
         },

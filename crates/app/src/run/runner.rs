@@ -118,6 +118,7 @@ impl<'a> Runner<'a> {
                     .ok()
                     .and_then(|v| v.as_str().map(String::from))
                     .unwrap_or_default(),
+                split_separator: model.factor_split_separator(),
                 reuses_factor: model.reuses_factor(),
                 contact_edge_fit: fit,
             },

@@ -174,6 +174,12 @@ impl Model {
         self.ldlt.ordering()
     }
 
+    /// The unknowns of the top separator when the factorization is split there
+    /// ([`crate::linsolve::SparseLdlt::split_separator`]); `None` for a whole factor.
+    pub fn factor_split_separator(&self) -> Option<usize> {
+        self.ldlt.split_separator()
+    }
+
     /// The reference elements of `mesh`.
     fn reference_elements(mesh: &Mesh) -> Result<Elements, FemError> {
         Ok(match mesh.element() {

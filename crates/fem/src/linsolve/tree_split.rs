@@ -1,0 +1,743 @@
+//! The sparse LDLᵀ split at the top separator of the elimination tree, so that its two halves
+//! factorize on two threads (parallelism across the tree rather than inside supernodes).
+//!
+//! With the unknowns in three sets, half 0, half 1 and the separator S (METIS's vertex
+//! separator on the node graph, [`crate::ordering::bisection`]: no entry couples the halves),
+//!
+//! ```text
+//!     K = [ A₀  0   B₀ ]        M_i = [ A_i   B_i ]      T_i = C/2 − B_iᵀ A_i⁻¹ B_i
+//!         [ 0   A₁  B₁ ]              [ B_iᵀ  C/2 ]      S   = T₀ + T₁ = C − Σ B_iᵀ A_i⁻¹ B_i
+//!         [ B₀ᵀ B₁ᵀ C  ]
+//! ```
+//!
+//! Each bordered half M_i (its unknowns in nested-dissection order, S last) is factorized by
+//! faer's sequential supernodal LDLᵀ, the two on their own threads (`rayon::join`). Because S
+//! comes last, the rows and columns of S in M_i's factor are the LDLᵀ factor of M_i's Schur
+//! complement T_i, which is gathered into a dense matrix. S = T₀ + T₁ is factorized by dense
+//! LDLᵀ. Every piece is sequential and summed in a fixed order, so the factor is bitwise the
+//! same whether the halves run side by side or one after the other: the thread count changes
+//! the time, not the bits.
+//!
+//! Sylvester's law over the block elimination gives the inertia: the negative pivots of K are
+//! those of A₀ (the first pivots of M₀'s factor), of A₁ and of S.
+//!
+//! A solve of K x = b takes two solves with each M_i (again side by side):
+//! 1. [u_i; v_i] = M_i⁻¹ [b_i; 0], whence q_i = B_iᵀ A_i⁻¹ b_i = −T_i v_i;
+//! 2. x_S = S⁻¹ (b_S − q₀ − q₁);
+//! 3. [x_i; x_S] = M_i⁻¹ [b_i; T_i (x_S − v_i)], which gives x_i = A_i⁻¹ (b_i − B_i x_S).
+//!
+//! Measured on the whole capped tube (`crates/fem/examples/subtree_split.rs`, `ORDER=ring`): the
+//! halves' flops equal the whole nested-dissection factor's within 1 %, and side by side they
+//! factorize in 0.5–0.6 of the whole factor's time on this 2-core machine, where faer's
+//! parallelism inside supernodes is slower than one thread.
+
+use crate::linsolve::FactorizationError;
+use crate::FemError;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
+use faer::linalg::matmul::triangular::BlockStructure;
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
+};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat};
+use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
+
+/// LDLᵀ without pivoting and without regularization: a zero pivot is an error.
+const NO_REGULARIZATION: LdltRegularization<'static, f64> = LdltRegularization {
+    dynamic_regularization_signs: None,
+    dynamic_regularization_delta: 0.0,
+    dynamic_regularization_epsilon: 0.0,
+};
+
+/// One bordered half M_i = [A_i B_i; B_iᵀ C/2] with its symbolic and numeric factor.
+struct Half {
+    /// the half's unknowns (global indices) in elimination order; S follows them
+    members: Vec<usize>,
+    pattern: SymbolicSparseColMat<usize>,
+    /// per entry of M_i: the index of the value of K it takes (32 bits: the pattern of a
+    /// million unknowns has some 10⁷ entries, and half the bytes matter at that size)
+    source: Vec<u32>,
+    /// per entry of M_i: its position in `pattern` (duplicates summed)
+    slot: Vec<u32>,
+    /// the entries from this one on are S × S: they take half of K's value, the two halves
+    /// sharing C
+    halved_from: usize,
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    /// T_i, the trailing block of L D Lᵀ (dense, both triangles), after a factorization
+    trailing: Mat<f64>,
+    /// L_SS, S's rows and columns of the factor (unit lower, D_S on the diagonal)
+    l_ss: Mat<f64>,
+}
+
+/// K's LDLᵀ as two bordered halves and the separator's dense Schur complement.
+pub(crate) struct TreeSplit {
+    n: usize,
+    /// the separator's unknowns (global), ascending
+    separator: Vec<usize>,
+    halves: [Half; 2],
+    /// LDLᵀ of S: L strictly below the diagonal, D on it
+    schur: Mat<f64>,
+    /// run the halves side by side (on the current rayon pool; the default)
+    parallel: bool,
+}
+
+impl Half {
+    /// The bordered half `side` of the pattern `pairs` (row ≥ col) on `n` unknowns, with the
+    /// separator `separator` last.
+    fn new(
+        sides: &[u8],
+        side: u8,
+        separator: &[usize],
+        pairs: &[(usize, usize)],
+    ) -> Result<Self, FemError> {
+        let n = sides.len();
+        let own: Vec<usize> = (0..n).filter(|&k| sides[k] == side).collect();
+        let mut local = vec![usize::MAX; n];
+        for (i, &k) in own.iter().enumerate() {
+            local[k] = i;
+        }
+        let inner: Vec<(usize, usize)> = pairs
+            .iter()
+            .filter(|&&(r, c)| sides[r] == side && sides[c] == side)
+            .map(|&(r, c)| (local[r], local[c]))
+            .collect();
+        let order = crate::ordering::nested_dissection(own.len(), &inner)
+            .map_err(FactorizationError::Ordering)?;
+        let members: Vec<usize> = order.iter().map(|&i| own[i]).collect();
+        let mut at = vec![usize::MAX; n];
+        for (i, &k) in members.iter().chain(separator).enumerate() {
+            at[k] = i;
+        }
+        let m = members.len() + separator.len();
+        // M_i's entries: the values they take (K's entries of the half and of S; S × S last,
+        // where the two halves share C), and the position of each in M_i's pattern
+        let mut entries: Vec<(u32, usize, usize)> = Vec::new();
+        let mut shared = Vec::new();
+        let too_large =
+            |_| FactorizationError::Ordering(crate::ordering::OrderingError::TooLarge(n));
+        for (e, &(r, c)) in pairs.iter().enumerate() {
+            let (sr, sc) = (sides[r], sides[c]);
+            if (sr == side || sr == 2) && (sc == side || sc == 2) {
+                let (a, b) = (at[r].max(at[c]), at[r].min(at[c]));
+                let e = u32::try_from(e).map_err(too_large)?;
+                if sr == 2 && sc == 2 {
+                    shared.push((e, a, b));
+                } else {
+                    entries.push((e, a, b));
+                }
+            }
+        }
+        let halved_from = entries.len();
+        entries.extend(shared);
+        // the pattern: by column, rows ascending, without duplicates
+        let mut cells: Vec<(usize, usize)> = entries.iter().map(|&(_, r, c)| (c, r)).collect();
+        cells.sort_unstable();
+        cells.dedup();
+        let mut col_ptr = vec![0usize; m + 1];
+        for &(c, _) in &cells {
+            col_ptr[c + 1] += 1;
+        }
+        for c in 0..m {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let row_idx: Vec<usize> = cells.iter().map(|&(_, r)| r).collect();
+        drop(cells);
+        let mut source = Vec::with_capacity(entries.len());
+        let mut slot = Vec::with_capacity(entries.len());
+        for &(e, r, c) in &entries {
+            let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+            let at = col_ptr[c] + rows.partition_point(|&x| x < r);
+            source.push(e);
+            slot.push(u32::try_from(at).map_err(too_large)?);
+        }
+        drop(entries);
+        let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
+        // the order is the one built here: the identity as a custom ordering (faer 0.24's
+        // `Identity` with the lower triangle analyses the diagonal alone); supernodal, so that
+        // S's rows of the factor are dense blocks
+        let id: Vec<usize> = (0..m).collect();
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Custom(PermRef::new_checked(&id, &id, m)),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(FactorizationError::Symbolic)?;
+        Ok(Self {
+            members,
+            pattern,
+            source,
+            slot,
+            halved_from,
+            l_values: Vec::new(),
+            symbolic,
+            trailing: Mat::zeros(0, 0),
+            l_ss: Mat::zeros(0, 0),
+        })
+    }
+
+    fn dim(&self) -> usize {
+        self.pattern.nrows()
+    }
+
+    /// The numeric LDLᵀ of M_i from K's values, then T_i; returns the negative pivots of A_i.
+    fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
+        let mut vals = vec![0.0; self.pattern.compute_nnz()];
+        for (k, (&e, &at)) in self.source.iter().zip(&self.slot).enumerate() {
+            let w = if k < self.halved_from { 1.0 } else { 0.5 };
+            vals[at as usize] += w * values[e as usize];
+        }
+        let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
+        let req = self
+            .symbolic
+            .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
+        let mut mem = MemBuffer::try_new(req)
+            .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?;
+        if self.l_values.len() != self.symbolic.len_val() {
+            self.l_values = vec![0.0; self.symbolic.len_val()];
+        }
+        let index_of = |local: usize| self.members.get(local).copied();
+        self.symbolic
+            .factorize_numeric_ldlt::<f64>(
+                &mut self.l_values,
+                mat.as_ref(),
+                Side::Lower,
+                NO_REGULARIZATION,
+                Par::Seq,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| match e {
+                LdltError::ZeroPivot { index } => FemError::ZeroPivot {
+                    index: index_of(index).unwrap_or(index),
+                    value: 0.0,
+                },
+            })?;
+        let n = self.members.len();
+        let s = self.dim() - n;
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            unreachable!("supernodal layout forced")
+        };
+        let (begin, end, ptr) = (
+            sn.supernode_begin(),
+            sn.supernode_end(),
+            sn.col_ptr_for_val(),
+        );
+        // the half's pivots, and S's part of the factor: L_SS (unit lower) and D_S
+        let mut negative = 0;
+        let mut l = Mat::<f64>::zeros(s, s);
+        for k in 0..sn.n_supernodes() {
+            let (b, e) = (begin[k], end[k]);
+            let pattern = sn.supernode(k).pattern();
+            let rows = e - b + pattern.len();
+            let block =
+                MatRef::from_column_major_slice(&self.l_values[ptr[k]..ptr[k + 1]], rows, e - b);
+            for j in 0..e - b {
+                let d = block[(j, j)];
+                if b + j < n {
+                    if !d.is_finite() || d == 0.0 {
+                        return Err(FemError::ZeroPivot {
+                            index: self.members[b + j],
+                            value: d,
+                        });
+                    }
+                    negative += usize::from(d < 0.0);
+                    continue;
+                }
+                let c = b + j - n;
+                l[(c, c)] = d;
+                for i in j + 1..e - b {
+                    l[(b + i - n, c)] = block[(i, j)];
+                }
+                for (t, &r) in pattern.iter().enumerate() {
+                    l[(r - n, c)] = block[(e - b + t, j)];
+                }
+            }
+        }
+        // T_i = L D Lᵀ: W = L D (lower, D on the diagonal), then the lower half of W Lᵀ
+        let mut w = l.clone();
+        for c in 0..s {
+            let d = l[(c, c)];
+            for r in c + 1..s {
+                w[(r, c)] *= d;
+            }
+        }
+        let mut t = Mat::<f64>::zeros(s, s);
+        faer::linalg::matmul::triangular::matmul(
+            t.as_mut(),
+            BlockStructure::TriangularLower,
+            Accum::Replace,
+            w.as_ref(),
+            BlockStructure::TriangularLower,
+            l.as_ref().transpose(),
+            BlockStructure::UnitTriangularUpper,
+            1.0,
+            Par::Seq,
+        );
+        for c in 0..s {
+            for r in c + 1..s {
+                t[(c, r)] = t[(r, c)];
+            }
+        }
+        self.trailing = t;
+        self.l_ss = l;
+        Ok(negative)
+    }
+
+    /// y = L⁻¹ y in place (L: M_i's unit lower factor), supernode by supernode, as faer's
+    /// supernodal LDLᵀ solve does its first sweep (faer exposes the whole solve only).
+    fn forward(&self, y: &mut [f64]) {
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            unreachable!("supernodal layout forced")
+        };
+        let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
+        let mut tmp = Vec::new();
+        for k in 0..sn.n_supernodes() {
+            let node = factor.supernode(k);
+            let (top, bottom) = node.val().split_at_row(node.val().ncols());
+            let start = node.start();
+            let mut x = MatMut::from_column_major_slice_mut(
+                &mut y[start..start + top.ncols()],
+                top.ncols(),
+                1,
+            );
+            faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place(
+                top,
+                x.as_mut(),
+                Par::Seq,
+            );
+            tmp.clear();
+            tmp.resize(bottom.nrows(), 0.0);
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(&mut tmp, bottom.nrows(), 1),
+                Accum::Replace,
+                bottom,
+                x.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            for (&i, &t) in node.pattern().iter().zip(&tmp) {
+                y[i] -= t;
+            }
+        }
+    }
+
+    /// y = L⁻ᵀ y in place, the solve's last sweep.
+    fn backward(&self, y: &mut [f64]) {
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            unreachable!("supernodal layout forced")
+        };
+        let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
+        let mut tmp = Vec::new();
+        for k in (0..sn.n_supernodes()).rev() {
+            let node = factor.supernode(k);
+            let (top, bottom) = node.val().split_at_row(node.val().ncols());
+            tmp.clear();
+            tmp.extend(node.pattern().iter().map(|&i| y[i]));
+            let start = node.start();
+            let mut x = MatMut::from_column_major_slice_mut(
+                &mut y[start..start + top.ncols()],
+                top.ncols(),
+                1,
+            );
+            faer::linalg::matmul::matmul(
+                x.as_mut(),
+                Accum::Add,
+                bottom.transpose(),
+                MatRef::from_column_major_slice(&tmp, bottom.nrows(), 1),
+                -1.0,
+                Par::Seq,
+            );
+            faer::linalg::triangular_solve::solve_unit_upper_triangular_in_place(
+                top.transpose(),
+                x.as_mut(),
+                Par::Seq,
+            );
+        }
+    }
+
+    /// The pivots of A_i (the first of M_i's), in elimination order.
+    fn half_pivots(&self) -> Vec<f64> {
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            unreachable!("supernodal layout forced")
+        };
+        let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
+        let n = self.members.len();
+        let mut d = Vec::with_capacity(n);
+        for k in 0..sn.n_supernodes() {
+            let node = factor.supernode(k);
+            let start = node.start();
+            for j in 0..node.val().ncols() {
+                if start + j < n {
+                    d.push(node.val()[(j, j)]);
+                }
+            }
+        }
+        d
+    }
+}
+
+impl TreeSplit {
+    /// The split of the pattern `pairs` (row, col; one per value given to
+    /// [`TreeSplit::factorize`]) on `n` unknowns at METIS's top separator; `None` when METIS
+    /// leaves a half empty.
+    pub(crate) fn new(n: usize, pairs: &[(usize, usize)]) -> Result<Option<Self>, FemError> {
+        let Some(sides) =
+            crate::ordering::bisection(n, pairs).map_err(FactorizationError::Ordering)?
+        else {
+            return Ok(None);
+        };
+        if (0..2).any(|h| !sides.contains(&h))
+            || pairs
+                .iter()
+                .any(|&(r, c)| sides[r] != 2 && sides[c] != 2 && sides[r] != sides[c])
+        {
+            return Ok(None);
+        }
+        let separator: Vec<usize> = (0..n).filter(|&k| sides[k] == 2).collect();
+        // one after the other: METIS, which orders each half, is not reentrant
+        let h0 = Half::new(&sides, 0, &separator, pairs)?;
+        let h1 = Half::new(&sides, 1, &separator, pairs)?;
+        let s = separator.len();
+        Ok(Some(Self {
+            n,
+            separator,
+            halves: [h0, h1],
+            schur: Mat::zeros(s, s),
+            parallel: true,
+        }))
+    }
+
+    /// Factorize (and solve) the two halves side by side (`true`, the default) or one after the
+    /// other: the bits are the same.
+    #[cfg(test)]
+    pub(crate) fn set_parallel(&mut self, parallel: bool) {
+        self.parallel = parallel;
+    }
+
+    /// The separator's size.
+    pub(crate) fn separator_len(&self) -> usize {
+        self.separator.len()
+    }
+
+    /// The flops of one factorization, counted as [`crate::linsolve::SparseLdlt::factor_flops`]
+    /// counts them: the two halves' sparse factors (S's columns included), the products
+    /// T_i = L D Lᵀ (s³/3 each) and S's dense LDLᵀ.
+    pub(crate) fn flops(&self) -> f64 {
+        let s = self.separator.len() as f64;
+        let dense: f64 = (0..self.separator.len())
+            .map(|j| {
+                let c = s - 1.0 - j as f64;
+                c * (c + 2.0)
+            })
+            .sum();
+        self.halves
+            .iter()
+            .map(|h| crate::linsolve::symbolic_flops(&h.symbolic, h.dim()))
+            .sum::<f64>()
+            + 2.0 * s * s * s / 3.0
+            + dense
+    }
+
+    /// The stored entries of the factor: the halves' and S's lower triangle.
+    pub(crate) fn nnz(&self) -> usize {
+        let s = self.separator.len();
+        self.halves
+            .iter()
+            .map(|h| h.symbolic.len_val())
+            .sum::<usize>()
+            + s * (s + 1) / 2
+    }
+
+    /// Numeric LDLᵀ of K with the values `values` (one per pair given to `new`); returns the
+    /// number of negative pivots.
+    pub(crate) fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
+        let [h0, h1] = &mut self.halves;
+        let (n0, n1) = if self.parallel {
+            rayon::join(|| h0.factorize(values), || h1.factorize(values))
+        } else {
+            (h0.factorize(values), h1.factorize(values))
+        };
+        let (n0, n1) = (n0?, n1?);
+        let s = self.separator.len();
+        let mut schur = &self.halves[0].trailing + &self.halves[1].trailing;
+        let req = faer::linalg::cholesky::ldlt::factor::cholesky_in_place_scratch::<f64>(
+            s,
+            Par::Seq,
+            Default::default(),
+        );
+        let mut mem = MemBuffer::try_new(req)
+            .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?;
+        faer::linalg::cholesky::ldlt::factor::cholesky_in_place(
+            schur.as_mut(),
+            NO_REGULARIZATION,
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .map_err(|e| match e {
+            LdltError::ZeroPivot { index } => FemError::ZeroPivot {
+                index: self.separator[index],
+                value: 0.0,
+            },
+        })?;
+        let mut negative = n0 + n1;
+        for j in 0..s {
+            let d = schur[(j, j)];
+            if !d.is_finite() || d == 0.0 {
+                return Err(FemError::ZeroPivot {
+                    index: self.separator[j],
+                    value: d,
+                });
+            }
+            negative += usize::from(d < 0.0);
+        }
+        self.schur = schur;
+        Ok(negative)
+    }
+
+    /// The pivots: A₀'s, A₁'s (each in its elimination order), then S's.
+    pub(crate) fn pivots(&self) -> Vec<f64> {
+        let mut d = Vec::with_capacity(self.n);
+        for h in &self.halves {
+            d.extend(h.half_pivots());
+        }
+        d.extend((0..self.separator.len()).map(|j| self.schur[(j, j)]));
+        d
+    }
+
+    /// Solve K x = rhs in place with the last factorization (see the module's steps).
+    pub(crate) fn solve(&self, rhs: &mut [f64]) {
+        let s = self.separator.len();
+        // 1. [w_i; z_i] = L⁻¹ [b_i; 0] in M_i's factor; q_i = B_iᵀ A_i⁻¹ b_i = −L_SS z_i
+        let first = |h: &Half| {
+            let n = h.members.len();
+            let mut y: Vec<f64> = h.members.iter().map(|&k| rhs[k]).collect();
+            y.resize(h.dim(), 0.0);
+            h.forward(&mut y);
+            let mut q = Mat::<f64>::zeros(s, 1);
+            faer::linalg::matmul::triangular::matmul(
+                q.as_mut(),
+                BlockStructure::Rectangular,
+                Accum::Replace,
+                h.l_ss.as_ref(),
+                BlockStructure::UnitTriangularLower,
+                MatRef::from_column_major_slice(&y[n..], s, 1),
+                BlockStructure::Rectangular,
+                -1.0,
+                Par::Seq,
+            );
+            (y, q)
+        };
+        let ((mut y0, q0), (mut y1, q1)) =
+            self.join(|| first(&self.halves[0]), || first(&self.halves[1]));
+        // 2. x_S = S⁻¹ (b_S − q₀ − q₁)
+        let mut x = Mat::<f64>::from_fn(s, 1, |i, _| {
+            rhs[self.separator[i]] - q0[(i, 0)] - q1[(i, 0)]
+        });
+        faer::linalg::cholesky::ldlt::solve::solve_in_place_with_conj(
+            self.schur.as_ref(),
+            self.schur.diagonal(),
+            Conj::No,
+            x.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut MemBuffer::new(faer::dyn_stack::StackReq::EMPTY)),
+        );
+        // 3. x_i = L⁻ᵀ [D_A⁻¹ w_i; L_SSᵀ x_S] (the first block): A_i⁻¹ (b_i − B_i x_S)
+        let second = |h: &Half, y: &mut Vec<f64>| {
+            let n = h.members.len();
+            for (v, d) in y[..n].iter_mut().zip(h.half_pivots()) {
+                *v /= d;
+            }
+            faer::linalg::matmul::triangular::matmul(
+                MatMut::from_column_major_slice_mut(&mut y[n..], s, 1),
+                BlockStructure::Rectangular,
+                Accum::Replace,
+                h.l_ss.as_ref().transpose(),
+                BlockStructure::UnitTriangularUpper,
+                x.as_ref(),
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+            h.backward(y);
+        };
+        self.join(
+            || second(&self.halves[0], &mut y0),
+            || second(&self.halves[1], &mut y1),
+        );
+        for (h, y) in self.halves.iter().zip([y0, y1]) {
+            for (&k, &value) in h.members.iter().zip(&y) {
+                rhs[k] = value;
+            }
+        }
+        for (i, &k) in self.separator.iter().enumerate() {
+            rhs[k] = x[(i, 0)];
+        }
+    }
+
+    /// `a` and `b`, side by side when the split runs in parallel.
+    fn join<A: Send, B: Send>(
+        &self,
+        a: impl FnOnce() -> A + Send,
+        b: impl FnOnce() -> B + Send,
+    ) -> (A, B) {
+        if self.parallel {
+            rayon::join(a, b)
+        } else {
+            (a(), b())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linsolve::{Layout, SparseLdlt};
+    use crate::ordering::Ordering;
+
+    /// n, the pairs, their values, a solution x, b = K x and the negative eigenvalues.
+    type Problem = (
+        usize,
+        Vec<(usize, usize)>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        usize,
+    );
+
+    /// A `k` × `k` grid's pattern (3 unknowns per node, bilinear couplings) with an indefinite,
+    /// diagonally dominant matrix on it: every 7th diagonal entry negative, |d| ≥ 2 against
+    /// off-diagonal row sums ≤ 1.75 (Gershgorin: no eigenvalue within 0.25 of zero, and the
+    /// negative eigenvalues are as many as the negative diagonal entries, which the off-diagonal
+    /// part, switched on continuously, cannot change). Some entries are given twice, halved
+    /// (duplicates are summed). Returns n, the pairs, their values, a solution x and b = K x.
+    fn problem(k: usize) -> Problem {
+        let (n, grid) = crate::ordering::grid(k);
+        let d = |i: usize| {
+            if i % 7 == 3 {
+                -2.0 - 0.001 * i as f64
+            } else {
+                2.0 + 0.001 * i as f64
+            }
+        };
+        let off = |r: usize, c: usize| 0.05 * (((r * 31 + c * 17) % 11) as f64 / 10.0 - 0.5);
+        let mut pairs = Vec::new();
+        let mut vals = Vec::new();
+        for (e, &(r, c)) in grid.iter().enumerate() {
+            let v = if r == c { d(r) } else { off(r, c) };
+            if e % 5 == 0 {
+                pairs.extend([(r, c), (r, c)]);
+                vals.extend([0.5 * v, 0.5 * v]);
+            } else {
+                pairs.push((r, c));
+                vals.push(v);
+            }
+        }
+        let x: Vec<f64> = (0..n).map(|i| (0.3 * i as f64).cos()).collect();
+        let mut b = vec![0.0; n];
+        for (&(r, c), &v) in pairs.iter().zip(&vals) {
+            b[r] += v * x[c];
+            if r != c {
+                b[c] += v * x[r];
+            }
+        }
+        let negative = (0..n).filter(|&i| d(i) < 0.0).count();
+        (n, pairs, vals, x, b, negative)
+    }
+
+    #[test]
+    fn the_split_solves_the_matrix_and_keeps_its_inertia() {
+        let (n, pairs, vals, x, b, negative) = problem(24);
+        let mut t = TreeSplit::new(n, &pairs).unwrap().expect("a split");
+        // a separator, and two halves that together with it hold every unknown once
+        let sizes = [t.halves[0].members.len(), t.halves[1].members.len()];
+        assert!(t.separator_len() > 0 && sizes[0] > 0 && sizes[1] > 0);
+        assert_eq!(sizes[0] + sizes[1] + t.separator_len(), n);
+        // a 24-node grid's separator is a line of about 24 nodes, not the whole
+        assert!(t.separator_len() <= 3 * 2 * 24, "{}", t.separator_len());
+        assert_eq!(t.factorize(&vals).unwrap(), negative);
+        assert_eq!(
+            t.pivots().iter().filter(|&&d| d < 0.0).count(),
+            negative,
+            "the pivots' signs"
+        );
+        let mut y = b.clone();
+        t.solve(&mut y);
+        // condition number ≤ 3.75 / 0.25 = 15 (Gershgorin), a backward-stable solve: exact to
+        // about 15 × 1e-16 per unit of |x| ≤ 1
+        for i in 0..n {
+            assert!(
+                (y[i] - x[i]).abs() < 1e-12,
+                "x[{i}]: {} against {}",
+                y[i],
+                x[i]
+            );
+        }
+    }
+
+    #[test]
+    fn the_split_is_bitwise_the_same_side_by_side_and_one_after_the_other() {
+        let (n, pairs, vals, _, b, _) = problem(24);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let run = |parallel: bool| {
+            pool.install(|| {
+                let mut t = TreeSplit::new(n, &pairs).unwrap().expect("a split");
+                t.set_parallel(parallel);
+                t.factorize(&vals).unwrap();
+                let mut y = b.clone();
+                t.solve(&mut y);
+                (t.pivots(), y)
+            })
+        };
+        let (one, two) = (run(false), run(true));
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&one.0), bits(&two.0));
+        assert_eq!(bits(&one.1), bits(&two.1));
+    }
+
+    #[test]
+    fn a_singular_matrix_is_a_zero_pivot_of_the_split() {
+        let (n, pairs, _, _, _, _) = problem(12);
+        let mut t = TreeSplit::new(n, &pairs).unwrap().expect("a split");
+        let zeros = vec![0.0; pairs.len()];
+        assert!(matches!(
+            t.factorize(&zeros),
+            Err(FemError::ZeroPivot { .. })
+        ));
+    }
+
+    #[test]
+    fn a_large_nested_dissection_factor_is_split_and_agrees_with_the_whole_one() {
+        // 183² nodes × 3 = 100,467 unknowns, just above the split's threshold
+        let (n, pairs, vals, x, b, negative) = problem(183);
+        assert!(n >= crate::linsolve::SPLIT_MIN_UNKNOWNS);
+        let mut split =
+            SparseLdlt::with_options(n, &pairs, Layout::Auto, Ordering::NestedDissection).unwrap();
+        let mut whole = SparseLdlt::with_options(n, &pairs, Layout::Auto, Ordering::Amd).unwrap();
+        let s = split.split_separator().expect("split");
+        // a grid's separator is a line of nodes, about √(n/3) of them
+        assert!(s <= 3 * 2 * 183, "separator {s}");
+        assert_eq!(whole.split_separator(), None, "AMD keeps the whole factor");
+        assert_eq!(split.factorize(&vals).unwrap(), negative);
+        assert_eq!(whole.factorize(&vals).unwrap(), negative);
+        let (mut y, mut z) = (b.clone(), b.clone());
+        split.solve(&mut y);
+        whole.solve(&mut z);
+        for i in 0..n {
+            assert!((y[i] - x[i]).abs() < 1e-12, "split x[{i}]");
+            assert!((y[i] - z[i]).abs() < 1e-12, "split against whole x[{i}]");
+        }
+    }
+}
