@@ -1567,3 +1567,80 @@ fn the_outputs_speak_one_vocabulary() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// A whole tube above the split's threshold (`SPLIT_MIN_UNKNOWNS`, 100,000 unknowns): with
+/// `ordering = "auto"` the factorization is split at METIS's top separator and its halves run
+/// side by side. The inflation and the squeeze with the gas closed in (augmented contact, the
+/// factor reused by GMRES) reach the states that AMD's whole factor reaches, to the Newton
+/// tolerance (rtol 1e-9 relative residual; the contact's augmentation stops at a gap tolerance
+/// 1e-9 of the radius, so 1e-7 relative on the contact force and χ), with the same negative
+/// pivots at every step; and a run on a pool of one thread gives the same bits as on two.
+#[test]
+fn a_split_factorization_gives_the_whole_factors_states_and_the_same_bits_on_any_thread_count() {
+    let text = |ordering: &str| {
+        format!(
+            "[geometry]\nradius = 1.0\nlength = 20.0\nthickness = 0.01\ncaps = \"hemisphere\"\n\
+             [material]\nmodel = \"abb\"\nshear_modulus = 1.0\nkuhn = 30\n\
+             [mesh]\naround = 96\nalong = 340\nsymmetry = \"none\"\n\
+             [solver]\ncheckpoint_every = 0\nordering = \"{ordering}\"\n\
+             [[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = 1.3\nsteps = 2\n\
+             [[stage]]\nkind = \"squeeze\"\ntarget_rho = 0.9\nsteps = 2\n"
+        )
+    };
+    let run_on = |ordering: &str, threads: usize| {
+        let case = Case::parse(&text(ordering)).unwrap();
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(&case, "whole", &mut []).into_result().unwrap())
+    };
+    let split = run_on("auto", 2);
+    let whole = run_on("amd", 2);
+    assert!(split.mesh.equations >= tubemem_fem::linsolve::SPLIT_MIN_UNKNOWNS);
+    let s = split
+        .mesh
+        .split_separator
+        .expect("the factorization is split");
+    // METIS's separator of a tube is a ring of nodes around it: 96 nodes, 3 unknowns each, less
+    // the rigid-mode pins' (at most 6) where the ring holds them
+    assert!((3 * 96 - 6..=3 * 2 * 96).contains(&s), "separator {s}");
+    assert_eq!(split.mesh.ordering, "nested-dissection");
+    assert_eq!(whole.mesh.split_separator, None);
+    let states = |r: &tubemem_app::report::RunReport| -> Vec<(f64, f64, f64, usize)> {
+        r.stages
+            .iter()
+            .flat_map(|st| {
+                st.steps.iter().map(|row| {
+                    (
+                        row.midspan.w,
+                        row.midspan.lambda_s,
+                        row.contact.as_ref().map_or(0.0, |c| c.values.chi),
+                        row.negative_pivots,
+                    )
+                })
+            })
+            .collect()
+    };
+    let (a, b) = (states(&split), states(&whole));
+    assert_eq!(a.len(), b.len());
+    assert!(a.iter().any(|r| r.2 > 0.0), "the squeeze made contact");
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x.0 / y.0 - 1.0).abs() < 1e-8, "ϖ {x:?} against {y:?}");
+        assert!((x.1 / y.1 - 1.0).abs() < 1e-8, "λs {x:?} against {y:?}");
+        assert!(
+            (x.2 - y.2).abs() <= 1e-7 * y.2.abs(),
+            "χ {x:?} against {y:?}"
+        );
+        assert_eq!(x.3, y.3, "negative pivots {x:?} against {y:?}");
+    }
+    // one thread: the halves one after the other, the same bits
+    let one = run_on("auto", 1);
+    let bits = |r: &tubemem_app::report::RunReport| {
+        states(r)
+            .iter()
+            .map(|s| (s.0.to_bits(), s.1.to_bits(), s.2.to_bits(), s.3))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&one), bits(&split));
+}
