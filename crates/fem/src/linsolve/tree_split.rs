@@ -37,7 +37,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::linalg::matmul::triangular::BlockStructure;
 use faer::perm::PermRef;
-use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
+use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
@@ -72,6 +72,8 @@ struct Half {
     trailing: Mat<f64>,
     /// L_SS, S's rows and columns of the factor (unit lower, D_S on the diagonal)
     l_ss: Mat<f64>,
+    /// A_i's pivots (the first of M_i's), in elimination order
+    pivots: Vec<f64>,
 }
 
 /// K's LDLᵀ as two bordered halves and the separator's dense Schur complement.
@@ -181,6 +183,7 @@ impl Half {
             symbolic,
             trailing: Mat::zeros(0, 0),
             l_ss: Mat::zeros(0, 0),
+            pivots: Vec::new(),
         })
     }
 
@@ -188,8 +191,17 @@ impl Half {
         self.pattern.nrows()
     }
 
+    /// The supernodal structure of M_i's factor (the layout `new` forces).
+    fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => sn,
+            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal layout forced"),
+        }
+    }
+
     /// The numeric LDLᵀ of M_i from K's values, then T_i; returns the negative pivots of A_i.
-    fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
+    /// A zero pivot names its unknown of K (`separator`: S's, in M_i's order).
+    fn factorize(&mut self, values: &[f64], separator: &[usize]) -> Result<usize, FemError> {
         let mut vals = vec![0.0; self.pattern.compute_nnz()];
         for (k, (&e, &at)) in self.source.iter().zip(&self.slot).enumerate() {
             let w = if k < self.halved_from { 1.0 } else { 0.5 };
@@ -204,7 +216,14 @@ impl Half {
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
         }
-        let index_of = |local: usize| self.members.get(local).copied();
+        let n = self.members.len();
+        let global = |local: usize| {
+            if local < n {
+                self.members[local]
+            } else {
+                separator[local - n]
+            }
+        };
         self.symbolic
             .factorize_numeric_ldlt::<f64>(
                 &mut self.l_values,
@@ -217,15 +236,12 @@ impl Half {
             )
             .map_err(|e| match e {
                 LdltError::ZeroPivot { index } => FemError::ZeroPivot {
-                    index: index_of(index).unwrap_or(index),
+                    index: global(index),
                     value: 0.0,
                 },
             })?;
-        let n = self.members.len();
         let s = self.dim() - n;
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("supernodal layout forced")
-        };
+        let sn = self.supernodal();
         let (begin, end, ptr) = (
             sn.supernode_begin(),
             sn.supernode_end(),
@@ -233,6 +249,7 @@ impl Half {
         );
         // the half's pivots, and S's part of the factor: L_SS (unit lower) and D_S
         let mut negative = 0;
+        let mut pivots = Vec::with_capacity(n);
         let mut l = Mat::<f64>::zeros(s, s);
         for k in 0..sn.n_supernodes() {
             let (b, e) = (begin[k], end[k]);
@@ -250,6 +267,7 @@ impl Half {
                         });
                     }
                     negative += usize::from(d < 0.0);
+                    pivots.push(d);
                     continue;
                 }
                 let c = b + j - n;
@@ -289,15 +307,14 @@ impl Half {
         }
         self.trailing = t;
         self.l_ss = l;
+        self.pivots = pivots;
         Ok(negative)
     }
 
     /// y = L⁻¹ y in place (L: M_i's unit lower factor), supernode by supernode, as faer's
     /// supernodal LDLᵀ solve does its first sweep (faer exposes the whole solve only).
     fn forward(&self, y: &mut [f64]) {
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("supernodal layout forced")
-        };
+        let sn = self.supernodal();
         let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
         let mut tmp = Vec::new();
         for k in 0..sn.n_supernodes() {
@@ -332,9 +349,7 @@ impl Half {
 
     /// y = L⁻ᵀ y in place, the solve's last sweep.
     fn backward(&self, y: &mut [f64]) {
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("supernodal layout forced")
-        };
+        let sn = self.supernodal();
         let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
         let mut tmp = Vec::new();
         for k in (0..sn.n_supernodes()).rev() {
@@ -362,26 +377,6 @@ impl Half {
                 Par::Seq,
             );
         }
-    }
-
-    /// The pivots of A_i (the first of M_i's), in elimination order.
-    fn half_pivots(&self) -> Vec<f64> {
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            unreachable!("supernodal layout forced")
-        };
-        let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
-        let n = self.members.len();
-        let mut d = Vec::with_capacity(n);
-        for k in 0..sn.n_supernodes() {
-            let node = factor.supernode(k);
-            let start = node.start();
-            for j in 0..node.val().ncols() {
-                if start + j < n {
-                    d.push(node.val()[(j, j)]);
-                }
-            }
-        }
-        d
     }
 }
 
@@ -462,9 +457,13 @@ impl TreeSplit {
     pub(crate) fn factorize(&mut self, values: &[f64]) -> Result<usize, FemError> {
         let [h0, h1] = &mut self.halves;
         let (n0, n1) = if self.parallel {
-            rayon::join(|| h0.factorize(values), || h1.factorize(values))
+            let sep = &self.separator;
+            rayon::join(|| h0.factorize(values, sep), || h1.factorize(values, sep))
         } else {
-            (h0.factorize(values), h1.factorize(values))
+            (
+                h0.factorize(values, &self.separator),
+                h1.factorize(values, &self.separator),
+            )
         };
         let (n0, n1) = (n0?, n1?);
         let s = self.separator.len();
@@ -508,7 +507,7 @@ impl TreeSplit {
     pub(crate) fn pivots(&self) -> Vec<f64> {
         let mut d = Vec::with_capacity(self.n);
         for h in &self.halves {
-            d.extend(h.half_pivots());
+            d.extend(&h.pivots);
         }
         d.extend((0..self.separator.len()).map(|j| self.schur[(j, j)]));
         d
@@ -554,7 +553,7 @@ impl TreeSplit {
         // 3. x_i = L⁻ᵀ [D_A⁻¹ w_i; L_SSᵀ x_S] (the first block): A_i⁻¹ (b_i − B_i x_S)
         let second = |h: &Half, y: &mut Vec<f64>| {
             let n = h.members.len();
-            for (v, d) in y[..n].iter_mut().zip(h.half_pivots()) {
+            for (v, d) in y[..n].iter_mut().zip(&h.pivots) {
                 *v /= d;
             }
             faer::linalg::matmul::triangular::matmul(
