@@ -77,10 +77,15 @@ pub(crate) fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f6
 
 /// The factor: faer's supernodal or simplicial LDLᵀ of the whole matrix, or the split at the
 /// top separator ([`crate::linsolve::tree_split`]).
+/// A whole factor keeps K's pattern (lower triangle, duplicates merged) and the map from the
+/// values given to it; a split factor does not need them (its halves have their own), which at
+/// a million unknowns saves some 300 MB.
 enum Factor {
     Whole {
         symbolic: Box<SymbolicCholesky<usize>>,
         l_values: Vec<f64>,
+        pattern: SymbolicSparseColMat<usize>,
+        argsort: Argsort<usize>,
     },
     Split(Box<TreeSplit>),
 }
@@ -96,8 +101,6 @@ pub const SPLIT_MIN_UNKNOWNS: usize = 100_000;
 /// A symmetric sparse matrix pattern (lower triangle) with its symbolic factorization.
 pub struct SparseLdlt {
     n: usize,
-    pattern: SymbolicSparseColMat<usize>,
-    argsort: Argsort<usize>,
     entries: usize,
     factor: Factor,
     factorized: bool,
@@ -130,12 +133,15 @@ impl SparseLdlt {
         layout: Layout,
         ordering: Ordering,
     ) -> Result<Self, FemError> {
-        let idx: Vec<Pair<usize, usize>> = pairs
-            .iter()
-            .map(|&(r, c)| Pair::new(r.max(c), r.min(c)))
-            .collect();
-        let (pattern, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx)
-            .map_err(FactorizationError::Pattern)?;
+        // K's pattern (lower triangle, duplicates merged) and the map from the values
+        let merged = || -> Result<_, FactorizationError> {
+            let idx: Vec<Pair<usize, usize>> = pairs
+                .iter()
+                .map(|&(r, c)| Pair::new(r.max(c), r.min(c)))
+                .collect();
+            SymbolicSparseColMat::try_new_from_indices(n, n, &idx)
+                .map_err(FactorizationError::Pattern)
+        };
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: match layout {
                 Layout::Auto => SupernodalThreshold::AUTO,
@@ -144,7 +150,7 @@ impl SparseLdlt {
             },
             ..Default::default()
         };
-        let amd = || {
+        let amd = |pattern: &SymbolicSparseColMat<usize>| {
             factorize_symbolic_cholesky(
                 pattern.as_ref(),
                 Side::Lower,
@@ -153,7 +159,7 @@ impl SparseLdlt {
             )
             .map_err(FactorizationError::Symbolic)
         };
-        let nested = || -> Result<SymbolicCholesky<usize>, FactorizationError> {
+        let nested = |pattern: &SymbolicSparseColMat<usize>| -> Result<SymbolicCholesky<usize>, FactorizationError> {
             let perm = crate::ordering::nested_dissection(n, pairs)
                 .map_err(FactorizationError::Ordering)?;
             let mut inverse = vec![0usize; n];
@@ -168,10 +174,16 @@ impl SparseLdlt {
             )
             .map_err(FactorizationError::Symbolic)
         };
-        let whole = |symbolic: SymbolicCholesky<usize>| Factor::Whole {
-            l_values: vec![0.0; symbolic.len_val()],
-            symbolic: Box::new(symbolic),
-        };
+        let whole =
+            |symbolic: SymbolicCholesky<usize>,
+             (pattern, argsort): (SymbolicSparseColMat<usize>, Argsort<usize>)| {
+                Factor::Whole {
+                    l_values: vec![0.0; symbolic.len_val()],
+                    symbolic: Box::new(symbolic),
+                    pattern,
+                    argsort,
+                }
+            };
         // nested dissection on a large matrix: its top split as two halves factorized side by
         // side ([`crate::linsolve::tree_split`]); METIS's top separator is the one its nested dissection
         // of the whole would start from, so the flops are the same within about 1 %
@@ -181,35 +193,41 @@ impl SparseLdlt {
             None
         };
         let (factor, ordering) = match (ordering, split) {
-            (Ordering::Amd, _) => (whole(amd()?), Ordering::Amd),
+            (Ordering::Amd, _) => {
+                let m = merged()?;
+                (whole(amd(&m.0)?, m), Ordering::Amd)
+            }
             (Ordering::NestedDissection, Some(t)) => {
                 (Factor::Split(Box::new(t)), Ordering::NestedDissection)
             }
-            (Ordering::NestedDissection, None) => (whole(nested()?), Ordering::NestedDissection),
+            (Ordering::NestedDissection, None) => {
+                let m = merged()?;
+                (whole(nested(&m.0)?, m), Ordering::NestedDissection)
+            }
             (Ordering::Auto, Some(t)) => {
                 // the split against AMD, by flops
-                let a = amd()?;
+                let m = merged()?;
+                let a = amd(&m.0)?;
                 if t.flops() < symbolic_flops(&a, n) {
                     (Factor::Split(Box::new(t)), Ordering::NestedDissection)
                 } else {
-                    (whole(a), Ordering::Amd)
+                    (whole(a, m), Ordering::Amd)
                 }
             }
             (Ordering::Auto, None) => {
                 // both analyses, and the one whose factorization costs fewer flops (AMD on a
                 // tie, so a pattern where nested dissection gains nothing keeps AMD's factor)
-                let (a, d) = (amd()?, nested()?);
+                let m = merged()?;
+                let (a, d) = (amd(&m.0)?, nested(&m.0)?);
                 if symbolic_flops(&d, n) < symbolic_flops(&a, n) {
-                    (whole(d), Ordering::NestedDissection)
+                    (whole(d, m), Ordering::NestedDissection)
                 } else {
-                    (whole(a), Ordering::Amd)
+                    (whole(a, m), Ordering::Amd)
                 }
             }
         };
         Ok(Self {
             n,
-            pattern,
-            argsort,
             entries: pairs.len(),
             factor,
             factorized: false,
@@ -292,8 +310,13 @@ impl SparseLdlt {
                 Self::check_finite(values, self.entries)?;
                 t.factorize(values)?
             }
-            Factor::Whole { symbolic, l_values } => {
-                let mat = Self::fill(&self.pattern, &self.argsort, self.entries, values)?;
+            Factor::Whole {
+                symbolic,
+                l_values,
+                pattern,
+                argsort,
+            } => {
+                let mat = Self::fill(pattern, argsort, self.entries, values)?;
                 let par = self.par;
                 let req = symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
                 let mut mem = MemBuffer::try_new(req)
@@ -334,7 +357,9 @@ impl SparseLdlt {
     /// two halves', then the separator's).
     pub fn pivots(&self) -> Vec<f64> {
         let (symbolic, l_values) = match &self.factor {
-            Factor::Whole { symbolic, l_values } => (symbolic, l_values),
+            Factor::Whole {
+                symbolic, l_values, ..
+            } => (symbolic, l_values),
             Factor::Split(t) => return t.pivots(),
         };
         match symbolic.raw() {
@@ -365,16 +390,16 @@ impl SparseLdlt {
 
     /// The symmetric matrix whose values (one per pair given to `new`, duplicates summed)
     /// are `values`, as an operator ([`SymmetricMatrix::apply`]).
-    pub fn matrix(&self, values: &[f64]) -> Result<SymmetricMatrix, FemError> {
-        Ok(SymmetricMatrix {
-            lower: self.filled(values)?,
-        })
-    }
-
-    /// The lower triangle with `values` (one per pair given to `new`, duplicates summed),
-    /// refused where an entry is not finite.
-    fn filled(&self, values: &[f64]) -> Result<SparseColMat<usize, f64>, FemError> {
-        Self::fill(&self.pattern, &self.argsort, self.entries, values)
+    pub fn matrix(&self, values: &[f64]) -> Result<SymmetricMatrix<'_>, FemError> {
+        Ok(SymmetricMatrix(match &self.factor {
+            Factor::Whole {
+                pattern, argsort, ..
+            } => Operator::Lower(Self::fill(pattern, argsort, self.entries, values)?),
+            Factor::Split(t) => {
+                Self::check_finite(values, self.entries)?;
+                Operator::Split(t.matrix(values))
+            }
+        }))
     }
 
     /// [`SparseLdlt::filled`] from the pattern's parts.
@@ -404,7 +429,9 @@ impl SparseLdlt {
     pub fn solve(&self, rhs: &mut [f64]) {
         assert!(self.factorized, "solve after a successful factorize");
         let (symbolic, l_values) = match &self.factor {
-            Factor::Whole { symbolic, l_values } => (symbolic, l_values),
+            Factor::Whole {
+                symbolic, l_values, ..
+            } => (symbolic, l_values),
             Factor::Split(t) => return t.solve(rhs),
         };
         // sequential whatever the factorization's threads: faer's parallel triangular solve
@@ -424,30 +451,50 @@ impl SparseLdlt {
     }
 }
 
-/// A symmetric sparse matrix stored by its lower triangle ([`SparseLdlt::matrix`]).
-pub struct SymmetricMatrix {
-    lower: SparseColMat<usize, f64>,
+/// A symmetric sparse matrix as an operator ([`SparseLdlt::matrix`]): by its lower triangle,
+/// or, for a split factor, as the sum of the split's two halves.
+pub struct SymmetricMatrix<'a>(Operator<'a>);
+
+enum Operator<'a> {
+    Lower(SparseColMat<usize, f64>),
+    Split(tree_split::SplitMatrix<'a>),
 }
 
-impl SymmetricMatrix {
+impl SymmetricMatrix<'_> {
     /// out = A x, column by column in a fixed order (sequential: the sums do not depend on the
     /// number of threads).
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        let m = self.lower.as_ref();
-        let (ptr, rows, vals) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
-        for j in 0..x.len() {
-            let xj = x[j];
-            let mut yj = 0.0;
-            for k in ptr[j]..ptr[j + 1] {
-                let (i, a) = (rows[k], vals[k]);
-                out[i] += a * xj;
-                if i != j {
-                    yj += a * x[i];
-                }
+        match &self.0 {
+            Operator::Lower(m) => {
+                out.iter_mut().for_each(|v| *v = 0.0);
+                let m = m.as_ref();
+                apply_lower(
+                    m.symbolic().col_ptr(),
+                    m.symbolic().row_idx(),
+                    m.val(),
+                    x,
+                    out,
+                );
             }
-            out[j] += yj;
+            Operator::Split(m) => m.apply(x, out),
         }
+    }
+}
+
+/// out += A x for the symmetric A whose lower triangle is (`ptr`, `rows`, `vals`) by column,
+/// column by column in a fixed order.
+pub(crate) fn apply_lower(ptr: &[usize], rows: &[usize], vals: &[f64], x: &[f64], out: &mut [f64]) {
+    for j in 0..x.len() {
+        let xj = x[j];
+        let mut yj = 0.0;
+        for k in ptr[j]..ptr[j + 1] {
+            let (i, a) = (rows[k], vals[k]);
+            out[i] += a * xj;
+            if i != j {
+                yj += a * x[i];
+            }
+        }
+        out[j] += yj;
     }
 }
 
