@@ -1,6 +1,8 @@
 //! The sparsity pattern of the global tangent, built once per mesh: for every element, the
 //! positions of its 3N × 3N entries (N = 4 or 9 nodes) in the lower triangle of the global matrix (in pattern
-//! order), and the position of every diagonal entry (for shifts).
+//! order), and the position of every diagonal entry (for shifts). The global (row, col) of
+//! each value is built with it and handed to the symbolic factorization, not kept: 16 bytes a
+//! value, some 400 MB at a million unknowns.
 
 use crate::dofs::DofMap;
 
@@ -8,15 +10,19 @@ use crate::dofs::DofMap;
 pub struct Pattern {
     /// per element: (local row, local col) of each entry it contributes, in pattern order
     entries: Vec<Vec<(u8, u8)>>,
-    /// (row, col) of every entry, row ≥ col, in the order values are given
-    pairs: Vec<(usize, usize)>,
+    /// the number of values
+    len: usize,
     /// the position in `pairs` of one entry of each diagonal
     diag: Vec<usize>,
 }
 
 impl Pattern {
-    /// The pattern of elements given by their node lists (in element order).
-    pub fn new<'a>(dofs: &DofMap, elements: impl IntoIterator<Item = &'a [usize]>) -> Self {
+    /// The pattern of elements given by their node lists (in element order), and the (row, col)
+    /// of every value, row ≥ col, in the order values are given (duplicates included).
+    pub fn new<'a>(
+        dofs: &DofMap,
+        elements: impl IntoIterator<Item = &'a [usize]>,
+    ) -> (Self, Vec<(usize, usize)>) {
         let mut entries = Vec::new();
         let mut pairs = Vec::new();
         let mut diag = vec![usize::MAX; dofs.len()];
@@ -40,11 +46,12 @@ impl Pattern {
             }
             entries.push(list);
         }
-        Self {
+        let pattern = Self {
             entries,
-            pairs,
+            len: pairs.len(),
             diag,
-        }
+        };
+        (pattern, pairs)
     }
 
     /// The local (row, col) entries of element `e`, in pattern order.
@@ -52,18 +59,13 @@ impl Pattern {
         &self.entries[e]
     }
 
-    /// Every (row, col) of the lower triangle, one per value, duplicates included.
-    pub fn pairs(&self) -> &[(usize, usize)] {
-        &self.pairs
-    }
-
     /// The number of values.
     pub fn len(&self) -> usize {
-        self.pairs.len()
+        self.len
     }
 
     pub fn is_empty(&self) -> bool {
-        self.pairs.is_empty()
+        self.len == 0
     }
 
     /// The value positions of the diagonal entries (one each; `usize::MAX` for an equation that

@@ -209,19 +209,15 @@ impl Model {
         dofs: &DofMap,
         ordering: crate::ordering::Ordering,
     ) -> Result<(Pattern, SparseLdlt), FemError> {
-        let pattern = Pattern::new(dofs, (0..elements.len()).map(|e| elements.nodes(e)));
+        let (pattern, pairs) = Pattern::new(dofs, (0..elements.len()).map(|e| elements.nodes(e)));
         if let Some(k) = pattern.diagonal().iter().position(|&d| d == usize::MAX) {
             let node = (0..mesh.nodes.len())
                 .find(|&i| (0..3).any(|c| dofs.eq(i, c) == Some(k)))
                 .unwrap_or(usize::MAX);
             return Err(FemError::UnusedNode { node });
         }
-        let ldlt = SparseLdlt::with_options(
-            dofs.len(),
-            pattern.pairs(),
-            crate::linsolve::Layout::Auto,
-            ordering,
-        )?;
+        let ldlt =
+            SparseLdlt::with_options(dofs.len(), &pairs, crate::linsolve::Layout::Auto, ordering)?;
         Ok((pattern, ldlt))
     }
 
