@@ -37,6 +37,7 @@ pub mod dofs;
 pub mod edge_load;
 pub mod element;
 pub mod geometry;
+pub mod heap;
 pub mod krylov;
 pub mod linsolve;
 pub mod manufactured;

@@ -197,9 +197,17 @@ impl newton::Problem for MembraneProblem<'_> {
             return Err(FemError::Interrupted);
         }
         let m = self.model.multiplicity();
-        let (a, assembly_seconds) = self.assemble_at(state)?;
+        let (mut a, assembly_seconds) = self.assemble_at(state)?;
         state.p = self.pressure(state.p, a.volume);
         let p = state.p;
+        // the values of K = K_int − ϖH (the sums of `tangent_values`), made once in K_int's
+        // storage and H dropped: at a million unknowns each array takes some 200 MB, and the
+        // factorization's peak memory had all three
+        let mut k = std::mem::take(&mut a.k_int);
+        for (k, h) in k.iter_mut().zip(&a.k_vol) {
+            *k -= p * h;
+        }
+        a.k_vol = Vec::new();
         let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
         // the constraint c, its gradient h in x and its derivative cp in ϖ
         let mut cp = 0.0;
@@ -282,7 +290,7 @@ impl newton::Problem for MembraneProblem<'_> {
                 let eta = reuse::forcing(res, self.model.settings.rtol);
                 let minus_r: Vec<f64> = r.iter().map(|v| -v).collect();
                 self.model.reused_correction(
-                    &a,
+                    (&a, &k),
                     p,
                     gas_newton,
                     minus_r,
@@ -305,7 +313,10 @@ impl newton::Problem for MembraneProblem<'_> {
                 (dx, dp, negative, 0.0, 0.0, seconds, krylov, false)
             } else {
                 let t_factor = std::time::Instant::now();
-                let (neg, shift) = self.model.factorize(&a, p)?;
+                // the stiffness scale of a held mode's eigenvalue, before the factorization
+                // takes (and may shift) the values
+                let stiffness = self.model.largest_diagonal_in(&k);
+                let (neg, shift) = self.model.factorize_values(k)?;
                 if eligible && self.model.reuses_factor() {
                     let positions = self.branch.as_deref().unwrap_or(&state.x).to_vec();
                     self.model.factorized_at(&positions);
@@ -360,7 +371,7 @@ impl newton::Problem for MembraneProblem<'_> {
                         if converged {
                             self.held = Some(Held {
                                 force: dot(phi0, &r),
-                                relative_eigenvalue: mu / self.model.largest_diagonal(&a, p),
+                                relative_eigenvalue: mu / stiffness,
                                 energy: a.energy,
                                 mode: phi,
                             });

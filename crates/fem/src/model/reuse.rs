@@ -200,20 +200,21 @@ impl Model {
     }
 
     /// The Newton correction (Δx, Δp) with the reused factor preconditioning GMRES on the
-    /// current tangent K = K_int − ϖH (+ (ϖ/V) g gᵀ for closed gas): `minus_r` is −R, `border`
+    /// current tangent K = K_int − ϖH (+ (ϖ/V) g gᵀ for closed gas) of the assembly `a`, whose
+    /// values (one per pattern entry) are `k`: `minus_r` is −R, `border`
     /// the constraint's (h, c, ∂c/∂ϖ) of a bordered control. None where a solve did not reach
     /// `eta` within [`MAX_KRYLOV`] iterations (the caller refactorizes); Err where K cannot be
     /// built. Also returns the GMRES iterations it took.
     pub(super) fn reused_correction(
         &mut self,
-        a: &Assembled,
+        (a, k): (&Assembled, &[f64]),
         p: f64,
         gas: bool,
         mut minus_r: Vec<f64>,
         border: Option<(&[f64], f64, f64)>,
         eta: f64,
     ) -> Result<(Option<Correction>, usize), FemError> {
-        let k = self.ldlt.matrix(&super::solve::tangent_values(a, p))?;
+        let k = self.ldlt.matrix(k)?;
         let cc = if gas { p / a.volume } else { 0.0 };
         let ldlt = &self.ldlt;
         let mut iterations = 0;

@@ -36,8 +36,22 @@ impl Model {
     /// Factorize K = K_int − p H; if K is singular, retry with diagonal shifts of 1e-10 …
     /// 1e-4 of its largest diagonal entry. Returns (#neg, shift).
     pub(super) fn factorize(&mut self, a: &Assembled, p: f64) -> Result<(usize, f64), FemError> {
-        let mut vals = tangent_values(a, p);
+        self.factorize_values(tangent_values(a, p))
+    }
+
+    /// [`Model::factorize`] of the tangent whose values (one per pattern entry) are `vals`.
+    pub(super) fn factorize_values(
+        &mut self,
+        mut vals: Vec<f64>,
+    ) -> Result<(usize, f64), FemError> {
         let result = self.factorize_shifted(&mut vals);
+        // the tangent's values and the factorization's transients are freed here: on a large
+        // model their pages go back to the system ([`crate::heap`])
+        let large = vals.len() >= crate::heap::LARGE_VALUES;
+        drop(vals);
+        if large {
+            crate::heap::release_free();
+        }
         if let Ok((neg, shift)) = result {
             self.factorized(neg, shift);
         }

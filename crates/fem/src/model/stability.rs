@@ -140,12 +140,21 @@ impl Model {
 
     /// The largest |diagonal entry| of K = K_int − p H in `a` (the scale of the stiffness).
     pub(super) fn largest_diagonal(&self, a: &Assembled, p: f64) -> f64 {
-        self.pattern
-            .diagonal()
-            .iter()
-            .map(|&d| (a.k_int[d] - p * a.k_vol[d]).abs())
-            .fold(0.0, f64::max)
-            .max(1e-300)
+        self.largest_diagonal_of(
+            self.pattern
+                .diagonal()
+                .iter()
+                .map(|&d| a.k_int[d] - p * a.k_vol[d]),
+        )
+    }
+
+    /// The largest |diagonal entry| of the tangent whose values (one per pattern entry) are `k`.
+    pub(super) fn largest_diagonal_in(&self, k: &[f64]) -> f64 {
+        self.largest_diagonal_of(self.pattern.diagonal().iter().map(|&d| k[d]))
+    }
+
+    fn largest_diagonal_of(&self, diagonal: impl Iterator<Item = f64>) -> f64 {
+        diagonal.map(f64::abs).fold(0.0, f64::max).max(1e-300)
     }
 
     /// Inverse iteration with the factor of K = K_int − ϖ H at `state` (with the load's planes;
