@@ -60,8 +60,11 @@ pub(crate) fn mesh_of(
 /// The estimated peak memory of a model with `equations` equations: 8 MiB + 240 B·n·log2 n.
 /// Fitted to the measured peak RSS of pressure-controlled runs (release, this 2-core machine):
 /// 19.7, 56.9, 167 and 414 MiB at 4,520, 16,280, 47,904 and 104,448 equations (the fit is
-/// within 10 % there); at 978,432 equations it gives 4.7 GiB against the 3.6 GiB measured, so
-/// it errs on the safe side as the factor's fill grows more slowly than n log n.
+/// within 10 % there); at 978,432 equations it gives 4.7 GiB against the 4.2–4.6 GiB peak
+/// measured with the split factorization (`bash scripts/bench-million.sh`, `ORDERING=auto
+/// THREADS=2`; it was 5.6 GiB before the factorization's transients were kept from one
+/// factorization to the next and the global pattern pairs dropped), so it errs on the safe side
+/// as the factor's fill grows more slowly than n log n.
 pub(crate) fn memory_estimate(equations: usize) -> u64 {
     let n = equations.max(2) as f64;
     (8.0 * (1u64 << 20) as f64 + 240.0 * n * n.log2()) as u64
