@@ -259,17 +259,17 @@ impl Half {
         let mut vals = std::mem::take(&mut self.vals);
         self.values_into(values, &mut vals);
         let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
-        if self.scratch.is_none() {
-            let req = self
-                .symbolic
-                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
-            self.scratch = Some(
-                MemBuffer::try_new(req)
-                    .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?,
-            );
-        }
-        let Some(mem) = self.scratch.as_mut() else {
-            unreachable!("the workspace was made above")
+        let mem = match &mut self.scratch {
+            Some(mem) => mem,
+            None => {
+                let req = self
+                    .symbolic
+                    .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
+                self.scratch.insert(
+                    MemBuffer::try_new(req)
+                        .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?,
+                )
+            }
         };
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
