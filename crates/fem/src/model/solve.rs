@@ -39,16 +39,22 @@ impl Model {
         self.factorize_values(tangent_values(a, p))
     }
 
-    /// [`Model::factorize`] of the tangent whose values (one per pattern entry) are `vals`.
-    pub(super) fn factorize_values(
-        &mut self,
-        mut vals: Vec<f64>,
-    ) -> Result<(usize, f64), FemError> {
-        let result = self.factorize_shifted(&mut vals);
-        // the tangent's values and the factorization's transients are freed here: on a large
-        // model their pages go back to the system ([`crate::heap`])
+    /// [`Model::factorize`] of the tangent whose values (one per pattern entry) are `vals`,
+    /// taken: the factorization drops them when it can ([`SparseLdlt::factorize_shifted`]).
+    pub(super) fn factorize_values(&mut self, vals: Vec<f64>) -> Result<(usize, f64), FemError> {
+        const SHIFTS: [f64; 4] = [1e-10, 1e-8, 1e-6, 1e-4];
+        let diag = self.pattern.diagonal();
+        let scale = diag
+            .iter()
+            .map(|&d| vals[d].abs())
+            .fold(0.0, f64::max)
+            .max(1e-300);
+        // the tangent's values and the factorization's transients are freed by the end of
+        // it: on a large model their pages go back to the system ([`crate::heap`])
         let large = vals.len() >= crate::heap::LARGE_VALUES;
-        drop(vals);
+        let result = self
+            .ldlt
+            .factorize_shifted(vals, diag, &SHIFTS.map(|rel| rel * scale));
         if large {
             crate::heap::release_free();
         }
@@ -56,34 +62,6 @@ impl Model {
             self.factorized(neg, shift);
         }
         result
-    }
-
-    /// The factorization of `vals`, shifted where singular ([`Model::factorize`]).
-    fn factorize_shifted(&mut self, vals: &mut [f64]) -> Result<(usize, f64), FemError> {
-        const SHIFTS: [f64; 4] = [1e-10, 1e-8, 1e-6, 1e-4];
-        match self.ldlt.factorize(vals) {
-            Ok(neg) => Ok((neg, 0.0)),
-            Err(first) => {
-                let diag = self.pattern.diagonal();
-                let scale = diag
-                    .iter()
-                    .map(|&d| vals[d].abs())
-                    .fold(0.0, f64::max)
-                    .max(1e-300);
-                let mut applied = 0.0;
-                for rel in SHIFTS {
-                    let s = rel * scale;
-                    for &d in diag {
-                        vals[d] += s - applied;
-                    }
-                    applied = s;
-                    if let Ok(neg) = self.ldlt.factorize(vals) {
-                        return Ok((neg, s));
-                    }
-                }
-                Err(first)
-            }
-        }
     }
 
     /// Newton iterations under `load`; `state` is the initial guess and, on success, the
