@@ -110,6 +110,29 @@ pub struct SparseLdlt {
     ordering: Ordering,
 }
 
+/// `attempt(0)`, then where it fails `attempt(s − s_prev)` for each shift s of `shifts` in turn
+/// (each attempt adds its argument to the diagonal, so the k-th one factorizes with shift
+/// `shifts[k]`): the negative pivots and the shift of the first that factorizes, or the first
+/// failure.
+fn with_shifts(
+    shifts: &[f64],
+    mut attempt: impl FnMut(f64) -> Result<usize, FemError>,
+) -> Result<(usize, f64), FemError> {
+    let first = match attempt(0.0) {
+        Ok(neg) => return Ok((neg, 0.0)),
+        Err(e) => e,
+    };
+    let mut applied = 0.0;
+    for &s in shifts {
+        let result = attempt(s - applied);
+        applied = s;
+        if let Ok(neg) = result {
+            return Ok((neg, s));
+        }
+    }
+    Err(first)
+}
+
 impl SparseLdlt {
     /// `pairs`: the (row, col) positions, row ≥ col, in the order in which values will be given
     /// (duplicates are summed).
@@ -374,39 +397,23 @@ impl SparseLdlt {
             Self::check_finite(&values, self.entries)?;
             t.gather(&values);
             drop(values);
-            let first = match t.factorize_gathered() {
-                Ok(neg) => {
-                    self.factorized = true;
-                    return Ok((neg, 0.0));
+            let result = with_shifts(shifts, |delta| {
+                if delta != 0.0 {
+                    t.shift(delta);
                 }
-                Err(e) => e,
-            };
-            let mut applied = 0.0;
-            for &s in shifts {
-                t.shift(s - applied);
-                applied = s;
-                if let Ok(neg) = t.factorize_gathered() {
-                    self.factorized = true;
-                    return Ok((neg, s));
+                t.factorize_gathered()
+            });
+            self.factorized = result.is_ok();
+            return result;
+        }
+        with_shifts(shifts, |delta| {
+            if delta != 0.0 {
+                for &d in diagonal {
+                    values[d] += delta;
                 }
             }
-            return Err(first);
-        }
-        let first = match self.factorize(&values) {
-            Ok(neg) => return Ok((neg, 0.0)),
-            Err(e) => e,
-        };
-        let mut applied = 0.0;
-        for &s in shifts {
-            for &d in diagonal {
-                values[d] += s - applied;
-            }
-            applied = s;
-            if let Ok(neg) = self.factorize(&values) {
-                return Ok((neg, s));
-            }
-        }
-        Err(first)
+            self.factorize(&values)
+        })
     }
 
     /// The pivots D_kk of the last factorization (in elimination order; a split factor's: the

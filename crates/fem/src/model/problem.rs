@@ -313,10 +313,10 @@ impl newton::Problem for MembraneProblem<'_> {
                 (dx, dp, negative, 0.0, 0.0, seconds, krylov, false)
             } else {
                 let t_factor = std::time::Instant::now();
-                // the stiffness scale of a held mode's eigenvalue, before the factorization
-                // takes (and may shift) the values
+                // the stiffness scale of a held mode's eigenvalue (and of the factorization's
+                // shifts), before the factorization takes (and may shift) the values
                 let stiffness = self.model.largest_diagonal_in(&k);
-                let (neg, shift) = self.model.factorize_values(k)?;
+                let (neg, shift) = self.model.factorize_scaled(k, stiffness)?;
                 if eligible && self.model.reuses_factor() {
                     let positions = self.branch.as_deref().unwrap_or(&state.x).to_vec();
                     self.model.factorized_at(&positions);

@@ -42,19 +42,26 @@ impl Model {
     /// [`Model::factorize`] of the tangent whose values (one per pattern entry) are `vals`,
     /// taken: the factorization drops them when it can ([`SparseLdlt::factorize_shifted`]).
     pub(super) fn factorize_values(&mut self, vals: Vec<f64>) -> Result<(usize, f64), FemError> {
+        let scale = self.largest_diagonal_in(&vals);
+        self.factorize_scaled(vals, scale)
+    }
+
+    /// [`Model::factorize_values`] with the largest |diagonal entry| of `vals` already known
+    /// (`scale`, [`Model::largest_diagonal_in`]), which sets the shifts.
+    pub(super) fn factorize_scaled(
+        &mut self,
+        vals: Vec<f64>,
+        scale: f64,
+    ) -> Result<(usize, f64), FemError> {
         const SHIFTS: [f64; 4] = [1e-10, 1e-8, 1e-6, 1e-4];
-        let diag = self.pattern.diagonal();
-        let scale = diag
-            .iter()
-            .map(|&d| vals[d].abs())
-            .fold(0.0, f64::max)
-            .max(1e-300);
         // the tangent's values and the factorization's transients are freed by the end of
         // it: on a large model their pages go back to the system ([`crate::heap`])
         let large = vals.len() >= crate::heap::LARGE_VALUES;
-        let result = self
-            .ldlt
-            .factorize_shifted(vals, diag, &SHIFTS.map(|rel| rel * scale));
+        let result = self.ldlt.factorize_shifted(
+            vals,
+            self.pattern.diagonal(),
+            &SHIFTS.map(|rel| rel * scale),
+        );
         if large {
             crate::heap::release_free();
         }
