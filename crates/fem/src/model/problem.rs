@@ -1,6 +1,7 @@
 //! The membrane equilibrium under one load as a [`newton::Problem`] ([`MembraneProblem`]), its
 //! convergence scale and potential, and the arc-length constraint ([`ArcConstraint`]).
 
+use super::assembly::{Pressure, TangentForm};
 use super::reuse::{self, CONTRACTION};
 use super::*;
 
@@ -129,7 +130,7 @@ impl MembraneProblem<'_> {
             let contact = self.contact(state);
             let a = self.model.assemble_terms(
                 x,
-                true,
+                TangentForm::At(self.pressure_of(state)),
                 contact.as_deref(),
                 &state.multipliers,
                 Some(branch),
@@ -139,6 +140,7 @@ impl MembraneProblem<'_> {
         if let Some((xt, a, secs)) = self.trial.borrow_mut().take() {
             let same = xt.x.len() == x.len()
                 && xt.planes.to_bits() == state.planes.to_bits()
+                && self.pressure_of(&xt).same_as(self.pressure_of(state))
                 && xt
                     .x
                     .iter()
@@ -151,16 +153,30 @@ impl MembraneProblem<'_> {
                 .set(self.rejected_seconds.get() + secs);
         }
         let t = std::time::Instant::now();
-        let a = self
-            .model
-            .assemble_state(state, true, self.contact(state).as_deref())?;
+        let a = self.assemble_tangent(state)?;
         Ok((a, t.elapsed().as_secs_f64()))
     }
 
-    pub(super) fn pressure(&self, state_p: f64, volume: f64) -> f64 {
+    /// The assembly at `state` with K = K_int − ϖH at the state's pressure
+    /// ([`MembraneProblem::pressure_of`]).
+    fn assemble_tangent(&self, state: &State) -> Result<Assembled, FemError> {
+        self.model.assemble_terms(
+            &state.x,
+            TangentForm::At(self.pressure_of(state)),
+            self.contact(state).as_deref(),
+            &state.multipliers,
+            None,
+        )
+    }
+
+    /// The pressure at `state`: the state's own, or closed gas's pv/(m V_part).
+    pub(super) fn pressure_of(&self, state: &State) -> Pressure {
         match self.load.gas() {
-            Some(pv) => pv / (self.model.multiplicity() * volume),
-            None => state_p,
+            Some(pv) => Pressure::Gas {
+                pv,
+                multiplicity: self.model.multiplicity(),
+            },
+            None => Pressure::Given(state.p),
         }
     }
 
@@ -198,16 +214,10 @@ impl newton::Problem for MembraneProblem<'_> {
         }
         let m = self.model.multiplicity();
         let (mut a, assembly_seconds) = self.assemble_at(state)?;
-        state.p = self.pressure(state.p, a.volume);
+        // the pressure the assembly formed K = K_int − ϖH at
+        state.p = self.pressure_of(state).at(a.volume);
         let p = state.p;
-        // the values of K = K_int − ϖH (the sums of `tangent_values`), made once in K_int's
-        // storage and H dropped: at a million unknowns each array takes some 200 MB, and the
-        // factorization's peak memory had all three
-        let mut k = std::mem::take(&mut a.k_int);
-        for (k, h) in k.iter_mut().zip(&a.k_vol) {
-            *k -= p * h;
-        }
-        a.k_vol = Vec::new();
+        let k = std::mem::take(&mut a.k);
         let r: Vec<f64> = a.f_int.iter().zip(&a.g).map(|(f, g)| f - p * g).collect();
         // the constraint c, its gradient h in x and its derivative cp in ϖ
         let mut cp = 0.0;
@@ -482,10 +492,8 @@ impl newton::Problem for MembraneProblem<'_> {
             self.rejected_seconds
                 .set(self.rejected_seconds.get() + secs);
         }
-        let trial = self
-            .model
-            .assemble_state(state, true, self.contact(state).as_deref())?;
-        let pt = self.pressure(state.p, trial.volume);
+        let trial = self.assemble_tangent(state)?;
+        let pt = self.pressure_of(state).at(trial.volume);
         let rt: Vec<f64> = trial
             .f_int
             .iter()
