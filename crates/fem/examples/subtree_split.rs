@@ -33,6 +33,8 @@
 //!    (−B_iᵀ A_i⁻¹ B_i = (L D Lᵀ)_ring) and its dense Cholesky; ln det K = Σ ln det A_i +
 //!    ln det S against the whole factor's, which shows that the split factorizes the same
 //!    matrix.
+mod tube_pattern;
+
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
@@ -43,6 +45,7 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Par, Side};
 use std::time::Instant;
+use tube_pattern::factor_seconds;
 use tubemem_mesh::{tube::capped_tube, Symmetry};
 
 fn symbolic(m: &SparseColMat<usize, f64>) -> SymbolicCholesky<usize> {
@@ -60,35 +63,6 @@ fn symbolic(m: &SparseColMat<usize, f64>) -> SymbolicCholesky<usize> {
         params,
     )
     .expect("symbolic")
-}
-
-/// Seconds of a numeric LDLᵀ on `par` into a factor and a workspace that an earlier
-/// factorization has touched (as the solver's, which keeps its factor's storage from one
-/// factorization to the next): the second of two; also the workspace's bytes.
-fn factor_seconds(
-    m: &SparseColMat<usize, f64>,
-    s: &SymbolicCholesky<usize>,
-    par: Par,
-) -> (f64, usize) {
-    let mut l = vec![0.0; s.len_val()];
-    let req = s.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
-    let mut mem = MemBuffer::new(req);
-    let mut seconds = 0.0;
-    for _ in 0..2 {
-        let t = Instant::now();
-        s.factorize_numeric_ldlt::<f64>(
-            &mut l,
-            m.as_ref(),
-            Side::Lower,
-            LdltRegularization::default(),
-            par,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .expect("numeric");
-        seconds = t.elapsed().as_secs_f64();
-    }
-    (seconds, req.size_bytes())
 }
 
 /// Σ over columns of (entries below the diagonal)², faer's supernodal layout.
@@ -233,24 +207,7 @@ fn main() {
         args.get(1).copied().unwrap_or(560),
     );
     let mesh = capped_tube(1.0, 20.0, around, along, Symmetry::None).expect("mesh");
-    let n = 3 * mesh.nodes.len();
-    let mut pairs = Vec::new();
-    for q in &mesh.quads {
-        for &a in q {
-            for &b in q {
-                for ca in 0..3 {
-                    for cb in 0..3 {
-                        let (r, c) = (3 * a + ca, 3 * b + cb);
-                        if r >= c {
-                            pairs.push((r, c));
-                        }
-                    }
-                }
-            }
-        }
-    }
-    pairs.sort_unstable();
-    pairs.dedup();
+    let (n, pairs) = tube_pattern::pairs(&mesh);
     let nd = tubemem_fem::ordering::nested_dissection(n, &pairs).expect("ordering");
     // the tube's own top separator: the ring of nodes at mid-length (z = 0), each half ordered
     // by nested dissection, the ring last
@@ -293,40 +250,7 @@ fn main() {
         }
     );
     let perm = if which == "ring" { ring_split } else { nd };
-    let mut inv = vec![0usize; n];
-    for (k, &p) in perm.iter().enumerate() {
-        inv[p] = k;
-    }
-    // an SPD matrix on the pattern, diagonally dominant by 1e-3 only, in the nested-dissection order: its
-    // factor's entries decay slowly (a strongly dominant diagonal makes them decay to
-    // subnormal numbers, which the dense kernels process many times slower)
-    // off the diagonal −1 between equal components and −0.1 (1 + a b) between components a ≠ b
-    // (three unknowns of a node with equal couplings would make the ring's Schur complement
-    // singular); on it the sum of the row's magnitudes plus 10⁻³
-    let off = |r: usize, c: usize| {
-        let (a, b) = (r % 3, c % 3);
-        if a == b {
-            -1.0
-        } else {
-            -0.1 * (1 + a * b) as f64
-        }
-    };
-    let mut diagonal = vec![1e-3; n];
-    for &(r, c) in &pairs {
-        if r != c {
-            diagonal[r] -= off(r, c);
-            diagonal[c] -= off(r, c);
-        }
-    }
-    let triplets: Vec<Triplet<usize, usize, f64>> = pairs
-        .iter()
-        .map(|&(r, c)| {
-            let (pr, pc) = (inv[r], inv[c]);
-            let v = if r == c { diagonal[r] } else { off(r, c) };
-            Triplet::new(pr.max(pc), pr.min(pc), v)
-        })
-        .collect();
-    let m = SparseColMat::try_new_from_triplets(n, n, &triplets).expect("matrix");
+    let m = tube_pattern::dominant_matrix(n, &pairs, &perm);
     let sym = symbolic(&m);
     let SymbolicCholeskyRaw::Supernodal(sn) = sym.raw() else {
         panic!("supernodal layout forced")
@@ -448,14 +372,14 @@ fn main() {
         );
     }
     for round in 0..2 {
-        let (whole1, bytes) = factor_seconds(&m, &sym, Par::Seq);
-        let (whole2, _) = factor_seconds(&m, &sym, Par::rayon(2));
+        let (whole1, bytes) = factor_seconds(&m, &sym, Par::Seq, 1);
+        let (whole2, _) = factor_seconds(&m, &sym, Par::rayon(2), 1);
         let seq: Vec<f64> = (0..2)
-            .map(|i| factor_seconds(&subs[i], &subsym[i], Par::Seq).0)
+            .map(|i| factor_seconds(&subs[i], &subsym[i], Par::Seq, 1).0)
             .collect();
         let (a, b) = rayon::join(
-            || factor_seconds(&subs[0], &subsym[0], Par::Seq).0,
-            || factor_seconds(&subs[1], &subsym[1], Par::Seq).0,
+            || factor_seconds(&subs[0], &subsym[0], Par::Seq, 1).0,
+            || factor_seconds(&subs[1], &subsym[1], Par::Seq, 1).0,
         );
         println!(
             "round {round}: whole 1 thread {whole1:.3} s (workspace {:.0} MiB), whole 2 threads {whole2:.3} s; shares one after the other {:.3} + {:.3} = {:.3} s, side by side {a:.3} and {b:.3} s ({:.2}× the sequential shares)",

@@ -1,0 +1,112 @@
+//! What the factorization examples (`subtree_split`, `supernode_bound`) share: the whole capped
+//! tube's pattern (the mesh's node graph expanded to 3 unknowns per node, no constraint taken
+//! out), a matrix on it, and the timing of faer's numeric LDLᵀ.
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Par, Side};
+use std::time::Instant;
+use tubemem_mesh::Mesh;
+
+/// The unknowns and the lower triangle's (row, column) pairs of `mesh`'s 4-node elements, 3
+/// unknowns per node, sorted.
+pub fn pairs(mesh: &Mesh) -> (usize, Vec<(usize, usize)>) {
+    let n = 3 * mesh.nodes.len();
+    let mut pairs = Vec::new();
+    for q in &mesh.quads {
+        for &a in q {
+            for &b in q {
+                for ca in 0..3 {
+                    for cb in 0..3 {
+                        let (r, c) = (3 * a + ca, 3 * b + cb);
+                        if r >= c {
+                            pairs.push((r, c));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    (n, pairs)
+}
+
+/// An SPD matrix on `pairs`, diagonally dominant by 1e-3 only, permuted by `perm` (the unknown
+/// eliminated k-th is `perm[k]`); its lower triangle. Its factor's entries decay slowly (a
+/// strongly dominant diagonal makes them decay to subnormal numbers, which the dense kernels
+/// process many times slower). Off the diagonal −1 between equal components and −0.1 (1 + a b)
+/// between components a ≠ b (three unknowns of a node with equal couplings would make a ring's
+/// Schur complement singular); on it the sum of the row's magnitudes plus 10⁻³.
+pub fn dominant_matrix(
+    n: usize,
+    pairs: &[(usize, usize)],
+    perm: &[usize],
+) -> SparseColMat<usize, f64> {
+    let mut inv = vec![0usize; n];
+    for (k, &p) in perm.iter().enumerate() {
+        inv[p] = k;
+    }
+    let off = |r: usize, c: usize| {
+        let (a, b) = (r % 3, c % 3);
+        if a == b {
+            -1.0
+        } else {
+            -0.1 * (1 + a * b) as f64
+        }
+    };
+    let mut diagonal = vec![1e-3; n];
+    for &(r, c) in pairs {
+        if r != c {
+            diagonal[r] -= off(r, c);
+            diagonal[c] -= off(r, c);
+        }
+    }
+    let triplets: Vec<Triplet<usize, usize, f64>> = pairs
+        .iter()
+        .map(|&(r, c)| {
+            let (pr, pc) = (inv[r], inv[c]);
+            let v = if r == c { diagonal[r] } else { off(r, c) };
+            Triplet::new(pr.max(pc), pr.min(pc), v)
+        })
+        .collect();
+    SparseColMat::try_new_from_triplets(n, n, &triplets).expect("matrix")
+}
+
+/// Seconds of a numeric LDLᵀ on `par` into a factor and a workspace that an earlier
+/// factorization has touched (as the solver's, which keeps its factor's storage from one
+/// factorization to the next): the best of `rounds` after a first; also the workspace's bytes.
+/// With `ROUNDS` set in the environment, each round's seconds go to stderr (the first one
+/// includes the first touch of the factor's and the workspace's pages).
+pub fn factor_seconds(
+    m: &SparseColMat<usize, f64>,
+    s: &SymbolicCholesky<usize>,
+    par: Par,
+    rounds: usize,
+) -> (f64, usize) {
+    let mut l = vec![0.0; s.len_val()];
+    let req = s.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
+    let mut mem = MemBuffer::new(req);
+    let mut best = f64::INFINITY;
+    for round in 0..=rounds {
+        let t = Instant::now();
+        s.factorize_numeric_ldlt::<f64>(
+            &mut l,
+            m.as_ref(),
+            Side::Lower,
+            LdltRegularization::default(),
+            par,
+            MemStack::new(&mut mem),
+            Default::default(),
+        )
+        .expect("numeric");
+        if std::env::var("ROUNDS").is_ok() {
+            eprintln!("round {round}: {:.3} s", t.elapsed().as_secs_f64());
+        }
+        if round > 0 {
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+    }
+    (best, req.size_bytes())
+}
