@@ -35,13 +35,7 @@
 //!    matrix.
 mod tube_pattern;
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
-};
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Par, Side};
 use std::time::Instant;
@@ -49,20 +43,7 @@ use tube_pattern::factor_seconds;
 use tubemem_mesh::{tube::capped_tube, Symmetry};
 
 fn symbolic(m: &SparseColMat<usize, f64>) -> SymbolicCholesky<usize> {
-    let params = CholeskySymbolicParams {
-        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-        ..Default::default()
-    };
-    // the identity as a custom ordering (faer 0.24's `Identity` with the lower triangle
-    // analyses the diagonal alone)
-    let id: Vec<usize> = (0..m.ncols()).collect();
-    factorize_symbolic_cholesky(
-        m.symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&id, &id, m.ncols())),
-        params,
-    )
-    .expect("symbolic")
+    tube_pattern::symbolic(m, None)
 }
 
 /// Σ over columns of (entries below the diagonal)², faer's supernodal layout.
@@ -83,24 +64,7 @@ fn flops_of(s: &SymbolicCholesky<usize>) -> f64 {
 
 /// The numeric LDLᵀ's values and seconds (the second of two, as in [`factor_seconds`]).
 fn factor_values(m: &SparseColMat<usize, f64>, s: &SymbolicCholesky<usize>) -> (Vec<f64>, f64) {
-    let mut l = vec![0.0; s.len_val()];
-    let req = s.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
-    let mut mem = MemBuffer::new(req);
-    let mut seconds = 0.0;
-    for _ in 0..2 {
-        let t = Instant::now();
-        s.factorize_numeric_ldlt::<f64>(
-            &mut l,
-            m.as_ref(),
-            Side::Lower,
-            LdltRegularization::default(),
-            Par::Seq,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .expect("numeric");
-        seconds = t.elapsed().as_secs_f64();
-    }
+    let (l, seconds, _) = tube_pattern::factor(m, s, Par::Seq, 1);
     (l, seconds)
 }
 
@@ -198,14 +162,7 @@ fn principal(m: &SparseColMat<usize, f64>, cols: &[usize]) -> SparseColMat<usize
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args()
-        .skip(1)
-        .map(|a| a.parse().expect("AROUND ALONG"))
-        .collect();
-    let (around, along) = (
-        args.first().copied().unwrap_or(448),
-        args.get(1).copied().unwrap_or(560),
-    );
+    let (around, along) = tube_pattern::around_along();
     let mesh = capped_tube(1.0, 20.0, around, along, Symmetry::None).expect("mesh");
     let (n, pairs) = tube_pattern::pairs(&mesh);
     let nd = tubemem_fem::ordering::nested_dissection(n, &pairs).expect("ordering");

@@ -30,12 +30,8 @@ mod tube_pattern;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, LdltParams, LdltRegularization};
 use faer::linalg::matmul::matmul;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
-    SymmetricOrdering,
-};
-use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
-use faer::{Accum, Mat, Par, Side, Spec};
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+use faer::{Accum, Mat, Par, Spec};
 use std::collections::BTreeMap;
 use std::time::Instant;
 use tubemem_mesh::{tube::capped_tube, Symmetry};
@@ -188,34 +184,8 @@ fn pieces(sym: &SymbolicCholesky<usize>) -> Vec<(Work, f64)> {
     out
 }
 
-fn symbolic(
-    m: &faer::sparse::SparseColMat<usize, f64>,
-    relax: &[(usize, f64)],
-) -> SymbolicCholesky<usize> {
-    let params = CholeskySymbolicParams {
-        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-        supernodal_params: SymbolicSupernodalParams { relax: Some(relax) },
-        ..Default::default()
-    };
-    let id: Vec<usize> = (0..m.ncols()).collect();
-    factorize_symbolic_cholesky(
-        m.symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&id, &id, m.ncols())),
-        params,
-    )
-    .expect("symbolic")
-}
-
 fn main() {
-    let args: Vec<usize> = std::env::args()
-        .skip(1)
-        .map(|a| a.parse().expect("AROUND ALONG"))
-        .collect();
-    let (around, along) = (
-        args.first().copied().unwrap_or(448),
-        args.get(1).copied().unwrap_or(560),
-    );
+    let (around, along) = tube_pattern::around_along();
     let mesh = capped_tube(1.0, 20.0, around, along, Symmetry::None).expect("mesh");
     let (n, pairs) = tube_pattern::pairs(&mesh);
     let perm = tubemem_fem::ordering::nested_dissection(n, &pairs).expect("ordering");
@@ -225,7 +195,7 @@ fn main() {
         .and_then(|v| v.parse::<usize>().ok())
     {
         // only the numeric factorization, `times` times after a first, for a profiler
-        let sym = symbolic(&m, &[(4, 1.0), (16, 0.8), (48, 0.1), (usize::MAX, 0.05)]);
+        let sym = tube_pattern::symbolic(&m, None);
         let (best, _) = tube_pattern::factor_seconds(&m, &sym, Par::Seq, times);
         println!("numeric LDLᵀ, 1 thread, best of {times}: {best:.3} s");
         return;
@@ -253,7 +223,7 @@ fn main() {
         if !which.split(',').any(|w| w == name) {
             continue;
         }
-        let sym = symbolic(&m, relax);
+        let sym = tube_pattern::symbolic(&m, Some(relax));
         let SymbolicCholeskyRaw::Supernodal(sn) = sym.raw() else {
             panic!("supernodal layout forced")
         };

@@ -3,7 +3,10 @@
 //! out), a matrix on it, and the timing of faer's numeric LDLᵀ.
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Par, Side};
 use std::time::Instant;
@@ -74,6 +77,44 @@ pub fn dominant_matrix(
     SparseColMat::try_new_from_triplets(n, n, &triplets).expect("matrix")
 }
 
+/// The mesh size from the command line: AROUND ALONG (default 448 × 560, the
+/// million-unknown benchmark's).
+pub fn around_along() -> (usize, usize) {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("AROUND ALONG"))
+        .collect();
+    (
+        args.first().copied().unwrap_or(448),
+        args.get(1).copied().unwrap_or(560),
+    )
+}
+
+/// faer's supernodal symbolic factor of `m` (lower triangle, already ordered) with the
+/// supernode relaxation `relax` (faer's default if None).
+pub fn symbolic(
+    m: &SparseColMat<usize, f64>,
+    relax: Option<&[(usize, f64)]>,
+) -> SymbolicCholesky<usize> {
+    let mut params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    if let Some(relax) = relax {
+        params.supernodal_params = SymbolicSupernodalParams { relax: Some(relax) };
+    }
+    // the identity as a custom ordering (faer 0.24's `Identity` with the lower triangle
+    // analyses the diagonal alone)
+    let id: Vec<usize> = (0..m.ncols()).collect();
+    factorize_symbolic_cholesky(
+        m.symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&id, &id, m.ncols())),
+        params,
+    )
+    .expect("symbolic")
+}
+
 /// Seconds of a numeric LDLᵀ on `par` into a factor and a workspace that an earlier
 /// factorization has touched (as the solver's, which keeps its factor's storage from one
 /// factorization to the next): the best of `rounds` after a first; also the workspace's bytes.
@@ -85,6 +126,17 @@ pub fn factor_seconds(
     par: Par,
     rounds: usize,
 ) -> (f64, usize) {
+    let (_, seconds, bytes) = factor(m, s, par, rounds);
+    (seconds, bytes)
+}
+
+/// [`factor_seconds`] with the factor's values.
+pub fn factor(
+    m: &SparseColMat<usize, f64>,
+    s: &SymbolicCholesky<usize>,
+    par: Par,
+    rounds: usize,
+) -> (Vec<f64>, f64, usize) {
     let mut l = vec![0.0; s.len_val()];
     let req = s.factorize_numeric_ldlt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::new(req);
@@ -108,5 +160,5 @@ pub fn factor_seconds(
             best = best.min(t.elapsed().as_secs_f64());
         }
     }
-    (best, req.size_bytes())
+    (l, best, req.size_bytes())
 }
