@@ -171,13 +171,7 @@ impl MembraneProblem<'_> {
 
     /// The pressure at `state`: the state's own, or closed gas's pv/(m V_part).
     pub(super) fn pressure_of(&self, state: &State) -> Pressure {
-        match self.load.gas() {
-            Some(pv) => Pressure::Gas {
-                pv,
-                multiplicity: self.model.multiplicity(),
-            },
-            None => Pressure::Given(state.p),
-        }
+        Pressure::under(self.load, self.model.multiplicity(), state.p)
     }
 
     /// Refuse states the loading cannot have: closed gas needs a positive volume, and the
