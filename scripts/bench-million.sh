@@ -9,7 +9,11 @@
 # contact zone's release (the first iteration presses a zone wider than the step's, and each
 # iteration frees about one element row at each of its edges), which grows less than the step,
 # while every step adds its multiplier updates and the factorization for its inertia. The
-# first squeeze step takes about 30 iterations at this size, hence the 40.
+# first squeeze step takes about 30 iterations at this size, hence the 40. Those release
+# iterations grow as 1/h, so the case runs with [solver] mesh_sequencing = SEQUENCING (1): first
+# on the tube of half the elements each way, then each load step here starts from that run's
+# state at the same point of its stage and releases a row or two (the end state is this mesh's
+# own: test a_sequenced_run_ends_where_the_plain_one_does_in_fewer_iterations, crates/app/tests/app.rs).
 #
 #   bash scripts/bench-million.sh                  # factor_threads = 1
 #   THREADS=2 bash scripts/bench-million.sh        # … = 2 (faer's threads inside supernodes)
@@ -17,6 +21,7 @@
 #   ORDERING=amd bash scripts/bench-million.sh     # AMD instead of the default "auto" (METIS here)
 #   AROUND=224 ALONG=280 bash scripts/bench-million.sh   # a quarter of the size
 #   INFLATE_STEPS=4 SQUEEZE_STEPS=5 MAX_ITERATIONS=30 bash scripts/bench-million.sh   # the steps until 2026-12
+#   SEQUENCING=0 bash scripts/bench-million.sh     # no mesh sequencing (SEQUENCING=2: two levels)
 #   REFACTORIZE=always bash scripts/bench-million.sh      # factorize at every Newton iteration
 #
 # Prints: the dense peak of this machine (faer's matmul, crates/fem/examples/dense_peak.rs), the
@@ -36,6 +41,7 @@ REFACTORIZE=${REFACTORIZE:-auto}
 INFLATE_STEPS=${INFLATE_STEPS:-1}
 SQUEEZE_STEPS=${SQUEEZE_STEPS:-2}
 MAX_ITERATIONS=${MAX_ITERATIONS:-40}
+SEQUENCING=${SEQUENCING:-1}
 OUT=${OUT:-runs/bench-million-$THREADS-$ORDERING-$REFACTORIZE}
 cargo build --release -q -p tubemem-cli
 peak=$(cargo run --release -q -p tubemem-fem --example dense_peak | tail -1)
@@ -66,6 +72,7 @@ factor_threads = $THREADS
 ordering = "$ORDERING"
 refactorize = "$REFACTORIZE"
 max_iterations = $MAX_ITERATIONS
+mesh_sequencing = $SEQUENCING
 
 [output]
 vtu = "stage-end"

@@ -37,6 +37,8 @@
 //! ordering = "auto"     # or "amd", "nested-dissection" (METIS); results do not change
 //! refactorize = "auto"  # or "always", "on-demand": the last factor preconditions GMRES until
 //!                       # it stops paying; results agree within the Newton tolerance
+//! mesh_sequencing = 0   # L ≥ 1: run on the tube with half the elements first (L levels) and
+//!                       # start each load step from its state there; the results are this mesh's
 //!
 //! [output]              # optional
 //! vtu = "every"         # VTU frames: "every" (default) | "stage-end" | "none"
@@ -330,7 +332,18 @@ pub struct SolverSpec {
     /// residual, so the results agree within the Newton tolerance
     #[serde(default)]
     pub refactorize: tubemem_fem::model::Refactorization,
+    /// levels of mesh sequencing (nested iteration, the `sequencing` module): 0 (default) none;
+    /// L ≥ 1 first runs the case on the generated tube with half the elements around, along
+    /// and in the caps (sequenced with L − 1 levels), and starts each load step from that
+    /// run's converged state at the same point of the stage; the results are this mesh's own,
+    /// converged to the same tolerances
+    #[serde(default)]
+    pub mesh_sequencing: usize,
 }
+
+/// The most levels `[solver] mesh_sequencing` takes (each halves the elements in both
+/// directions, and runs the case once more).
+pub const MAX_SEQUENCING_LEVELS: usize = 4;
 
 fn default_factor_threads() -> usize {
     1
@@ -350,6 +363,7 @@ impl Default for SolverSpec {
             factor_threads: default_factor_threads(),
             ordering: tubemem_fem::ordering::Ordering::default(),
             refactorize: tubemem_fem::model::Refactorization::default(),
+            mesh_sequencing: 0,
         }
     }
 }
@@ -1060,6 +1074,64 @@ impl Case {
 
     /// Its length: a flat list of independent checks of the whole case, each returning its
     /// own error with the key it names; there is no shared logic to factor out.
+    /// `[solver] mesh_sequencing`: a generated capped tube whose counts halve `L` times into
+    /// admissible ones, stepped by load steps on a mesh that stays put.
+    fn validate_sequencing(&self, plan: &[StagePlan]) -> Result<(), CaseError> {
+        let levels = self.solver.mesh_sequencing;
+        if levels == 0 {
+            return Ok(());
+        }
+        let max = MAX_SEQUENCING_LEVELS;
+        if levels > max {
+            invalid!("[solver] `mesh_sequencing` = {levels}: at most {max} levels");
+        }
+        let m = &self.mesh;
+        let (Some(around), Some(along), None) = (m.around, m.along, &m.file) else {
+            invalid!(
+                "[solver] `mesh_sequencing` runs the case on coarser generated tubes: a user mesh (`file`) has none"
+            );
+        };
+        if self.geometry.caps == Caps::RigidPlug {
+            invalid!(
+                "[solver] `mesh_sequencing` carries states between capped tubes (caps = \"hemisphere\"); the plugged tube's rigid plugs are not carried"
+            );
+        }
+        let f = 1usize << levels;
+        let cap_rows = m.cap_rows.unwrap_or(around / 8);
+        let coarse = (around / f, along / f, cap_rows / f);
+        if ![around, along, cap_rows]
+            .iter()
+            .all(|v| v.is_multiple_of(f))
+        {
+            invalid!(
+                "[solver] `mesh_sequencing` = {levels}: [mesh] `around` = {around}, `along` = {along} and the cap rows ({cap_rows}) must each halve {levels} time(s) exactly"
+            );
+        }
+        if let Err(tubemem_mesh::MeshError::InvalidParameter {
+            name, requirement, ..
+        }) = tubemem_mesh::tube::check_counts(coarse.0, coarse.1, coarse.2)
+        {
+            invalid!(
+                "[solver] `mesh_sequencing` = {levels}: the coarsest tube ({} around, {} along, {} cap rows) is not admissible: `{name}`: {requirement}",
+                coarse.0,
+                coarse.1,
+                coarse.2
+            );
+        }
+        if m.fit_contact_edge || m.contact_edge_angle.is_some() || m.track_contact_edge {
+            invalid!(
+                "[solver] `mesh_sequencing` carries states between uniform tubes: drop [mesh] `fit_contact_edge`, `contact_edge_angle` and `track_contact_edge`, which move node lines"
+            );
+        }
+        if let Some(p) = plan.iter().find(|p| p.arc_length) {
+            invalid!(
+                "[[stage]] {}: `control = \"arc-length\"` with [solver] `mesh_sequencing`: the coarse run guides load steps, which the arc-length path does not take",
+                p.index
+            );
+        }
+        Ok(())
+    }
+
     fn validate(&self) -> Result<Vec<StagePlan>, CaseError> {
         let g = &self.geometry;
         if self.units.is_some() && g.thickness.is_none() {
@@ -1271,6 +1343,7 @@ impl Case {
                 }
             }
         }
+        self.validate_sequencing(&plan)?;
         // the fit of a confine stage needs its walls symmetric about y = 0 (the closed form
         // leaves the section's rotation against the material free otherwise)
         if let Some(k) = plan

@@ -43,6 +43,7 @@ pub mod output_file;
 pub mod quantity;
 pub mod report;
 pub mod run;
+pub mod sequencing;
 pub mod stage;
 pub mod stats;
 pub mod verify;
@@ -143,6 +144,14 @@ pub enum AppError {
     },
     #[error("[mesh] `fit_contact_edge`: the locating solve ({around} elements around) failed")]
     Locator {
+        around: usize,
+        #[source]
+        source: Box<AppError>,
+    },
+    #[error(
+        "[solver] `mesh_sequencing`: the coarse run ({around} elements around) built no model"
+    )]
+    Sequencing {
         around: usize,
         #[source]
         source: Box<AppError>,

@@ -45,6 +45,9 @@ pub trait Observer {
     ) -> Result<(), BoxError> {
         Ok(())
     }
+    /// `[solver] mesh_sequencing`: the case runs first on the tube of `around` × `along`
+    /// elements, before this run's model is built ([`crate::sequencing`]).
+    fn coarse_started(&mut self, _around: usize, _along: usize) {}
     fn stage_started(&mut self, _plan: &StagePlan, _stages: usize) {}
     /// A converged step; an error stops the run.
     fn step(&mut self, _view: &StepView) -> Result<(), BoxError> {

@@ -65,6 +65,13 @@ impl Observer for Console {
         Ok(())
     }
 
+    fn coarse_started(&mut self, around: usize, along: usize) {
+        // the console's own line; a closed stderr loses it, as it loses every progress line
+        let _ = say!(
+            "mesh sequencing: the case runs first on the tube of {around} × {along} elements; its steps start this run's"
+        );
+    }
+
     fn stage_started(&mut self, plan: &StagePlan, stages: usize) {
         let label = format!("stage {}/{} ({})", plan.index, stages, plan.describe());
         if self.terminal {

@@ -56,6 +56,8 @@ pub use newton::NewtonSettings;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_prolong;
+#[cfg(test)]
 mod tests_quad9;
 #[cfg(test)]
 mod tests_remap;
@@ -78,6 +80,9 @@ pub enum FemError {
     DegenerateNode { element: usize, node: usize },
     #[error("the state cannot be carried to the moved mesh: {reason}")]
     Remap { reason: String },
+    /// A coarse mesh's state that cannot be carried to this mesh (mesh sequencing).
+    #[error("the coarse mesh's state cannot be carried to this mesh: {reason}")]
+    Prolong { reason: String },
     /// A load or problem the model cannot take (a pressure on an open sheet, a manufactured
     /// problem set up inconsistently).
     #[error("{reason}")]

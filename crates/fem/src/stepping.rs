@@ -139,6 +139,18 @@ fn carried<'a>(
     v
 }
 
+/// The converged states of the same stage on a coarser mesh of the same surface (mesh
+/// sequencing, nested iteration; [`run_stage_refitted`]): the stage is stepped to the fractions
+/// where they are, each step's Newton solve starting from the state there carried to the model
+/// ([`Model::prolong`]) instead of the secant predictor. A step that fails from a guide's state
+/// is cut back as any other, and the rest of the stage is stepped without the guide.
+pub trait Guide {
+    /// The fractions of the stage (ascending, in (0, 1], the last 1) where the guide has states.
+    fn fractions(&self) -> &[f64];
+    /// The state at `fractions()[k]`, carried to `model` under the step's `load`.
+    fn state(&self, model: &Model, k: usize, load: &Load) -> Result<State, FemError>;
+}
+
 /// A reference mesh and the states on it, kept to go back to ([`run_stage_refitted`]).
 struct Fixed {
     nodes: Vec<[f64; 3]>,
@@ -246,16 +258,20 @@ pub fn run_stage_from<E>(
     load: impl Fn(f64) -> Load,
     on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
 ) -> Result<(), StageError<E>> {
-    run_stage_refitted(model, state, stage, resume, load, on_step, None)
+    run_stage_refitted(model, state, stage, resume, load, on_step, None, None)
 }
 
 /// [`run_stage_from`] with the reference mesh following the solution by `refit` (see
 /// [`Refit`]). A step whose re-solve on the moved mesh fails is cut back like any other, from
 /// the last converged state carried to the moved mesh.
 ///
+/// With a `guide` (not on a resumed stage), the steps go to the guide's fractions and start
+/// from its states ([`Guide`]).
+///
 /// Its length is the adaptive load-stepping loop in one place: step size, the mesh refit, the
 /// Newton solve, the cut-back of a failed step from the last converged state, and the growth
 /// of the next; each branch updates the same step state.
+#[allow(clippy::too_many_arguments)]
 pub fn run_stage_refitted<E>(
     model: &mut Model,
     state: &mut State,
@@ -264,15 +280,20 @@ pub fn run_stage_refitted<E>(
     load: impl Fn(f64) -> Load,
     mut on_step: impl FnMut(&Model, &State, &StepInfo) -> Result<(), E>,
     mut refit: Option<&mut dyn Refit>,
+    guide: Option<&dyn Guide>,
 ) -> Result<(), StageError<E>> {
     let (from, to) = (stage.from, stage.to);
     let set = &stage.settings;
+    // the guide, while its states lead the steps; a resumed stage is stepped without it
+    let mut guide = guide.filter(|g| resume.is_none() && g.fractions().last() == Some(&1.0));
     if resume.is_none() {
         // nothing to do: the stage ends where it starts (a target equal to the current state)
         if (to - from).abs() <= 1e-14 * from.abs().max(to.abs()).max(1.0) {
             return Ok(());
         }
-        if state.p == 0.0 && !matches!(load(from).loading, Loading::Pressure(_)) {
+        // (a guided stage starts from the guide's loaded state instead)
+        if state.p == 0.0 && guide.is_none() && !matches!(load(from).loading, Loading::Pressure(_))
+        {
             prestress(model, state, stage)?;
         }
     }
@@ -306,19 +327,29 @@ pub fn run_stage_refitted<E>(
                 fraction: lambda,
             }));
         }
+        // the guide's next state, where it leads: its first fraction past this one
+        let guided = guide.and_then(|g| {
+            g.fractions()
+                .iter()
+                .position(|&f| f > lambda + 1e-12)
+                .map(|k| (g, k, g.fractions()[k]))
+        });
         // snap to the end when within rounding of it (no zero-length last step)
-        let next = if lambda + dl >= 1.0 - 1e-9 {
-            1.0
-        } else {
-            lambda + dl
+        let next = match guided {
+            Some((_, _, f)) => f,
+            None if lambda + dl >= 1.0 - 1e-9 => 1.0,
+            None => lambda + dl,
         };
         let value = from + (to - from) * next;
         let predict = |state: &State, previous: &Option<State>| match (previous, previous_lambda) {
             (Some(prev), Some(l0)) if lambda > l0 => secant(state, prev, l0, lambda, next),
             _ => state.clone(),
         };
-        let mut trial = predict(state, &previous);
         let l = load(value);
+        let mut trial = match guided {
+            Some((g, k, _)) => g.state(model, k, &l).map_err(StageError::Solve)?,
+            None => predict(state, &previous),
+        };
         let mut refits = 0;
         let moved = |source: FemError| crate::newton::NewtonError::Problem {
             iteration: 0,
@@ -398,7 +429,10 @@ pub fn run_stage_refitted<E>(
                 previous_lambda = Some(lambda);
                 lambda = next;
                 previous = Some(std::mem::replace(state, trial));
-                if difficulty <= set.easy_iterations {
+                if guided.is_some() {
+                    // the step the guide took: the length to go on from without it
+                    dl = (lambda - previous_lambda.unwrap_or(0.0)).min(set.max_fraction);
+                } else if difficulty <= set.easy_iterations {
                     dl = (dl * set.growth).min(set.max_fraction);
                 }
                 let info = StepInfo {
@@ -431,6 +465,15 @@ pub fn run_stage_refitted<E>(
                 }
                 if let Some(m) = e.cause().filter(|c| c.material_cause().is_some()) {
                     material = Some(m.clone());
+                }
+                if guided.is_some() {
+                    // cut back the guide's step, and go on without it (from the pre-stress a
+                    // stress-free start takes without a guide)
+                    guide = None;
+                    dl = next - lambda;
+                    if state.p == 0.0 && !matches!(l.loading, Loading::Pressure(_)) {
+                        prestress(model, state, stage)?;
+                    }
                 }
                 cuts += 1;
                 dl *= 0.5;

@@ -11,7 +11,7 @@ use crate::stage::failure::{stage_error, FailureInput};
 use crate::stage::record::{step_record, RecordInput};
 use crate::stage::summary::stage_report;
 use crate::stage::{LoadParts, StageKind};
-use crate::Result;
+use crate::{AppError, Result};
 use std::cell::RefCell;
 use tubemem_fem::continuation::{run_arc_stage, ArcLoading, Critical, CriticalKind};
 use tubemem_fem::model::{Model, State};
@@ -135,16 +135,26 @@ pub(super) fn drive_stage(
                         },
                         edges: r.tracked_edges.clone(),
                     });
+            // mesh sequencing: the coarse run's steps of this stage lead (not on a resumed
+            // stage, which steps on from its checkpoint)
+            let load = kind.load(&parts);
+            let guide = match (&r.coarse, &progress) {
+                (Some(c), None) => c.guide(i, &r.model).map_err(AppError::Model)?,
+                _ => None,
+            };
             run_stage_refitted(
                 &mut r.model,
                 &mut r.state,
                 &stage,
                 progress,
-                kind.load(&parts),
+                load,
                 &mut on_step,
                 tracker
                     .as_mut()
                     .map(|t| t as &mut dyn tubemem_fem::stepping::Refit),
+                guide
+                    .as_ref()
+                    .map(|g| g as &dyn tubemem_fem::stepping::Guide),
             )
         }
     };

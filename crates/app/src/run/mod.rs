@@ -112,8 +112,11 @@ fn run_inner(
     observers: &mut [&mut dyn Observer],
     slot: &mut Option<RunReport>,
 ) -> Result<()> {
-    let (mut runner, contact_edge_fit) = Runner::build(case, options)?;
+    let (mut runner, contact_edge_fit) = Runner::build(case, options, observers)?;
     let report = slot.insert(runner.initial_report(label, contact_edge_fit));
+    if let Some(w) = runner.coarse.as_ref().and_then(|c| c.warning.clone()) {
+        report.warnings.push(w);
+    }
     if let Some(ck) = &options.resume {
         runner.restore(ck, label, report)?;
     }

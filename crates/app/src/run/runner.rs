@@ -34,6 +34,8 @@ pub(super) struct Runner<'a> {
     pub node: usize,
     /// the reference volume of the whole tube
     pub v0: f64,
+    /// `[solver] mesh_sequencing`: the coarse run whose steps guide this one's
+    pub coarse: Option<crate::sequencing::Coarse>,
 }
 
 /// Where a stage starts: its context and, for a restored stage, the stepping's progress and
@@ -70,11 +72,35 @@ fn gps_limits(
 impl<'a> Runner<'a> {
     /// The memory guard, the mesh (fitted to the contact edge if the case asks), the law and
     /// the model in its reference state; with where the mesh was fitted.
-    pub fn build(case: &'a Case, options: &RunOptions) -> Result<(Self, Option<ContactEdgeFit>)> {
+    pub fn build(
+        case: &'a Case,
+        options: &RunOptions,
+        observers: &mut [&mut dyn crate::observer::Observer],
+    ) -> Result<(Self, Option<ContactEdgeFit>)> {
         // the memory guard, before anything large is built
         if let Some(n) = equations_estimate(case) {
             check_memory(n, options.force)?;
         }
+        // the coarse run of mesh sequencing first, so that its model is gone before this
+        // one is built (a resumed run steps on without it)
+        let coarse = match options.resume {
+            None => {
+                let quiet = RunOptions {
+                    interrupt: options.interrupt.clone(),
+                    force: options.force,
+                    resume: None,
+                };
+                crate::sequencing::Coarse::run(case, observers, &mut |coarse, collector| {
+                    super::run_with(
+                        coarse,
+                        "mesh-sequencing coarse run",
+                        &quiet,
+                        &mut [collector],
+                    )
+                })?
+            }
+            Some(_) => None,
+        };
         let (mesh, contact_edge_fit) = build_mesh_with_fit(case, options.interrupt.as_ref())?;
         if case.mesh.file.is_some() {
             check_memory(3 * mesh.nodes.len(), options.force)?;
@@ -95,6 +121,7 @@ impl<'a> Runner<'a> {
             tracked_edges: Default::default(),
             node,
             v0,
+            coarse,
         };
         Ok((runner, contact_edge_fit))
     }
@@ -198,6 +225,7 @@ impl<'a> Runner<'a> {
             limits: self.limits.as_ref(),
             node: self.node,
             v0: self.v0,
+            guided: self.coarse.as_ref().is_some_and(|c| c.guides(plan.index)),
         };
         let context = setup_stage(kind, plan, &setup, &mut self.model, &mut self.state, report)?;
         Ok(StageStart {

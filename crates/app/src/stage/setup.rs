@@ -22,6 +22,9 @@ pub struct SetupInput<'a> {
     pub node: usize,
     /// the reference volume of the whole tube
     pub v0: f64,
+    /// the stage's steps start from a coarse run's states (`[solver] mesh_sequencing`), which
+    /// are loaded: no pre-stress
+    pub guided: bool,
 }
 
 /// Set up a stage of `kind` at its start. A precondition that fails is recorded in the report
@@ -63,7 +66,7 @@ pub(crate) fn setup_stage(
     // the controlled value before any pre-stress: where the stage's steps are measured from
     let from_before = kind.controlled_value(model, state, node);
     let closed_gas = kind.closed_gas();
-    if state.p == 0.0 && !closed_gas {
+    if state.p == 0.0 && !closed_gas && !run.guided {
         let estimate = kind.pressure_estimate(run.law);
         let mut pre = settings;
         // an arc-length stage always starts pre-stressed: its first tangent needs the

@@ -52,6 +52,7 @@ mod diagnostics;
 mod elements;
 mod load;
 mod problem;
+mod prolong;
 mod remap;
 mod reuse;
 mod solve;
@@ -62,6 +63,7 @@ pub use diagnostics::{IterationTiming, LockingProximity, NEAR_LOCKING};
 pub use elements::Elements;
 pub use load::{Load, Loading, State};
 pub use problem::{ArcConstraint, PRESSURE_FLOOR};
+pub use prolong::{Prolongation, MAX_OFF_SURFACE};
 pub use reuse::{
     Refactorization, AUTO_FLOP_RATIO, CONTRACTION, MAX_FORCING, MAX_KRYLOV, MAX_STATUS_CHANGES,
 };
