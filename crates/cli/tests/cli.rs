@@ -1263,6 +1263,33 @@ fn a_killed_run_that_reuses_its_factor_resumes_bit_identical() {
     );
 }
 
+/// Restart of a sequenced run (`[solver] mesh_sequencing = 1`): killed in its squeeze and
+/// resumed, it runs the coarse case again and takes the same guided steps from where it
+/// stopped, ending bit-identical to an uninterrupted run (steps.csv, summary.json, the PVD index
+/// and every VTU frame).
+#[test]
+fn a_killed_sequenced_run_resumes_bit_identical() {
+    let text = include_str!("../../../cases/squeeze_abb30_ls1.3.toml");
+    assert!(!text.contains("[solver]"));
+    let (case, reference, killed) = killed_in_its_squeeze(
+        "resume-sequenced",
+        &format!("{text}\n[solver]\nmesh_sequencing = 1\n"),
+    );
+    let o = run_in(&case, &killed, &["--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("mesh sequencing: the case runs first"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert_same_run(
+        &reference,
+        &killed,
+        &["steps.csv", "summary.json", "tube.pvd"],
+        true,
+    );
+}
+
 /// Issue #25, class 5: a confine stage whose walls never touch the tube prints no `NaN%` (the
 /// relative errors of a wall that carries nothing in GPS read "none in GPS").
 #[test]

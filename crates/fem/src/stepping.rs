@@ -78,6 +78,10 @@ pub struct StepState {
     /// predictor; `None` before the stage's second step)
     #[serde(default)]
     pub previous_lambda: Option<f64>,
+    /// the stage's [`Guide`] was dropped (a step from its state failed): the rest of the stage,
+    /// a resumed one too, is stepped without it
+    #[serde(default)]
+    pub unguided: bool,
 }
 
 /// A converged step as the stepping reports it to its caller.
@@ -265,8 +269,9 @@ pub fn run_stage_from<E>(
 /// [`Refit`]). A step whose re-solve on the moved mesh fails is cut back like any other, from
 /// the last converged state carried to the moved mesh.
 ///
-/// With a `guide` (not on a resumed stage), the steps go to the guide's fractions and start
-/// from its states ([`Guide`]).
+/// With a `guide`, the steps go to the guide's fractions and start from its states
+/// ([`Guide`]); a resumed stage takes the same guide from where it stopped, so that it repeats
+/// the uninterrupted one.
 ///
 /// Its length is the adaptive load-stepping loop in one place: step size, the mesh refit, the
 /// Newton solve, the cut-back of a failed step from the last converged state, and the growth
@@ -284,8 +289,8 @@ pub fn run_stage_refitted<E>(
 ) -> Result<(), StageError<E>> {
     let (from, to) = (stage.from, stage.to);
     let set = &stage.settings;
-    // the guide, while its states lead the steps; a resumed stage is stepped without it
-    let mut guide = guide.filter(|g| resume.is_none() && g.fractions().last() == Some(&1.0));
+    // the guide, while its states lead the steps
+    let mut guide = guide.filter(|g| g.fractions().last() == Some(&1.0));
     if resume.is_none() {
         // nothing to do: the stage ends where it starts (a target equal to the current state)
         if (to - from).abs() <= 1e-14 * from.abs().max(to.abs()).max(1.0) {
@@ -304,6 +309,7 @@ pub fn run_stage_refitted<E>(
             step: 0,
             cuts: 0,
             previous_lambda: None,
+            unguided: false,
         },
         None,
     ));
@@ -313,7 +319,11 @@ pub fn run_stage_refitted<E>(
         mut step,
         mut cuts,
         mut previous_lambda,
+        mut unguided,
     } = progress;
+    if unguided {
+        guide = None;
+    }
     if previous_lambda.is_none() {
         previous = None;
     }
@@ -442,6 +452,7 @@ pub fn run_stage_refitted<E>(
                         step,
                         cuts,
                         previous_lambda,
+                        unguided,
                     },
                     step,
                     value,
@@ -470,6 +481,7 @@ pub fn run_stage_refitted<E>(
                     // cut back the guide's step, and go on without it (from the pre-stress a
                     // stress-free start takes without a guide)
                     guide = None;
+                    unguided = true;
                     dl = next - lambda;
                     if state.p == 0.0 && !matches!(l.loading, Loading::Pressure(_)) {
                         prestress(model, state, stage)?;

@@ -135,12 +135,12 @@ pub(super) fn drive_stage(
                         },
                         edges: r.tracked_edges.clone(),
                     });
-            // mesh sequencing: the coarse run's steps of this stage lead (not on a resumed
-            // stage, which steps on from its checkpoint)
+            // mesh sequencing: the coarse run's steps of this stage lead (a resumed stage from
+            // where it stopped)
             let load = kind.load(&parts);
-            let guide = match (&r.coarse, &progress) {
-                (Some(c), None) => c.guide(i, &r.model).map_err(AppError::Model)?,
-                _ => None,
+            let guide = match &r.coarse {
+                Some(c) => c.guide(i, &r.model).map_err(AppError::Model)?,
+                None => None,
             };
             run_stage_refitted(
                 &mut r.model,

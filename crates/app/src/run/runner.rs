@@ -82,25 +82,21 @@ impl<'a> Runner<'a> {
             check_memory(n, options.force)?;
         }
         // the coarse run of mesh sequencing first, so that its model is gone before this
-        // one is built (a resumed run steps on without it)
-        let coarse = match options.resume {
-            None => {
-                let quiet = RunOptions {
-                    interrupt: options.interrupt.clone(),
-                    force: options.force,
-                    resume: None,
-                };
-                crate::sequencing::Coarse::run(case, observers, &mut |coarse, collector| {
-                    super::run_with(
-                        coarse,
-                        "mesh-sequencing coarse run",
-                        &quiet,
-                        &mut [collector],
-                    )
-                })?
-            }
-            Some(_) => None,
+        // one is built; a resumed run runs it again (it is deterministic), so that its steps
+        // repeat the uninterrupted run's
+        let quiet = RunOptions {
+            interrupt: options.interrupt.clone(),
+            force: options.force,
+            resume: None,
         };
+        let coarse = crate::sequencing::Coarse::run(case, observers, &mut |coarse, collector| {
+            super::run_with(
+                coarse,
+                "mesh-sequencing coarse run",
+                &quiet,
+                &mut [collector],
+            )
+        })?;
         let (mesh, contact_edge_fit) = build_mesh_with_fit(case, options.interrupt.as_ref())?;
         if case.mesh.file.is_some() {
             check_memory(3 * mesh.nodes.len(), options.force)?;

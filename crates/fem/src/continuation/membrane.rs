@@ -267,6 +267,7 @@ pub fn run_arc_stage<E>(
                             step: step0 + s.step,
                             cuts: s.cuts,
                             previous_lambda: None,
+                            unguided: false,
                         },
                         step: step0 + s.step,
                         value: s.monitor,
