@@ -137,6 +137,13 @@ impl Coarse {
         self.stages.get(index - 1).is_some_and(|s| !s.is_empty())
     }
 
+    /// Drop the states of stage `index` (from 1), once it is driven.
+    pub fn release(&mut self, index: usize) {
+        if let Some(s) = self.stages.get_mut(index - 1) {
+            *s = Vec::new();
+        }
+    }
+
     /// The guide of stage `index` (from 1) on `model`: the coarse run's converged steps of
     /// that stage, carried over on demand; `None` where the coarse run did not finish the
     /// stage.

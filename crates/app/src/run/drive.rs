@@ -158,6 +158,10 @@ pub(super) fn drive_stage(
             )
         }
     };
+    // the coarse run's states of this stage are not needed again
+    if let Some(c) = r.coarse.as_mut() {
+        c.release(i);
+    }
     if let Err(e) = result {
         let failed = Failed {
             kind,
