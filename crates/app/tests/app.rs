@@ -1647,6 +1647,24 @@ fn a_split_factorization_gives_the_whole_factors_states_and_the_same_bits_on_any
     assert_eq!(bits(&one), bits(&split));
 }
 
+/// Each finished stage's mid-span ϖ, λs and λz at its end, its steps and its Newton iterations.
+fn stage_ends(report: &tubemem_app::report::RunReport) -> Vec<(f64, f64, f64, usize, usize)> {
+    report
+        .stages
+        .iter()
+        .map(|s| match &s.outcome {
+            StageOutcome::Finished(f) => (
+                f.final_state.midspan.w,
+                f.final_state.midspan.lambda_s,
+                f.final_state.midspan.lambda_z,
+                s.steps.len(),
+                s.steps.iter().map(|r| r.newton_iterations).sum::<usize>(),
+            ),
+            o => panic!("{o:?}"),
+        })
+        .collect()
+}
+
 /// The million-unknown benchmark's case (`scripts/bench-million.sh`: a whole capped tube,
 /// L/R = 20, ABB 𝒩 = 30 with tension-field relaxation, inflated to λs* = 1.3, squeezed to
 /// ρ = 0.8 with the gas closed in) at 32 × 40 elements: its end state does not depend on how
@@ -1670,19 +1688,7 @@ fn the_benchmarks_end_state_does_not_depend_on_its_load_steps() {
         let report = run(&Case::parse(text).unwrap(), "bench", &mut [])
             .into_result()
             .unwrap();
-        report
-            .stages
-            .iter()
-            .map(|s| match &s.outcome {
-                StageOutcome::Finished(f) => (
-                    f.final_state.midspan.w,
-                    f.final_state.midspan.lambda_s,
-                    f.final_state.midspan.lambda_z,
-                    s.steps.len(),
-                ),
-                o => panic!("{o:?}"),
-            })
-            .collect::<Vec<_>>()
+        stage_ends(&report)
     };
     let (before, now) = (end(&case(4, 5)), end(&case(1, 2)));
     for (stage, (a, b)) in before.iter().zip(&now).enumerate() {
@@ -1732,20 +1738,7 @@ fn a_sequenced_run_ends_where_the_plain_one_does_in_fewer_iterations() {
             "{:?}",
             report.warnings
         );
-        report
-            .stages
-            .iter()
-            .map(|s| match &s.outcome {
-                StageOutcome::Finished(f) => (
-                    f.final_state.midspan.w,
-                    f.final_state.midspan.lambda_s,
-                    f.final_state.midspan.lambda_z,
-                    s.steps.len(),
-                    s.steps.iter().map(|r| r.newton_iterations).sum::<usize>(),
-                ),
-                o => panic!("{o:?}"),
-            })
-            .collect::<Vec<_>>()
+        stage_ends(&report)
     };
     let end = |text: &str| end_on(text, 2);
     let (plain, sequenced) = (end(&case(0)), end(&case(1)));
