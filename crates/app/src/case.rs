@@ -1072,8 +1072,11 @@ impl Case {
         self.plan.truncate(n);
     }
 
-    /// Its length: a flat list of independent checks of the whole case, each returning its
-    /// own error with the key it names; there is no shared logic to factor out.
+    /// The resolved stages, to change (a coarse run's looser tolerances).
+    pub(crate) fn plan_mut(&mut self) -> &mut [StagePlan] {
+        &mut self.plan
+    }
+
     /// `[solver] mesh_sequencing`: a generated capped tube whose counts halve `L` times into
     /// admissible ones, stepped by load steps on a mesh that stays put.
     fn validate_sequencing(&self, plan: &[StagePlan]) -> Result<(), CaseError> {
@@ -1132,6 +1135,8 @@ impl Case {
         Ok(())
     }
 
+    /// Its length: a flat list of independent checks of the whole case, each returning its
+    /// own error with the key it names; there is no shared logic to factor out.
     fn validate(&self) -> Result<Vec<StagePlan>, CaseError> {
         let g = &self.geometry;
         if self.units.is_some() && g.thickness.is_none() {

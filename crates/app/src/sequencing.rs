@@ -14,12 +14,26 @@ use crate::case::Case;
 use crate::observer::{BoxError, Observer, StepView};
 use crate::report::{RunOutcome, RunReport, StageOutcome};
 use crate::{AppError, Result};
+use tubemem_fem::contact::Enforcement;
 use tubemem_fem::model::{Load, Model, Prolongation, State};
 use tubemem_fem::FemError;
 use tubemem_mesh::Mesh;
 
+/// The coarse run's Newton tolerance (at least the case's): its state differs from the fine
+/// mesh's by the coarse discretization error, about 1e-4 relative in ϖ at 224 around (0.651487
+/// against 0.651439 at 448, `scripts/bench-million.sh`), so converging it below 1e-6 buys the
+/// fine start nothing. Measured on the benchmark (`THREADS=2 bash scripts/bench-million.sh`,
+/// one run each): 1:45.2 wall with this and [`COARSE_GAP_TOLERANCE`], 1:49.5 with this alone,
+/// against 1:52–1:56 with the case's 1e-9, and the same printed fine results.
+pub const COARSE_RTOL: f64 = 1e-6;
+
+/// The coarse run's multiplier-update gap tolerance (at least the case's), in R: far below the
+/// coarse discretization's own displacement error, as [`COARSE_RTOL`].
+pub const COARSE_GAP_TOLERANCE: f64 = 1e-6;
+
 /// The case one level coarser: half the elements around, along and in the caps, one level
-/// fewer, nothing written.
+/// fewer, nothing written, with the predictor's tolerances ([`COARSE_RTOL`],
+/// [`COARSE_GAP_TOLERANCE`]).
 pub fn coarse_case(case: &Case) -> Case {
     let mut coarse = case.clone();
     coarse.mesh.around = case.mesh.around.map(|v| v / 2);
@@ -27,6 +41,13 @@ pub fn coarse_case(case: &Case) -> Case {
     coarse.mesh.cap_rows = case.mesh.cap_rows.map(|v| v / 2);
     coarse.solver.mesh_sequencing = case.solver.mesh_sequencing.saturating_sub(1);
     coarse.solver.checkpoint_every = 0;
+    // a predictor needs no more precision than its discretization has
+    coarse.solver.rtol = case.solver.rtol.max(COARSE_RTOL);
+    for p in coarse.plan_mut() {
+        if let Some(Enforcement::Augmented { gap_tolerance, .. }) = &mut p.enforcement {
+            *gap_tolerance = gap_tolerance.max(COARSE_GAP_TOLERANCE);
+        }
+    }
     coarse
 }
 
