@@ -23,7 +23,8 @@ use tubemem_mesh::Mesh;
 /// mesh's by the coarse discretization error, about 1e-4 relative in ϖ at 224 around (0.651487
 /// against 0.651439 at 448, `scripts/bench-million.sh`), so converging it below 1e-6 buys the
 /// fine start nothing. Measured on the benchmark (`THREADS=2 bash scripts/bench-million.sh`,
-/// one run each): 1:45.2 wall with this and [`COARSE_GAP_TOLERANCE`], 1:49.5 with this alone,
+/// one run each): 1:45.2 and 1:48.8 wall with this and [`COARSE_GAP_TOLERANCE`], 1:49.5 with
+/// this alone,
 /// against 1:52–1:56 with the case's 1e-9, and the same printed fine results.
 pub const COARSE_RTOL: f64 = 1e-6;
 
