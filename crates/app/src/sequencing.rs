@@ -24,8 +24,7 @@ use tubemem_mesh::Mesh;
 /// against 0.651439 at 448, `scripts/bench-million.sh`), so converging it below 1e-6 buys the
 /// fine start nothing. Measured on the benchmark (`THREADS=2 bash scripts/bench-million.sh`,
 /// one run each): 1:45.2 and 1:48.8 wall with this and [`COARSE_GAP_TOLERANCE`], 1:49.5 with
-/// this alone,
-/// against 1:52–1:56 with the case's 1e-9, and the same printed fine results.
+/// this alone, against 1:52–1:56 with the case's 1e-9, and the same printed fine results.
 pub const COARSE_RTOL: f64 = 1e-6;
 
 /// The coarse run's multiplier-update gap tolerance (at least the case's), in R: far below the
@@ -85,8 +84,9 @@ impl Observer for Collector {
 pub struct Coarse {
     mesh: Mesh,
     stages: Vec<Vec<(f64, State)>>,
-    /// elements around the coarse mesh
-    pub around: usize,
+    /// where the run's nodes lie on the coarse mesh: located at the first guided stage, for
+    /// all (the run's mesh does not move: sequencing refuses the moving ones)
+    prolongation: std::cell::OnceCell<Prolongation>,
     /// the coarse run's failure: stages from its failed one on are stepped without a guide
     pub warning: Option<String>,
 }
@@ -135,21 +135,15 @@ impl Coarse {
         let mut stages = collector.stages;
         stages.truncate(finished);
         let warning = outcome.error.map(|e| {
-            let mut chain = e.to_string();
-            let mut source = std::error::Error::source(&e);
-            while let Some(s) = source {
-                chain.push_str(": ");
-                chain.push_str(&s.to_string());
-                source = s.source();
-            }
             format!(
-                "[solver] mesh_sequencing: the coarse run ({around} around) stopped after {finished} finished stage(s) ({chain}); the stages after them were stepped without it"
+                "[solver] mesh_sequencing: the coarse run ({around} around) stopped after {finished} finished stage(s) ({}); the stages after them were stepped without it",
+                e.chain()
             )
         });
         Ok(Some(Coarse {
             mesh,
             stages,
-            around,
+            prolongation: std::cell::OnceCell::new(),
             warning,
         }))
     }
@@ -177,7 +171,13 @@ impl Coarse {
         let Some(steps) = self.stages.get(index - 1).filter(|s| !s.is_empty()) else {
             return Ok(None);
         };
-        let prolongation = model.prolongation_from(&self.mesh)?;
+        if self.prolongation.get().is_none() {
+            // set once: it was empty just above, and nothing else sets it
+            let _ = self.prolongation.set(model.prolongation_from(&self.mesh)?);
+        }
+        let Some(prolongation) = self.prolongation.get() else {
+            return Ok(None);
+        };
         Ok(Some(StageGuide {
             fractions: steps.iter().map(|s| s.0).collect(),
             steps,
@@ -190,7 +190,7 @@ impl Coarse {
 pub struct StageGuide<'a> {
     fractions: Vec<f64>,
     steps: &'a [(f64, State)],
-    prolongation: Prolongation,
+    prolongation: &'a Prolongation,
 }
 
 impl tubemem_fem::stepping::Guide for StageGuide<'_> {
@@ -199,6 +199,6 @@ impl tubemem_fem::stepping::Guide for StageGuide<'_> {
     }
 
     fn state(&self, model: &Model, k: usize, load: &Load) -> std::result::Result<State, FemError> {
-        model.prolong(&self.prolongation, &self.steps[k].1, load.contact.as_ref())
+        model.prolong(self.prolongation, &self.steps[k].1, load.contact.as_ref())
     }
 }

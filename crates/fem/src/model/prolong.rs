@@ -205,24 +205,19 @@ impl Model {
             return Err(fail("the coarse mesh has another symmetry".into()));
         }
         let locator = Locator::new(coarse);
-        let place = |p: [f64; 3]| -> Result<(usize, [f64; 2]), f64> {
-            match locator.locate(p) {
-                Some((e, xi, d)) if d <= MAX_OFF_SURFACE => Ok((e, xi)),
-                Some((_, _, d)) => Err(d),
-                None => Err(f64::INFINITY),
-            }
-        };
         let nodes: Vec<Vec<(usize, f64)>> = self
             .mesh
             .nodes
             .par_iter()
             .enumerate()
-            .map(|(n, &p)| {
-                place(p).map(|(e, xi)| locator.weights(e, xi)).map_err(|d| {
-                    fail(format!(
+            .map(|(n, &p)| match locator.locate(p) {
+                Some((e, xi, d)) if d <= MAX_OFF_SURFACE => Ok(locator.weights(e, xi)),
+                found => {
+                    let d = found.map_or(f64::INFINITY, |f| f.2);
+                    Err(fail(format!(
                         "node {n} of this mesh is {d:.3} coarse element sizes from the coarse surface (at most {MAX_OFF_SURFACE})"
-                    ))
-                })
+                    )))
+                }
             })
             .collect::<Result<_, _>>()?;
         Ok(Prolongation {
