@@ -10,6 +10,7 @@
 //! reacts (shift, cut-back).
 
 use crate::ordering::Ordering;
+pub mod multifrontal;
 pub mod tree_split;
 use crate::FemError;
 use faer::dyn_stack::{MemBuffer, MemStack};

@@ -1,6 +1,9 @@
-//! What the factorization examples (`subtree_split`, `supernode_bound`) share: the whole capped
-//! tube's pattern (the mesh's node graph expanded to 3 unknowns per node, no constraint taken
-//! out), a matrix on it, and the timing of faer's numeric LDLᵀ.
+//! What the factorization examples (`subtree_split`, `supernode_bound`, `factor_drivers`)
+//! share: the whole capped tube's pattern (the mesh's node graph expanded to 3 unknowns per
+//! node, no constraint taken out), a matrix on it, and the timing of faer's numeric LDLᵀ.
+
+// each example uses a part of these helpers
+#![allow(dead_code)]
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
