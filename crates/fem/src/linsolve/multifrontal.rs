@@ -1,5 +1,5 @@
 //! A multifrontal numeric LDLᵀ over faer's supernodal symbolic factor and its dense kernels:
-//! the measured alternative to faer's own numeric driver, which the solver keeps.
+//! the driver of the split factorization's two halves ([`crate::linsolve::tree_split`]).
 //!
 //! faer's numeric factorization is left-looking: a supernode gathers the update of every
 //! descendant whose rows reach it, one matrix product of small depth per (descendant,
@@ -21,17 +21,18 @@
 //!
 //! The update matrices live in one arena, stacked from both ends: a matrix goes to the end
 //! that its depth's parity names, so a parent's matrix is never on the children's end and
-//! nothing is moved. The arena's size comes from the symbolic factor. The result is in faer's
-//! supernodal layout (D on the diagonal of each diagonal block, L strictly below it, zeros
-//! above), so faer's supernodal solve reads it. Everything is sequential and in a fixed order:
-//! the bits do not depend on the thread count. They differ from faer's driver's by round-off,
-//! because the updates are summed in another order.
+//! nothing is moved. Each is its lower triangle stored by panels of 256 columns (a panel holds
+//! the rows from its first column down), about half the square. The arena's size comes from
+//! the symbolic factor. The result is in faer's supernodal layout (D on the diagonal of each
+//! diagonal block, L strictly below it, zeros above), so faer's supernodal solve reads it.
+//! Everything is sequential and in a fixed order: the bits do not depend on the thread count.
+//! They differ from faer's driver's by round-off, because the updates are summed in another
+//! order.
 //!
-//! Why the solver does not use it: measured on the million-unknown benchmark
-//! (`examples/factor_drivers.rs` and the split factorization, CHANGELOG), it is only a few
-//! per cent faster than faer's driver, within the machine's noise, and its update matrices
-//! and entry map take more memory than faer's workspace, which puts the benchmark's peak over
-//! its 4 GiB limit. `Phases` splits its time into the dense kernels and the memory-bound rest.
+//! The whole factor of a model (`SparseLdlt` without the split) keeps faer's driver: every
+//! shipped case is far below the split's size, and its results stay bit for bit. The example
+//! `factor_drivers` times the two drivers side by side, and [`Phases`] splits this one's time
+//! into the dense kernels and the memory-bound rest.
 
 use crate::linsolve::FactorizationError;
 use crate::ordering::OrderingError;
@@ -108,14 +109,49 @@ fn runs_of(map: &[usize], runs: &mut Vec<Run>) {
     }
 }
 
+/// Columns per panel of an update matrix's storage (narrow under test, so that the tests'
+/// small matrices have many panels).
+const PANEL: usize = if cfg!(test) { 16 } else { 256 };
+
+/// The length of an r × r update matrix's lower triangle stored by panels: panel k holds the
+/// rows from its first column's down, of its (at most [`PANEL`]) columns, column by column.
+/// Against the whole square, that halves the arena up to a panel's width a matrix.
+fn packed_len(r: usize) -> usize {
+    (0..r)
+        .step_by(PANEL)
+        .map(|k| (r - k) * PANEL.min(r - k))
+        .sum()
+}
+
+/// Where column j of an r × r update matrix stored by panels starts, and the row its first
+/// entry holds (its panel's first column).
+fn packed_column(r: usize, j: usize) -> (usize, usize) {
+    let panels = j / PANEL;
+    let k = panels * PANEL;
+    // the full panels before: Σ_{q < panels} (r − q P) P
+    let before = PANEL * (panels * r - PANEL * panels * panels.saturating_sub(1) / 2);
+    (before + (j - k) * (r - k), k)
+}
+
 /// column += a child's column `from`, its rows `j..` (the lower triangle), through the runs
-/// from `first` (the one holding row j); the column's row 0 is the front's row `offset`.
-fn add_column(column: &mut [f64], offset: usize, from: &[f64], j: usize, runs: &[Run]) {
+/// from the one holding row j; `from`'s first entry is the child's row `from_row`, the
+/// column's is the front's row `offset`.
+fn add_column(
+    column: &mut [f64],
+    offset: usize,
+    from: &[f64],
+    from_row: usize,
+    j: usize,
+    runs: &[Run],
+) {
     for run in runs {
         let lo = run.child.max(j);
         let hi = run.child + run.len;
         let at = run.parent + (lo - run.child) - offset;
-        for (d, &v) in column[at..at + hi - lo].iter_mut().zip(&from[lo..hi]) {
+        for (d, &v) in column[at..at + hi - lo]
+            .iter_mut()
+            .zip(&from[lo - from_row..hi - from_row])
+        {
             *d += v;
         }
     }
@@ -237,12 +273,12 @@ impl Multifrontal {
             let (_, c, below) = shape(sn, s);
             let r = below.len();
             let (own, kids) = if left[s] { (0, 1) } else { (1, 0) };
-            arena = arena.max(tops[0] + tops[1] + r * r);
+            arena = arena.max(tops[0] + tops[1] + packed_len(r));
             let from = frames[kids].len() - n_children[s];
             tops[kids] -= frames[kids].drain(from..).sum::<usize>();
             if r > 0 {
-                frames[own].push(r * r);
-                tops[own] += r * r;
+                frames[own].push(packed_len(r));
+                tops[own] += packed_len(r);
             }
             work = work.max(r * c);
             widest = widest.max(c);
@@ -352,28 +388,30 @@ impl Multifrontal {
             let u_at = if own == 0 {
                 tops[0]
             } else {
-                size - tops[1] - r * r
+                size - tops[1] - packed_len(r)
             };
-            let cut = if own == 0 { u_at + r * r } else { u_at };
+            let len = packed_len(r);
+            let cut = if own == 0 { u_at + len } else { u_at };
             let (low, high) = arena.split_at_mut(cut);
             let (u_p, children_side, children_base): (&mut [f64], &[f64], usize) = if own == 0 {
                 (&mut low[u_at..], &*high, cut)
             } else {
-                (&mut high[..r * r], &*low, 0)
+                (&mut high[..len], &*low, 0)
             };
             let children = frames[kids].split_off(frames[kids].len() - n_children[p]);
             // 2. the children's columns that are p's
             for &(offset, rc, child) in &children {
                 child_map(map, shape(sn, child).2, begin, begin + c, local);
                 runs_of(map, runs);
-                let u = &children_side[offset - children_base..][..rc * rc];
+                let u = &children_side[offset - children_base..][..packed_len(rc)];
                 let mut first = 0;
                 for (j, &t) in map.iter().enumerate().take_while(|&(_, &t)| t < c) {
                     while runs[first].child + runs[first].len <= j {
                         first += 1;
                     }
                     let column = &mut block[t * nr..(t + 1) * nr];
-                    add_column(column, 0, &u[j * rc..(j + 1) * rc], j, &runs[first..]);
+                    let (at, row) = packed_column(rc, j);
+                    add_column(column, 0, &u[at..at + rc - row], row, j, &runs[first..]);
                 }
             }
             clock.lap(|p| &mut p.extend_own);
@@ -415,42 +453,76 @@ impl Multifrontal {
                     }
                 }
                 clock.lap(|p| &mut p.copy);
-                // 4. U_p = −W L_Bᵀ, lower triangle
-                matmul(
-                    MatMut::from_column_major_slice_mut(&mut u_p[..r * r], r, r),
-                    BlockStructure::TriangularLower,
-                    Accum::Replace,
-                    MatRef::from_column_major_slice(w, r, c),
-                    BlockStructure::Rectangular,
-                    bottom.as_ref().transpose(),
-                    BlockStructure::Rectangular,
-                    -1.0,
-                    Par::Seq,
-                );
+                // 4. U_p = −W L_Bᵀ, lower triangle, panel by panel: its diagonal block
+                //    (lower triangle) and the rectangle below it
+                let w = MatRef::from_column_major_slice(w, r, c);
+                let l_b = bottom.as_ref();
+                for k in (0..r).step_by(PANEL) {
+                    let (width, height) = (PANEL.min(r - k), r - k);
+                    let (at, _) = packed_column(r, k);
+                    let panel = MatMut::from_column_major_slice_mut(
+                        &mut u_p[at..at + height * width],
+                        height,
+                        width,
+                    );
+                    let (diagonal, below_it) = panel.split_at_row_mut(width);
+                    let l_k = l_b.subrows(k, width).transpose();
+                    matmul(
+                        diagonal,
+                        BlockStructure::TriangularLower,
+                        Accum::Replace,
+                        w.subrows(k, width),
+                        BlockStructure::Rectangular,
+                        l_k,
+                        BlockStructure::Rectangular,
+                        -1.0,
+                        Par::Seq,
+                    );
+                    faer::linalg::matmul::matmul(
+                        below_it,
+                        Accum::Replace,
+                        w.subrows(k + width, height - width),
+                        l_k,
+                        -1.0,
+                        Par::Seq,
+                    );
+                }
             }
             clock.lap(|p| &mut p.update);
             // 5. the children's columns below p's, then the children go
             for &(offset, rc, child) in &children {
                 child_map(map, shape(sn, child).2, begin, begin + c, local);
                 runs_of(map, runs);
-                let u = &children_side[offset - children_base..][..rc * rc];
+                let u = &children_side[offset - children_base..][..packed_len(rc)];
                 let mut first = 0;
                 for (j, &t) in map.iter().enumerate().skip_while(|&(_, &t)| t < c) {
                     while runs[first].child + runs[first].len <= j {
                         first += 1;
                     }
-                    let column = &mut u_p[(t - c) * r..(t - c + 1) * r];
-                    add_column(column, c, &u[j * rc..(j + 1) * rc], j, &runs[first..]);
+                    let (to, to_row) = packed_column(r, t - c);
+                    let column = &mut u_p[to..to + r - to_row];
+                    let (at, row) = packed_column(rc, j);
+                    add_column(
+                        column,
+                        c + to_row,
+                        &u[at..at + rc - row],
+                        row,
+                        j,
+                        &runs[first..],
+                    );
                 }
             }
             clock.lap(|p| &mut p.extend_update);
             for &row in below {
                 local[row] = usize::MAX;
             }
-            tops[kids] -= children.iter().map(|&(_, rc, _)| rc * rc).sum::<usize>();
+            tops[kids] -= children
+                .iter()
+                .map(|&(_, rc, _)| packed_len(rc))
+                .sum::<usize>();
             if r > 0 {
                 frames[own].push((u_at, r, p));
-                tops[own] += r * r;
+                tops[own] += len;
             }
         }
         Ok(())

@@ -10,8 +10,10 @@
 //!         [ B₀ᵀ B₁ᵀ C  ]
 //! ```
 //!
-//! Each bordered half M_i (its unknowns in nested-dissection order, S last) is factorized by
-//! faer's sequential supernodal LDLᵀ, the two on their own threads (`rayon::join`). Because S
+//! Each bordered half M_i (its unknowns in nested-dissection order, S last) is factorized on
+//! faer's supernodal symbolic factor by the sequential multifrontal driver
+//! ([`crate::linsolve::multifrontal`]; measured faster than faer's own driver on these halves),
+//! the two on their own threads (`rayon::join`). Because S
 //! comes last, the rows and columns of S in M_i's factor are the LDLᵀ factor of M_i's Schur
 //! complement T_i, which is gathered into a dense matrix. S = T₀ + T₁ is factorized by dense
 //! LDLᵀ. Every piece is sequential and summed in a fixed order, so the factor is bitwise the
@@ -31,6 +33,7 @@
 //! factorize in 0.5–0.6 of the whole factor's time on this 2-core machine, where faer's
 //! parallelism inside supernodes is slower than one thread.
 
+use crate::linsolve::multifrontal::Multifrontal;
 use crate::linsolve::FactorizationError;
 use crate::FemError;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -43,7 +46,7 @@ use faer::sparse::linalg::cholesky::{
     SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{FaerError, SymbolicSparseColMat};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 /// LDLᵀ without pivoting and without regularization: a zero pivot is an error.
@@ -76,9 +79,11 @@ struct Half {
     pivots: Vec<f64>,
     /// W = L_SS D_S, the factorization's workspace for T_i
     work: Mat<f64>,
-    /// M_i's values at the last factorization, and faer's workspace for it
+    /// M_i's values at the last factorization
     vals: Vec<f64>,
-    scratch: Option<MemBuffer>,
+    /// the numeric factorization's driver (built at the first factorization, then kept with
+    /// its workspace)
+    driver: Option<Multifrontal>,
 }
 
 /// `m` as an `s` × `s` matrix of zeros, in its own storage when it has that size.
@@ -201,7 +206,7 @@ impl Half {
             pivots: Vec::new(),
             work: Mat::new(),
             vals: Vec::new(),
-            scratch: None,
+            driver: None,
         })
     }
 
@@ -276,21 +281,12 @@ impl Half {
     /// the negative pivots of A_i. A zero pivot names its unknown of K (`separator`: S's, in
     /// M_i's order).
     fn factorize(&mut self, separator: &[usize]) -> Result<usize, FemError> {
-        // faer's workspace in the last factorization's storage (a million unknowns: 118 MB a
-        // half, allocated anew at every factorization before)
         let vals = std::mem::take(&mut self.vals);
-        let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
-        let mem = match &mut self.scratch {
-            Some(mem) => mem,
-            None => {
-                let req = self
-                    .symbolic
-                    .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
-                self.scratch.insert(
-                    MemBuffer::try_new(req)
-                        .map_err(|e| FactorizationError::Workspace(FaerError::from(e)))?,
-                )
-            }
+        let driver = match &mut self.driver {
+            Some(driver) => driver,
+            None => self
+                .driver
+                .insert(Multifrontal::new(self.supernodal(), self.pattern.as_ref())?),
         };
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
@@ -303,17 +299,12 @@ impl Half {
                 separator[local - n]
             }
         };
-        let factorized = self
-            .symbolic
-            .factorize_numeric_ldlt::<f64>(
-                &mut self.l_values,
-                mat.as_ref(),
-                Side::Lower,
-                NO_REGULARIZATION,
-                Par::Seq,
-                MemStack::new(mem),
-                Default::default(),
-            )
+        let sn = match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => sn,
+            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal layout forced"),
+        };
+        let factorized = driver
+            .factorize(sn, &vals, &mut self.l_values, None)
             .map_err(|e| match e {
                 LdltError::ZeroPivot { index } => FemError::ZeroPivot {
                     index: global(index),
@@ -863,7 +854,7 @@ mod tests {
         assert_eq!(bits(&one.1), bits(&two.1));
     }
 
-    /// A factorization in the storage of an earlier one (the halves' values, faer's workspace,
+    /// A factorization in the storage of an earlier one (the halves' values, the driver's workspace,
     /// the dense blocks, all kept from one factorization to the next) gives the bits of a
     /// fresh split's, and so does one after a failed factorization.
     #[test]
