@@ -854,8 +854,8 @@ mod tests {
         assert_eq!(bits(&one.1), bits(&two.1));
     }
 
-    /// A factorization in the storage of an earlier one (the halves' values, the driver's workspace,
-    /// the dense blocks, all kept from one factorization to the next) gives the bits of a
+    /// A factorization in the storage of an earlier one (the halves' values, the driver's
+    /// workspace, the dense blocks, all kept from one factorization to the next) gives the bits of a
     /// fresh split's, and so does one after a failed factorization.
     #[test]
     fn the_split_reuses_its_storage_without_changing_a_bit() {
