@@ -198,14 +198,57 @@ impl Clock<'_> {
     }
 }
 
-/// A child's rows (`rows`, ascending) as rows of its parent's front: the parent's own
-/// columns `begin..end` first, then the parent's rows below (`local`).
-fn child_map(map: &mut Vec<usize>, rows: &[usize], begin: usize, end: usize, local: &[usize]) {
+/// A child's rows (`rows`, ascending) as rows of its parent's front (`map`): the parent's own
+/// `c` columns from `begin` first, then the parent's rows below (`local`); and their runs of
+/// consecutive rows. Returns how many of the child's rows are the parent's columns.
+fn child_runs(
+    map: &mut Vec<usize>,
+    runs: &mut Vec<Run>,
+    rows: &[usize],
+    begin: usize,
+    c: usize,
+    local: &[usize],
+) -> usize {
     map.clear();
-    map.extend(
-        rows.iter()
-            .map(|&row| if row < end { row - begin } else { local[row] }),
-    );
+    map.extend(rows.iter().map(|&row| {
+        if row < begin + c {
+            row - begin
+        } else {
+            local[row]
+        }
+    }));
+    runs_of(map, runs);
+    map.partition_point(|&t| t < c)
+}
+
+/// Adds the `columns` of a child's update matrix `u` (rc × rc, by panels) to `target`, whose
+/// front column t is `target[start..start + len]` with its first entry the front's row
+/// `offset`, for `(start, len, offset) = place(t)`; `map` and `runs` from [`child_runs`].
+fn extend_add(
+    target: &mut [f64],
+    place: impl Fn(usize) -> (usize, usize, usize),
+    u: &[f64],
+    rc: usize,
+    map: &[usize],
+    runs: &[Run],
+    columns: std::ops::Range<usize>,
+) {
+    let mut first = 0;
+    for j in columns {
+        while runs[first].child + runs[first].len <= j {
+            first += 1;
+        }
+        let (start, len, offset) = place(map[j]);
+        let (at, row) = packed_column(rc, j);
+        add_column(
+            &mut target[start..start + len],
+            offset,
+            &u[at..at + rc - row],
+            row,
+            j,
+            &runs[first..],
+        );
+    }
 }
 
 impl Multifrontal {
@@ -401,18 +444,9 @@ impl Multifrontal {
             let children = frames[kids].split_off(frames[kids].len() - n_children[p]);
             // 2. the children's columns that are p's
             for &(offset, rc, child) in &children {
-                child_map(map, shape(sn, child).2, begin, begin + c, local);
-                runs_of(map, runs);
+                let split = child_runs(map, runs, shape(sn, child).2, begin, c, local);
                 let u = &children_side[offset - children_base..][..packed_len(rc)];
-                let mut first = 0;
-                for (j, &t) in map.iter().enumerate().take_while(|&(_, &t)| t < c) {
-                    while runs[first].child + runs[first].len <= j {
-                        first += 1;
-                    }
-                    let column = &mut block[t * nr..(t + 1) * nr];
-                    let (at, row) = packed_column(rc, j);
-                    add_column(column, 0, &u[at..at + rc - row], row, j, &runs[first..]);
-                }
+                extend_add(block, |t| (t * nr, nr, 0), u, rc, map, runs, 0..split);
             }
             clock.lap(|p| &mut p.extend_own);
             // 3. the diagonal block's LDLᵀ and the block below it: L_B D, kept in W, then L_B
@@ -491,26 +525,13 @@ impl Multifrontal {
             clock.lap(|p| &mut p.update);
             // 5. the children's columns below p's, then the children go
             for &(offset, rc, child) in &children {
-                child_map(map, shape(sn, child).2, begin, begin + c, local);
-                runs_of(map, runs);
+                let split = child_runs(map, runs, shape(sn, child).2, begin, c, local);
                 let u = &children_side[offset - children_base..][..packed_len(rc)];
-                let mut first = 0;
-                for (j, &t) in map.iter().enumerate().skip_while(|&(_, &t)| t < c) {
-                    while runs[first].child + runs[first].len <= j {
-                        first += 1;
-                    }
+                let column = |t: usize| {
                     let (to, to_row) = packed_column(r, t - c);
-                    let column = &mut u_p[to..to + r - to_row];
-                    let (at, row) = packed_column(rc, j);
-                    add_column(
-                        column,
-                        c + to_row,
-                        &u[at..at + rc - row],
-                        row,
-                        j,
-                        &runs[first..],
-                    );
-                }
+                    (to, r - to_row, c + to_row)
+                };
+                extend_add(u_p, column, u, rc, map, runs, split..rc);
             }
             clock.lap(|p| &mut p.extend_update);
             for &row in below {
