@@ -305,6 +305,8 @@ impl Multifrontal {
         // each update matrix goes to the end of the arena that its depth's parity names, so
         // that a parent's matrix never overlaps its children's (which are at the other end,
         // on top): each end is a stack in postorder, and no matrix is ever moved
+        // (a parent comes after its children in faer's numbering: it owns a row below their
+        // columns, and supernodes are disjoint ranges of columns)
         let mut left = vec![false; ns];
         for s in (0..ns).rev() {
             left[s] = parent[s].is_none_or(|p| !left[p]);
