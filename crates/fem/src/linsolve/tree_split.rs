@@ -86,6 +86,15 @@ struct Half {
     driver: Option<Multifrontal>,
 }
 
+/// The supernodal structure of a half's symbolic factor (`Half::new` forces that layout, so
+/// the simplicial arm cannot be reached).
+fn supernodal_of(symbolic: &SymbolicCholesky<usize>) -> &SymbolicSupernodalCholesky<usize> {
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Supernodal(sn) => sn,
+        SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal layout forced"),
+    }
+}
+
 /// `m` as an `s` × `s` matrix of zeros, in its own storage when it has that size.
 fn zeroed(mut m: Mat<f64>, s: usize) -> Mat<f64> {
     if m.nrows() == s && m.ncols() == s {
@@ -250,10 +259,7 @@ impl Half {
 
     /// The supernodal structure of M_i's factor (the layout `new` forces).
     fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => sn,
-            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal layout forced"),
-        }
+        supernodal_of(&self.symbolic)
     }
 
     /// M_i's values from K's `values` ([`Half::values`]), in the last factorization's storage
@@ -281,13 +287,13 @@ impl Half {
     /// the negative pivots of A_i. A zero pivot names its unknown of K (`separator`: S's, in
     /// M_i's order).
     fn factorize(&mut self, separator: &[usize]) -> Result<usize, FemError> {
-        let vals = std::mem::take(&mut self.vals);
         let driver = match &mut self.driver {
             Some(driver) => driver,
             None => self
                 .driver
                 .insert(Multifrontal::new(self.supernodal(), self.pattern.as_ref())?),
         };
+        let vals = std::mem::take(&mut self.vals);
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
         }
@@ -299,12 +305,13 @@ impl Half {
                 separator[local - n]
             }
         };
-        let sn = match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => sn,
-            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("supernodal layout forced"),
-        };
         let factorized = driver
-            .factorize(sn, &vals, &mut self.l_values, None)
+            .factorize(
+                supernodal_of(&self.symbolic),
+                &vals,
+                &mut self.l_values,
+                None,
+            )
             .map_err(|e| match e {
                 LdltError::ZeroPivot { index } => FemError::ZeroPivot {
                     index: global(index),
