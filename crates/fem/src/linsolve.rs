@@ -51,6 +51,11 @@ pub enum FactorizationError {
     Workspace(#[source] FaerError),
     #[error("cannot compute the fill-reducing ordering")]
     Ordering(#[source] crate::ordering::OrderingError),
+    #[error(
+        "a partial factorization up to column {stop} needs the columns from there on in the \
+         last supernode, which begins at column {begin}"
+    )]
+    Trailing { stop: usize, begin: usize },
 }
 
 /// The flops of one numeric factorization with the symbolic structure `symbolic` of an `n` × `n`
@@ -62,18 +67,29 @@ pub(crate) fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f6
             let p = s.col_ptr();
             (0..n).map(|k| col((p[k + 1] - p[k]) as f64 - 1.0)).sum()
         }
-        SymbolicCholeskyRaw::Supernodal(s) => {
-            let (begin, end) = (s.supernode_begin(), s.supernode_end());
-            let val = s.col_ptr_for_val();
-            (0..s.n_supernodes())
-                .map(|k| {
-                    let ncols = end[k] - begin[k];
-                    let nrows = (val[k + 1] - val[k]) / ncols;
-                    (0..ncols).map(|j| col((nrows - j - 1) as f64)).sum::<f64>()
-                })
-                .sum()
-        }
+        SymbolicCholeskyRaw::Supernodal(s) => supernodal_flops(s, n),
     }
+}
+
+/// The flops of eliminating the columns before `stop` of the supernodal structure `s` (all
+/// of them for `stop` = n; a partial factorization's, [`multifrontal::Multifrontal::partial`],
+/// otherwise), counted as [`symbolic_flops`] counts them.
+pub(crate) fn supernodal_flops(
+    s: &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
+    stop: usize,
+) -> f64 {
+    let col = |c: f64| c * (c + 2.0);
+    let (begin, end) = (s.supernode_begin(), s.supernode_end());
+    let val = s.col_ptr_for_val();
+    (0..s.n_supernodes())
+        .map(|k| {
+            let ncols = end[k] - begin[k];
+            let nrows = (val[k + 1] - val[k]) / ncols;
+            (0..ncols.min(stop.saturating_sub(begin[k])))
+                .map(|j| col((nrows - j - 1) as f64))
+                .sum::<f64>()
+        })
+        .sum()
 }
 
 /// The factor: faer's supernodal or simplicial LDLᵀ of the whole matrix, or the split at the
@@ -395,8 +411,12 @@ impl SparseLdlt {
     ) -> Result<(usize, f64), FemError> {
         if let Factor::Split(t) = &mut self.factor {
             self.factorized = false;
-            Self::check_finite(&values, self.entries)?;
-            t.gather(&values);
+            assert_eq!(values.len(), self.entries, "one value per pattern entry");
+            // the halves see every value as they gather: a non-finite one is looked for (and
+            // named) only when they saw one
+            if !t.gather(&values) {
+                Self::check_finite(&values, self.entries)?;
+            }
             drop(values);
             let result = with_shifts(shifts, |delta| {
                 if delta != 0.0 {

@@ -10,23 +10,28 @@
 //!         [ B₀ᵀ B₁ᵀ C  ]
 //! ```
 //!
-//! Each bordered half M_i (its unknowns in nested-dissection order, S last) is factorized on
-//! faer's supernodal symbolic factor by the sequential multifrontal driver
-//! ([`crate::linsolve::multifrontal`]; measured faster than faer's own driver on these halves),
-//! the two on their own threads (`rayon::join`). Because S
-//! comes last, the rows and columns of S in M_i's factor are the LDLᵀ factor of M_i's Schur
-//! complement T_i, which is gathered into a dense matrix. S = T₀ + T₁ is factorized by dense
-//! LDLᵀ. Every piece is sequential and summed in a fixed order, so the factor is bitwise the
-//! same whether the halves run side by side or one after the other: the thread count changes
-//! the time, not the bits.
+//! Each bordered half M_i (its unknowns in nested-dissection order, S last) is factorized
+//! partially on faer's supernodal symbolic factor by the sequential multifrontal driver
+//! ([`crate::linsolve::multifrontal`]; measured faster than faer's own driver on these
+//! halves), the two on their own threads (`rayon::join`): A_i's columns are eliminated, and
+//! what is left where S's columns would be is M_i's Schur complement T_i, the last supernode's
+//! trailing block (S's columns are all in the last supernode of a half whose T_i is dense; the
+//! split is not made where they are not). S = T₀ + T₁ is factorized by dense LDLᵀ. Every
+//! piece is sequential and summed in a fixed order, so the factor is bitwise the same whether
+//! the halves run side by side or one after the other: the thread count changes the time,
+//! not the bits.
 //!
 //! Sylvester's law over the block elimination gives the inertia: the negative pivots of K are
 //! those of A₀ (the first pivots of M₀'s factor), of A₁ and of S.
 //!
-//! A solve of K x = b takes two solves with each M_i (again side by side):
-//! 1. [u_i; v_i] = M_i⁻¹ [b_i; 0], whence q_i = B_iᵀ A_i⁻¹ b_i = −T_i v_i;
+//! With L_SA, S's rows of M_i's factor in A_i's columns (L_SA D_A L_Aᵀ = B_iᵀ), a solve of
+//! K x = b takes one forward and one backward sweep over each half's A_i columns (the halves
+//! side by side):
+//! 1. the forward sweep on [b_i; 0] leaves y_i = L_A⁻¹ b_i in A_i's place and −q_i in S's,
+//!    q_i = L_SA y_i = B_iᵀ A_i⁻¹ b_i;
 //! 2. x_S = S⁻¹ (b_S − q₀ − q₁);
-//! 3. [x_i; x_S] = M_i⁻¹ [b_i; T_i (x_S − v_i)], which gives x_i = A_i⁻¹ (b_i − B_i x_S).
+//! 3. the backward sweep on [D_A⁻¹ y_i; x_S] gives x_i = L_A⁻ᵀ (D_A⁻¹ y_i − L_SAᵀ x_S)
+//!    = A_i⁻¹ (b_i − B_i x_S).
 //!
 //! Measured on the whole capped tube (`crates/fem/examples/subtree_split.rs`, `ORDER=ring`): the
 //! halves' flops equal the whole nested-dissection factor's within 1 %, and side by side they
@@ -38,7 +43,6 @@ use crate::linsolve::FactorizationError;
 use crate::FemError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
-use faer::linalg::matmul::triangular::BlockStructure;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLdltRef, SymbolicSupernodalCholesky};
 use faer::sparse::linalg::cholesky::{
@@ -70,15 +74,11 @@ struct Half {
     /// sharing C
     halved_from: usize,
     symbolic: SymbolicCholesky<usize>,
+    /// A_i's columns of M_i's factor and, where S's would be, T_i (its lower triangle), in
+    /// faer's supernodal layout (the last supernode holds all of S's columns)
     l_values: Vec<f64>,
-    /// T_i, the trailing block of L D Lᵀ (dense, both triangles), after a factorization
-    trailing: Mat<f64>,
-    /// L_SS, S's rows and columns of the factor (unit lower, D_S on the diagonal)
-    l_ss: Mat<f64>,
     /// A_i's pivots (the first of M_i's), in elimination order
     pivots: Vec<f64>,
-    /// W = L_SS D_S, the factorization's workspace for T_i
-    work: Mat<f64>,
     /// M_i's values at the last factorization
     vals: Vec<f64>,
     /// the numeric factorization's driver (built at the first factorization, then kept with
@@ -119,13 +119,15 @@ pub(crate) struct TreeSplit {
 
 impl Half {
     /// The bordered half `side` of the pattern `pairs` (row ≥ col) on `n` unknowns, with the
-    /// separator `separator` last.
+    /// separator `separator` last; `None` where S's columns of its factor are not all in its
+    /// last supernode (the partial factorization's condition, [`Multifrontal::partial`]:
+    /// where T_i is dense, as on a connected half, they are).
     fn new(
         sides: &[u8],
         side: u8,
         separator: &[usize],
         pairs: &[(usize, usize)],
-    ) -> Result<Self, FemError> {
+    ) -> Result<Option<Self>, FemError> {
         let n = sides.len();
         let own: Vec<usize> = (0..n).filter(|&k| sides[k] == side).collect();
         let mut local = vec![usize::MAX; n];
@@ -202,7 +204,15 @@ impl Half {
             },
         )
         .map_err(FactorizationError::Symbolic)?;
-        Ok(Self {
+        let last_begin = supernodal_of(&symbolic)
+            .supernode_begin()
+            .last()
+            .copied()
+            .unwrap_or(0);
+        if last_begin > members.len() {
+            return Ok(None);
+        }
+        Ok(Some(Self {
             members,
             pattern,
             source,
@@ -210,13 +220,10 @@ impl Half {
             halved_from,
             l_values: Vec::new(),
             symbolic,
-            trailing: Mat::zeros(0, 0),
-            l_ss: Mat::zeros(0, 0),
             pivots: Vec::new(),
-            work: Mat::new(),
             vals: Vec::new(),
             driver: None,
-        })
+        }))
     }
 
     fn dim(&self) -> usize {
@@ -226,18 +233,23 @@ impl Half {
     /// M_i's values in its pattern from K's `values` (duplicates summed; S × S halved).
     fn values(&self, values: &[f64]) -> Vec<f64> {
         let mut vals = Vec::new();
-        self.values_into(values, &mut vals);
+        // a non-finite value is the caller's to find (it is taken into the sum as it is)
+        let _finite = self.values_into(values, &mut vals);
         vals
     }
 
-    /// [`Half::values`] into `vals`' storage.
-    fn values_into(&self, values: &[f64], vals: &mut Vec<f64>) {
+    /// [`Half::values`] into `vals`' storage; whether every value it took was finite.
+    fn values_into(&self, values: &[f64], vals: &mut Vec<f64>) -> bool {
         vals.clear();
         vals.resize(self.pattern.compute_nnz(), 0.0);
+        let mut finite = true;
         for (k, (&e, &at)) in self.source.iter().zip(&self.slot).enumerate() {
             let w = if k < self.halved_from { 1.0 } else { 0.5 };
-            vals[at as usize] += w * values[e as usize];
+            let v = values[e as usize];
+            finite &= v.is_finite();
+            vals[at as usize] += w * v;
         }
+        finite
     }
 
     /// out += M_i x in K's unknowns (M_i's lower triangle `vals`, both triangles applied).
@@ -264,10 +276,12 @@ impl Half {
 
     /// M_i's values from K's `values` ([`Half::values`]), in the last factorization's storage
     /// (a million unknowns: 55 MB a half, allocated anew at every factorization before).
-    fn gather(&mut self, values: &[f64]) {
+    /// Returns whether every value it took was finite.
+    fn gather(&mut self, values: &[f64]) -> bool {
         let mut vals = std::mem::take(&mut self.vals);
-        self.values_into(values, &mut vals);
+        let finite = self.values_into(values, &mut vals);
         self.vals = vals;
+        finite
     }
 
     /// Add `delta` to the diagonal of the gathered values as a shift of K's diagonal would
@@ -283,21 +297,23 @@ impl Half {
         }
     }
 
-    /// The numeric LDLᵀ of M_i from its gathered values ([`Half::gather`]), then T_i; returns
-    /// the negative pivots of A_i. A zero pivot names its unknown of K (`separator`: S's, in
-    /// M_i's order).
+    /// The partial LDLᵀ of M_i from its gathered values ([`Half::gather`]): A_i's columns
+    /// eliminated, T_i left in S's place ([`Half::trailing`]); returns the negative pivots of
+    /// A_i. A zero pivot names its unknown of K (`separator`: S's, in M_i's order).
     fn factorize(&mut self, separator: &[usize]) -> Result<usize, FemError> {
+        let n = self.members.len();
         let driver = match &mut self.driver {
             Some(driver) => driver,
-            None => self
-                .driver
-                .insert(Multifrontal::new(self.supernodal(), self.pattern.as_ref())?),
+            None => self.driver.insert(Multifrontal::partial(
+                self.supernodal(),
+                self.pattern.as_ref(),
+                n,
+            )?),
         };
         let vals = std::mem::take(&mut self.vals);
         if self.l_values.len() != self.symbolic.len_val() {
             self.l_values = vec![0.0; self.symbolic.len_val()];
         }
-        let n = self.members.len();
         let global = |local: usize| {
             if local < n {
                 self.members[local]
@@ -320,98 +336,75 @@ impl Half {
             });
         self.vals = vals;
         factorized?;
-        let s = self.dim() - n;
+        // A_i's pivots, in elimination order
         let mut pivots = std::mem::take(&mut self.pivots);
-        let l_ss = std::mem::replace(&mut self.l_ss, Mat::new());
+        pivots.clear();
+        let mut negative = 0;
         let sn = self.supernodal();
         let (begin, end, ptr) = (
             sn.supernode_begin(),
             sn.supernode_end(),
             sn.col_ptr_for_val(),
         );
-        // the half's pivots, and S's part of the factor: L_SS (unit lower) and D_S
-        // the dense s × s blocks reuse the last factorization's storage: allocated anew at every
-        // factorization, blocks of some 10 MB (s = 1342 at a million unknowns) left the
-        // allocator's heap growing by about their size per factorization (measured: 5.56 GiB
-        // peak against 4.1 GiB after the first factorization)
-        let mut negative = 0;
-        pivots.clear();
-        let mut l = zeroed(l_ss, s);
         for k in 0..sn.n_supernodes() {
             let (b, e) = (begin[k], end[k]);
-            let pattern = sn.supernode(k).pattern();
-            let rows = e - b + pattern.len();
-            let block =
-                MatRef::from_column_major_slice(&self.l_values[ptr[k]..ptr[k + 1]], rows, e - b);
-            for j in 0..e - b {
-                let d = block[(j, j)];
-                if b + j < n {
-                    if !d.is_finite() || d == 0.0 {
-                        return Err(FemError::ZeroPivot {
-                            index: self.members[b + j],
-                            value: d,
-                        });
-                    }
-                    negative += usize::from(d < 0.0);
-                    pivots.push(d);
-                    continue;
+            let rows = (ptr[k + 1] - ptr[k]) / (e - b);
+            for j in 0..e.min(n).saturating_sub(b) {
+                let d = self.l_values[ptr[k] + j * rows + j];
+                if !d.is_finite() || d == 0.0 {
+                    return Err(FemError::ZeroPivot {
+                        index: self.members[b + j],
+                        value: d,
+                    });
                 }
-                let c = b + j - n;
-                l[(c, c)] = d;
-                for i in j + 1..e - b {
-                    l[(b + i - n, c)] = block[(i, j)];
-                }
-                for (t, &r) in pattern.iter().enumerate() {
-                    l[(r - n, c)] = block[(e - b + t, j)];
-                }
+                negative += usize::from(d < 0.0);
+                pivots.push(d);
             }
         }
-        // T_i = L D Lᵀ: W = L D (lower, D on the diagonal), then the lower half of W Lᵀ
-        let mut w = std::mem::replace(&mut self.work, Mat::new());
-        if w.nrows() != s {
-            w = Mat::zeros(s, s);
-        }
-        w.copy_from(&l);
-        for c in 0..s {
-            let d = l[(c, c)];
-            for r in c + 1..s {
-                w[(r, c)] *= d;
-            }
-        }
-        let mut t = zeroed(std::mem::replace(&mut self.trailing, Mat::new()), s);
-        faer::linalg::matmul::triangular::matmul(
-            t.as_mut(),
-            BlockStructure::TriangularLower,
-            Accum::Replace,
-            w.as_ref(),
-            BlockStructure::TriangularLower,
-            l.as_ref().transpose(),
-            BlockStructure::UnitTriangularUpper,
-            1.0,
-            Par::Seq,
-        );
-        for c in 0..s {
-            for r in c + 1..s {
-                t[(c, r)] = t[(r, c)];
-            }
-        }
-        self.trailing = t;
-        self.l_ss = l;
-        self.work = w;
         self.pivots = pivots;
         Ok(negative)
     }
 
-    /// y = L⁻¹ y in place (L: M_i's unit lower factor), supernode by supernode, as faer's
-    /// supernodal LDLᵀ solve does its first sweep (faer exposes the whole solve only).
+    /// T_i = C/2 − B_iᵀ A_i⁻¹ B_i from the last factorization: its lower triangle (the
+    /// entries above the diagonal are not part of it).
+    fn trailing(&self) -> MatRef<'_, f64> {
+        match &self.driver {
+            Some(driver) => driver.trailing(self.supernodal(), &self.l_values),
+            None => MatRef::from_column_major_slice(&[], 0, 0),
+        }
+    }
+
+    /// Supernode k of the factor of A_i's columns: its eliminated columns' diagonal block,
+    /// the block below it, and the unknowns (of M_i) of that block's rows. The last supernode
+    /// eliminates its columns before S's, and S's rows are below them.
+    fn eliminated<'a>(
+        &self,
+        factor: &SupernodalLdltRef<'a, usize, f64>,
+        k: usize,
+    ) -> (
+        usize,
+        MatRef<'a, f64>,
+        MatRef<'a, f64>,
+        impl Iterator<Item = usize> + Clone + 'a,
+    ) {
+        let node = factor.supernode(k);
+        let (start, c) = (node.start(), node.val().ncols());
+        let ce = c.min(self.members.len().saturating_sub(start));
+        let rows = (start + ce..start + c).chain(node.pattern().iter().copied());
+        let (top, bottom) = node.val().get(.., ..ce).split_at_row(ce);
+        (start, top, bottom, rows)
+    }
+
+    /// The forward sweep y = L⁻¹ y in place over A_i's columns (L: M_i's unit lower factor),
+    /// supernode by supernode, as faer's supernodal LDLᵀ solve does its first sweep (faer
+    /// exposes the whole solve only). On [b_i; 0] it leaves L_A⁻¹ b_i in A_i's unknowns and
+    /// −B_iᵀ A_i⁻¹ b_i in S's.
     fn forward(&self, y: &mut [f64]) {
         let sn = self.supernodal();
         let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
         let mut tmp = Vec::new();
         for k in 0..sn.n_supernodes() {
-            let node = factor.supernode(k);
-            let (top, bottom) = node.val().split_at_row(node.val().ncols());
-            let start = node.start();
+            let (start, top, bottom, rows) = self.eliminated(&factor, k);
             let mut x = MatMut::from_column_major_slice_mut(
                 &mut y[start..start + top.ncols()],
                 top.ncols(),
@@ -432,23 +425,22 @@ impl Half {
                 1.0,
                 Par::Seq,
             );
-            for (&i, &t) in node.pattern().iter().zip(&tmp) {
+            for (i, &t) in rows.zip(&tmp) {
                 y[i] -= t;
             }
         }
     }
 
-    /// y = L⁻ᵀ y in place, the solve's last sweep.
+    /// The backward sweep over A_i's columns, y_A = L_A⁻ᵀ (y_A − L_SAᵀ y_S) in place, with
+    /// S's entries y_S given.
     fn backward(&self, y: &mut [f64]) {
         let sn = self.supernodal();
         let factor = SupernodalLdltRef::<'_, usize, f64>::new(sn, &self.l_values);
         let mut tmp = Vec::new();
         for k in (0..sn.n_supernodes()).rev() {
-            let node = factor.supernode(k);
-            let (top, bottom) = node.val().split_at_row(node.val().ncols());
+            let (start, top, bottom, rows) = self.eliminated(&factor, k);
             tmp.clear();
-            tmp.extend(node.pattern().iter().map(|&i| y[i]));
-            let start = node.start();
+            tmp.extend(rows.map(|i| y[i]));
             let mut x = MatMut::from_column_major_slice_mut(
                 &mut y[start..start + top.ncols()],
                 top.ncols(),
@@ -490,8 +482,12 @@ impl TreeSplit {
         }
         let separator: Vec<usize> = (0..n).filter(|&k| sides[k] == 2).collect();
         // one after the other: METIS, which orders each half, is not reentrant
-        let h0 = Half::new(&sides, 0, &separator, pairs)?;
-        let h1 = Half::new(&sides, 1, &separator, pairs)?;
+        let Some(h0) = Half::new(&sides, 0, &separator, pairs)? else {
+            return Ok(None);
+        };
+        let Some(h1) = Half::new(&sides, 1, &separator, pairs)? else {
+            return Ok(None);
+        };
         let s = separator.len();
         Ok(Some(Self {
             n,
@@ -515,8 +511,8 @@ impl TreeSplit {
     }
 
     /// The flops of one factorization, counted as [`crate::linsolve::SparseLdlt::factor_flops`]
-    /// counts them: the two halves' sparse factors (S's columns included), the products
-    /// T_i = L D Lᵀ (s³/3 each) and S's dense LDLᵀ.
+    /// counts them: the two halves' partial factors (A_i's columns, their update of T_i
+    /// included) and S's dense LDLᵀ, that is, the flops of the whole factor in this order.
     pub(crate) fn flops(&self) -> f64 {
         let s = self.separator.len() as f64;
         let dense: f64 = (0..self.separator.len())
@@ -527,18 +523,30 @@ impl TreeSplit {
             .sum();
         self.halves
             .iter()
-            .map(|h| crate::linsolve::symbolic_flops(&h.symbolic, h.dim()))
+            .map(|h| crate::linsolve::supernodal_flops(h.supernodal(), h.members.len()))
             .sum::<f64>()
-            + 2.0 * s * s * s / 3.0
             + dense
     }
 
-    /// The stored entries of the factor: the halves' and S's lower triangle.
+    /// The entries of the factor: the halves' in A_i's columns and S's lower triangle.
     pub(crate) fn nnz(&self) -> usize {
         let s = self.separator.len();
         self.halves
             .iter()
-            .map(|h| h.symbolic.len_val())
+            .map(|h| {
+                let sn = h.supernodal();
+                let (begin, end, val) = (
+                    sn.supernode_begin(),
+                    sn.supernode_end(),
+                    sn.col_ptr_for_val(),
+                );
+                (0..sn.n_supernodes())
+                    .map(|k| {
+                        let c = end[k] - begin[k];
+                        (val[k + 1] - val[k]) / c * c.min(h.members.len().saturating_sub(begin[k]))
+                    })
+                    .sum::<usize>()
+            })
             .sum::<usize>()
             + s * (s + 1) / 2
     }
@@ -552,14 +560,15 @@ impl TreeSplit {
 
     /// The two halves' values from K's `values` (one per pair given to `new`), kept for
     /// [`TreeSplit::factorize_gathered`]: after this the split needs K's values no more.
-    pub(crate) fn gather(&mut self, values: &[f64]) {
+    /// Returns whether every value was finite (each value reaches at least one half).
+    pub(crate) fn gather(&mut self, values: &[f64]) -> bool {
         let [h0, h1] = &mut self.halves;
-        if self.parallel {
-            rayon::join(|| h0.gather(values), || h1.gather(values));
+        let (f0, f1) = if self.parallel {
+            rayon::join(|| h0.gather(values), || h1.gather(values))
         } else {
-            h0.gather(values);
-            h1.gather(values);
-        }
+            (h0.gather(values), h1.gather(values))
+        };
+        f0 && f1
     }
 
     /// Add `delta` to K's diagonal in the gathered values ([`TreeSplit::gather`]).
@@ -581,10 +590,15 @@ impl TreeSplit {
         };
         let (n0, n1) = (n0?, n1?);
         let s = self.separator.len();
-        // S = T₀ + T₁ in the last factorization's storage (see `Half::factorize`)
+        // S = T₀ + T₁ (lower triangles; the dense LDLᵀ reads no other) in the last
+        // factorization's storage
         let mut schur = zeroed(std::mem::replace(&mut self.schur, Mat::new()), s);
-        schur.copy_from(&self.halves[0].trailing);
-        schur += &self.halves[1].trailing;
+        let (t0, t1) = (self.halves[0].trailing(), self.halves[1].trailing());
+        for j in 0..s {
+            for i in j..s {
+                schur[(i, j)] = t0[(i, j)] + t1[(i, j)];
+            }
+        }
         let req = faer::linalg::cholesky::ldlt::factor::cholesky_in_place_scratch::<f64>(
             s,
             Par::Seq,
@@ -642,31 +656,19 @@ impl TreeSplit {
     /// Solve K x = rhs in place with the last factorization (see the module's steps).
     pub(crate) fn solve(&self, rhs: &mut [f64]) {
         let s = self.separator.len();
-        // 1. [w_i; z_i] = L⁻¹ [b_i; 0] in M_i's factor; q_i = B_iᵀ A_i⁻¹ b_i = −L_SS z_i
+        // 1. the forward sweep over A_i's columns on [b_i; 0]: y_i = L_A⁻¹ b_i, and in S's
+        //    place −q_i = −B_iᵀ A_i⁻¹ b_i
         let first = |h: &Half| {
-            let n = h.members.len();
             let mut y: Vec<f64> = h.members.iter().map(|&k| rhs[k]).collect();
             y.resize(h.dim(), 0.0);
             h.forward(&mut y);
-            let mut q = Mat::<f64>::zeros(s, 1);
-            faer::linalg::matmul::triangular::matmul(
-                q.as_mut(),
-                BlockStructure::Rectangular,
-                Accum::Replace,
-                h.l_ss.as_ref(),
-                BlockStructure::UnitTriangularLower,
-                MatRef::from_column_major_slice(&y[n..], s, 1),
-                BlockStructure::Rectangular,
-                -1.0,
-                Par::Seq,
-            );
-            (y, q)
+            y
         };
-        let ((mut y0, q0), (mut y1, q1)) =
-            self.join(|| first(&self.halves[0]), || first(&self.halves[1]));
+        let (mut y0, mut y1) = self.join(|| first(&self.halves[0]), || first(&self.halves[1]));
         // 2. x_S = S⁻¹ (b_S − q₀ − q₁)
+        let (n0, n1) = (self.halves[0].members.len(), self.halves[1].members.len());
         let mut x = Mat::<f64>::from_fn(s, 1, |i, _| {
-            rhs[self.separator[i]] - q0[(i, 0)] - q1[(i, 0)]
+            rhs[self.separator[i]] + y0[n0 + i] + y1[n1 + i]
         });
         faer::linalg::cholesky::ldlt::solve::solve_in_place_with_conj(
             self.schur.as_ref(),
@@ -676,23 +678,15 @@ impl TreeSplit {
             Par::Seq,
             MemStack::new(&mut MemBuffer::new(faer::dyn_stack::StackReq::EMPTY)),
         );
-        // 3. x_i = L⁻ᵀ [D_A⁻¹ w_i; L_SSᵀ x_S] (the first block): A_i⁻¹ (b_i − B_i x_S)
+        // 3. x_i = L_A⁻ᵀ (D_A⁻¹ y_i − L_SAᵀ x_S) = A_i⁻¹ (b_i − B_i x_S)
         let second = |h: &Half, y: &mut Vec<f64>| {
             let n = h.members.len();
             for (v, d) in y[..n].iter_mut().zip(&h.pivots) {
                 *v /= d;
             }
-            faer::linalg::matmul::triangular::matmul(
-                MatMut::from_column_major_slice_mut(&mut y[n..], s, 1),
-                BlockStructure::Rectangular,
-                Accum::Replace,
-                h.l_ss.as_ref().transpose(),
-                BlockStructure::UnitTriangularUpper,
-                x.as_ref(),
-                BlockStructure::Rectangular,
-                1.0,
-                Par::Seq,
-            );
+            for (v, i) in y[n..].iter_mut().zip(0..s) {
+                *v = x[(i, 0)];
+            }
             h.backward(y);
         };
         self.join(
@@ -742,7 +736,7 @@ impl SplitMatrix<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linsolve::{Layout, SparseLdlt};
+    use crate::linsolve::{Factor, Layout, SparseLdlt};
     use crate::ordering::Ordering;
 
     /// n, the pairs, their values, a solution x, b = K x and the negative eigenvalues.
@@ -992,5 +986,29 @@ mod tests {
                 Err(FemError::ZeroPivot { .. })
             ));
         }
+        // a non-finite value is named by its entry, split or whole (the split's halves see it
+        // as they gather; an entry of S × S is halved, an infinity stays one)
+        let in_separator = pairs
+            .iter()
+            .position(|&(r, c)| r != c && split_sides_are_separator(&split, r, c))
+            .expect("an entry coupling two unknowns of S");
+        for (entry, bad) in [(7, f64::NAN), (in_separator, f64::INFINITY)] {
+            let mut values = vals.clone();
+            values[entry] = bad;
+            for ldlt in [&mut split, &mut whole] {
+                assert!(matches!(
+                    ldlt.factorize_shifted(values.clone(), &diagonal, &[1.0]),
+                    Err(FemError::NonFiniteEntry { entry: e }) if e == entry
+                ));
+            }
+        }
+    }
+
+    /// Whether unknowns `r` and `c` are both in the split's separator.
+    fn split_sides_are_separator(ldlt: &SparseLdlt, r: usize, c: usize) -> bool {
+        let Factor::Split(t) = &ldlt.factor else {
+            return false;
+        };
+        t.separator.binary_search(&r).is_ok() && t.separator.binary_search(&c).is_ok()
     }
 }
