@@ -54,6 +54,19 @@ pub fn dominant_matrix(
     for (k, &p) in perm.iter().enumerate() {
         inv[p] = k;
     }
+    let triplets: Vec<Triplet<usize, usize, f64>> = pairs
+        .iter()
+        .zip(dominant_values(n, pairs))
+        .map(|(&(r, c), v)| {
+            let (pr, pc) = (inv[r], inv[c]);
+            Triplet::new(pr.max(pc), pr.min(pc), v)
+        })
+        .collect();
+    SparseColMat::try_new_from_triplets(n, n, &triplets).expect("matrix")
+}
+
+/// The values of [`dominant_matrix`], one per pair (unpermuted).
+pub fn dominant_values(n: usize, pairs: &[(usize, usize)]) -> Vec<f64> {
     let off = |r: usize, c: usize| {
         let (a, b) = (r % 3, c % 3);
         if a == b {
@@ -69,15 +82,10 @@ pub fn dominant_matrix(
             diagonal[c] -= off(r, c);
         }
     }
-    let triplets: Vec<Triplet<usize, usize, f64>> = pairs
+    pairs
         .iter()
-        .map(|&(r, c)| {
-            let (pr, pc) = (inv[r], inv[c]);
-            let v = if r == c { diagonal[r] } else { off(r, c) };
-            Triplet::new(pr.max(pc), pr.min(pc), v)
-        })
-        .collect();
-    SparseColMat::try_new_from_triplets(n, n, &triplets).expect("matrix")
+        .map(|&(r, c)| if r == c { diagonal[r] } else { off(r, c) })
+        .collect()
 }
 
 /// The mesh size from the command line: AROUND ALONG (default 448 × 560, the
