@@ -8,6 +8,7 @@
 //! ```
 //! (default 448 × 560, the million-unknown benchmark's mesh; `ROUNDS=N`, default 5.) Prints
 //! each driver's median seconds and GFLOP/s, the largest difference between the two factors,
+//! the entries of the update matrices the multifrontal driver forms against the factor's,
 //! the multifrontal driver's time by phase (the dense kernels — diagonal blocks and update
 //! products — against zeroing, assembling, extend-adding and copying, which move memory) and
 //! the memory each keeps beside the factor.
@@ -112,6 +113,11 @@ fn main() {
         driver.workspace_bytes() as f64 / 1e6
     );
     println!("  largest difference between the factors: {worst:.1e}");
+    println!(
+        "  the update matrices' entries (the extend-add's traffic): {:.1} M, against the factor's {:.1} M",
+        driver.update_entries(sn) as f64 / 1e6,
+        sym.len_val() as f64 / 1e6
+    );
     let Phases {
         matrix,
         extend_own,

@@ -438,6 +438,21 @@ impl Multifrontal {
         )
     }
 
+    /// The entries of all the update matrices it forms in one factorization (their lower
+    /// triangles, Σ r (r + 1)/2 over the supernodes that form one): the memory traffic of the
+    /// extend-add, against the factor's own entries.
+    pub fn update_entries(&self, sn: &SymbolicSupernodalCholesky<usize>) -> usize {
+        let last = sn.n_supernodes().saturating_sub(1);
+        (0..sn.n_supernodes())
+            .map(|s| {
+                let r = shape(sn, s).2.len();
+                // a partial factorization's last supernode updates its own trailing block
+                let kept = if s == last { sn.nrows() - self.stop } else { 0 };
+                (r + kept) * (r + kept + 1) / 2
+            })
+            .sum()
+    }
+
     /// The bytes this driver keeps beside the factor: its update-matrix arena, its entry map,
     /// W and the index arrays.
     pub fn workspace_bytes(&self) -> usize {
