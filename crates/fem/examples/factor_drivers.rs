@@ -7,11 +7,14 @@
 //! cargo run --release -p tubemem-fem --example factor_drivers -- [AROUND ALONG]
 //! ```
 //! (default 448 × 560, the million-unknown benchmark's mesh; `ROUNDS=N`, default 5.) Prints
-//! each driver's median seconds and GFLOP/s, the largest difference between the two factors,
-//! the entries of the update matrices the multifrontal driver forms against the factor's,
-//! the multifrontal driver's time by phase (the dense kernels — diagonal blocks and update
-//! products — against zeroing, assembling, extend-adding and copying, which move memory) and
-//! the memory each keeps beside the factor.
+//! each driver's median seconds, GFLOP/s and the memory it keeps beside the factor, the
+//! largest difference between the two factors, the entries of the update matrices the
+//! multifrontal driver forms against the factor's, and the multifrontal driver's time by phase
+//! — the dense kernels (diagonal blocks, update products; their rate is the flops over their
+//! seconds, since every flop is spent there) against zeroing, assembling, extend-adding and
+//! copying, which move memory — beside faer's matrix product on one thread. With `PAIR=1` it
+//! also runs two multifrontal factorizations side by side, each on its own thread as the
+//! split's halves run, and prints each one's phases against the product on both threads.
 mod tube_pattern;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -20,7 +23,6 @@ use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 use faer::{Par, Side};
 use std::time::Instant;
 use tubemem_fem::linsolve::multifrontal::{Multifrontal, Phases};
-use tubemem_mesh::{tube::capped_tube, Symmetry};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -28,13 +30,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    let (around, along) = tube_pattern::around_along();
-    let rounds: usize = std::env::var("ROUNDS")
-        .ok()
-        .and_then(|r| r.parse().ok())
-        .unwrap_or(5);
-    let mesh = capped_tube(1.0, 20.0, around, along, Symmetry::None).expect("mesh");
-    let (n, pairs) = tube_pattern::pairs(&mesh);
+    let rounds = tube_pattern::rounds();
+    let (n, pairs) = tube_pattern::tube_pairs();
     let perm = tubemem_fem::ordering::nested_dissection(n, &pairs).expect("ordering");
     let m = tube_pattern::dominant_matrix(n, &pairs, &perm);
     let sym = tube_pattern::symbolic(&m, None);
@@ -118,6 +115,60 @@ fn main() {
         driver.update_entries(sn) as f64 / 1e6,
         sym.len_val() as f64 / 1e6
     );
+    print_phases("its fastest round", &phases, flops);
+    println!(
+        "  faer's matrix product on one thread: {:.1} GFLOP/s",
+        tube_pattern::matmul_peak(Par::Seq)
+    );
+    if std::env::var("PAIR").is_ok() {
+        // two factorizations side by side, each on its own thread, as the split's two halves
+        // run: the dense kernels and the memory-bound phases with both cores busy
+        let mut second = Multifrontal::new(sn, m.symbolic()).expect("driver");
+        let mut other = vec![0.0; sym.len_val()];
+        let mut best: Option<(f64, Phases, Phases)> = None;
+        for round in 0..=rounds {
+            let t = Instant::now();
+            let (p, q) = rayon::join(
+                || {
+                    let mut p = Phases::default();
+                    driver
+                        .factorize(sn, m.val(), &mut ours, Some(&mut p))
+                        .expect("multifrontal");
+                    p
+                },
+                || {
+                    let mut q = Phases::default();
+                    second
+                        .factorize(sn, m.val(), &mut other, Some(&mut q))
+                        .expect("multifrontal");
+                    q
+                },
+            );
+            let s = t.elapsed().as_secs_f64();
+            eprintln!("pair round {round}: {s:.3} s");
+            if round > 0 && best.as_ref().is_none_or(|b| s < b.0) {
+                best = Some((s, p, q));
+            }
+        }
+        if let Some((s, p, q)) = best {
+            println!(
+                "  two side by side (PAIR), their fastest round {s:.3} s = {:.1} GFLOP/s together:",
+                2.0 * flops / s / 1e9
+            );
+            print_phases("first", &p, flops);
+            print_phases("second", &q, flops);
+            println!(
+                "  faer's matrix product on both threads: {:.1} GFLOP/s",
+                tube_pattern::matmul_peak(Par::rayon(0))
+            );
+        }
+    }
+}
+
+/// The multifrontal driver's `phases` (one factorization of `flops`) and the rate of its dense
+/// kernels: the flops over the seconds of the diagonal blocks and the update products, where
+/// every flop is spent.
+fn print_phases(label: &str, phases: &Phases, flops: f64) {
     let Phases {
         matrix,
         extend_own,
@@ -125,9 +176,9 @@ fn main() {
         copy,
         update,
         extend_update,
-    } = phases;
+    } = *phases;
     let total = matrix + extend_own + diagonal + copy + update + extend_update;
-    println!("  multifrontal by phase (its fastest round, {total:.3} s):");
+    println!("  multifrontal by phase ({label}, {total:.3} s):");
     for (name, s) in [
         ("diagonal blocks (dense LDLᵀ, solve)", diagonal),
         ("update products", update),
@@ -138,4 +189,9 @@ fn main() {
     ] {
         println!("    {name:38} {s:.3} s ({:.0} %)", 100.0 * s / total);
     }
+    println!(
+        "    the dense kernels' rate: {:.1} GFLOP/s; the memory-bound phases: {:.3} s",
+        flops / (diagonal + update) / 1e9,
+        matrix + extend_own + extend_update + copy
+    );
 }

@@ -16,45 +16,19 @@
 //! touches the factor's pages and is not counted.
 mod tube_pattern;
 
-use faer::{linalg::matmul::matmul, Accum, Mat, Par};
+use faer::Par;
 use std::time::Instant;
 use tubemem_fem::linsolve::{Layout, SparseLdlt};
 use tubemem_fem::ordering::Ordering;
-use tubemem_mesh::{tube::capped_tube, Symmetry};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
-/// faer's matrix product on every thread, n = 3000, best of 2: GFLOP/s.
-fn peak(a: &Mat<f64>, b: &Mat<f64>, c: &mut Mat<f64>) -> f64 {
-    let n = a.nrows() as f64;
-    let best = (0..2)
-        .map(|_| {
-            let t = Instant::now();
-            matmul(
-                c.as_mut(),
-                Accum::Add,
-                a.as_ref(),
-                b.as_ref(),
-                1.0,
-                Par::rayon(0),
-            );
-            t.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min);
-    2.0 * n * n * n / best / 1e9
-}
-
 fn main() {
-    let (around, along) = tube_pattern::around_along();
-    let rounds: usize = std::env::var("ROUNDS")
-        .ok()
-        .and_then(|r| r.parse().ok())
-        .unwrap_or(5);
-    let mesh = capped_tube(1.0, 20.0, around, along, Symmetry::None).expect("mesh");
-    let (n, pairs) = tube_pattern::pairs(&mesh);
+    let rounds = tube_pattern::rounds();
+    let (n, pairs) = tube_pattern::tube_pairs();
     let values = tube_pattern::dominant_values(n, &pairs);
     let diagonal: Vec<usize> = (0..pairs.len())
         .filter(|&e| pairs[e].0 == pairs[e].1)
@@ -70,10 +44,6 @@ fn main() {
         ldlt.factor_nnz() as f64 / 1e6,
         flops / 1e9
     );
-    let m = 3000;
-    let a = Mat::<f64>::from_fn(m, m, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.5);
-    let b = Mat::<f64>::from_fn(m, m, |i, j| ((i * 5 + j * 13) % 17) as f64 / 17.0 - 0.5);
-    let mut c = Mat::<f64>::zeros(m, m);
     let (mut seconds, mut peaks, mut shares) = (Vec::new(), Vec::new(), Vec::new());
     for round in 0..=rounds {
         let taken = values.clone();
@@ -81,7 +51,7 @@ fn main() {
         ldlt.factorize_shifted(taken, &diagonal, &[])
             .expect("the matrix is positive definite");
         let s = t.elapsed().as_secs_f64();
-        let g = peak(&a, &b, &mut c);
+        let g = tube_pattern::matmul_peak(Par::rayon(0));
         let share = flops / s / 1e9 / g;
         println!(
             "  round {round}: {s:.3} s = {:.1} GFLOP/s; dense peak {g:.1} GFLOP/s; {:.0} %{}",
@@ -95,7 +65,6 @@ fn main() {
             shares.push(share);
         }
     }
-    assert!(c.norm_l2().is_finite());
     let s = median(seconds);
     println!(
         "median of {rounds}: {s:.3} s = {:.1} GFLOP/s; dense peak {:.1} GFLOP/s; share {:.0} % (median of the rounds' shares)",

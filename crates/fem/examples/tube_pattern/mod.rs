@@ -101,6 +101,43 @@ pub fn around_along() -> (usize, usize) {
     )
 }
 
+/// faer's matrix product C ← C + A B (n = 3000, best of 2) with `par`: GFLOP/s, the dense peak
+/// as `dense_peak` measures it, for an example to take beside its own timing.
+pub fn matmul_peak(par: Par) -> f64 {
+    use faer::{linalg::matmul::matmul, Accum, Mat};
+    let n = 3000;
+    let a = Mat::<f64>::from_fn(n, n, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.5);
+    let b = Mat::<f64>::from_fn(n, n, |i, j| ((i * 5 + j * 13) % 17) as f64 / 17.0 - 0.5);
+    let mut c = Mat::<f64>::zeros(n, n);
+    let best = (0..2)
+        .map(|_| {
+            let t = Instant::now();
+            matmul(c.as_mut(), Accum::Add, a.as_ref(), b.as_ref(), 1.0, par);
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(c.norm_l2().is_finite());
+    2.0 * (n as f64).powi(3) / best / 1e9
+}
+
+/// The rounds a timing example repeats its measure (`ROUNDS`, default 5).
+pub fn rounds() -> usize {
+    std::env::var("ROUNDS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(5)
+}
+
+/// The whole capped tube of the command line's size ([`around_along`]; R = 1, L = 20, no
+/// symmetry): its unknowns and [`pairs`].
+pub fn tube_pairs() -> (usize, Vec<(usize, usize)>) {
+    let (around, along) = around_along();
+    let mesh =
+        tubemem_mesh::tube::capped_tube(1.0, 20.0, around, along, tubemem_mesh::Symmetry::None)
+            .expect("mesh");
+    pairs(&mesh)
+}
+
 /// faer's supernodal symbolic factor of `m` (lower triangle, already ordered) with the
 /// supernode relaxation `relax` (faer's default if None).
 pub fn symbolic(
