@@ -165,9 +165,18 @@ pub(crate) fn dict_message(msg: &str, text: &str) -> String {
 
 /// The case file's names in a message, as the dict paths and arguments of the Python API:
 /// `[[stage]] N: \`key\`` → `stage[N-1].key`, `[[stage]] N` → `stage[N-1]`, `[table] \`key\``
-/// → `table.key`, and the CLI's `--overwrite`, `--out`, `--resume` → `overwrite=True`, `out`,
+/// → `table.key`, `[material]: invalid material parameter \`key\`` → `material.key`, and the CLI's `--overwrite`, `--out`, `--resume` → `overwrite=True`, `out`,
 /// the CLI's `tubemem run --resume`.
 pub(crate) fn pythonic(msg: &str) -> String {
+    // the material's own check under the case's table, `[material]: invalid material
+    // parameter \`key\` = value: …`, as the other checks name a key: `material.key = value: …`
+    let material = msg
+        .split_once("[material]: invalid material parameter `")
+        .and_then(|(before, after)| {
+            let (key, tail) = after.split_once('`')?;
+            Some(format!("{before}material.{key}{tail}"))
+        });
+    let msg = material.as_deref().unwrap_or(msg);
     let mut out = String::with_capacity(msg.len());
     let mut rest = msg;
     while !rest.is_empty() {

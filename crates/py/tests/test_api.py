@@ -599,6 +599,10 @@ def test_case_validates_the_whole_plan_on_construction(tmp_path):
     stages = [tables["stage"][0], dict(tables["stage"][1], target_rho=1.5)]
     with pytest.raises(ValueError, match=r"stage\[1\]\.target_rho = 1.5: the plates must close on the tube"):
         tubemem.Case(**dict(tables, stage=stages))
+    # the material's own check names its key as the others do (it said `[material]: invalid
+    # material parameter \`shear_modulus\``, the case file's style, in a dict's message)
+    with pytest.raises(ValueError, match=r"case dict: material\.shear_modulus = -1: must be finite and > 0$"):
+        tubemem.Case(**dict(tables, material=dict(tables["material"], shear_modulus=-1.0)))
     assert not any(tmp_path.iterdir())
 
 
