@@ -48,6 +48,10 @@ pub trait Observer {
     /// `[solver] mesh_sequencing`: the case runs first on the tube of `around` × `along`
     /// elements, before this run's model is built ([`crate::sequencing`]).
     fn coarse_started(&mut self, _around: usize, _along: usize) {}
+    /// The coarse run of `[solver] mesh_sequencing` ended: it finished `stages` of the case's
+    /// stages with `steps` converged steps in `seconds` (its failure, if any, comes as the
+    /// run's warning).
+    fn coarse_finished(&mut self, _stages: usize, _steps: usize, _seconds: f64) {}
     fn stage_started(&mut self, _plan: &StagePlan, _stages: usize) {}
     /// A converged step; an error stops the run.
     fn step(&mut self, _view: &StepView) -> Result<(), BoxError> {

@@ -113,7 +113,9 @@ impl Coarse {
             mesh: None,
             stages: Vec::new(),
         };
+        let started = std::time::Instant::now();
         let outcome = solve(&coarse, &mut collector);
+        let seconds = started.elapsed().as_secs_f64();
         if let Some(e @ AppError::Interrupted { .. }) = outcome.error {
             return Err(e);
         }
@@ -134,6 +136,10 @@ impl Coarse {
             .count();
         let mut stages = collector.stages;
         stages.truncate(finished);
+        let steps = stages.iter().map(Vec::len).sum();
+        for o in observers.iter_mut() {
+            o.coarse_finished(finished, steps, seconds);
+        }
         let warning = outcome.error.map(|e| {
             format!(
                 "[solver] mesh_sequencing: the coarse run ({around} around) stopped after {finished} finished stage(s) ({}); the stages after them were stepped without it",

@@ -68,7 +68,13 @@ impl Observer for Console {
     fn coarse_started(&mut self, around: usize, along: usize) {
         // the console's own line; a closed stderr loses it, as it loses every progress line
         let _ = say!(
-            "mesh sequencing: the case runs first on the tube of {around} × {along} elements; its steps start this run's"
+            "mesh sequencing: the case runs first on the tube of {around} × {along} elements, and each step of this run starts from that run's state"
+        );
+    }
+
+    fn coarse_finished(&mut self, stages: usize, steps: usize, seconds: f64) {
+        let _ = say!(
+            "mesh sequencing: the coarse run finished {stages} stage(s) in {steps} step(s), {seconds:.1} s"
         );
     }
 

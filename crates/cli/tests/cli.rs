@@ -1277,10 +1277,15 @@ fn a_killed_sequenced_run_resumes_bit_identical() {
     );
     let o = run_in(&case, &killed, &["--resume"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
-        String::from_utf8_lossy(&o.stdout).contains("mesh sequencing: the case runs first"),
-        "{}",
-        String::from_utf8_lossy(&o.stdout)
+        stdout.contains("mesh sequencing: the case runs first"),
+        "{stdout}"
+    );
+    // the coarse run's end, with its two stages (inflation and squeeze)
+    assert!(
+        stdout.contains("mesh sequencing: the coarse run finished 2 stage(s) in "),
+        "{stdout}"
     );
     assert_same_run(
         &reference,
