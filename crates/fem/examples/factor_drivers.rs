@@ -24,11 +24,6 @@ use faer::{Par, Side};
 use std::time::Instant;
 use tubemem_fem::linsolve::multifrontal::{Multifrontal, Phases};
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 fn main() {
     let rounds = tube_pattern::rounds();
     let (n, pairs) = tube_pattern::tube_pairs();
@@ -92,7 +87,7 @@ fn main() {
         .zip(&theirs)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    let (a, b) = (median(t_faer), median(t_ours));
+    let (a, b) = (tube_pattern::median(t_faer), tube_pattern::median(t_ours));
     println!(
         "{n} unknowns, nested dissection, {} supernodes, {:.1} GFLOP per factorization, one thread, medians of {rounds}:",
         sn.n_supernodes(),

@@ -21,11 +21,6 @@ use std::time::Instant;
 use tubemem_fem::linsolve::{Layout, SparseLdlt};
 use tubemem_fem::ordering::Ordering;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 fn main() {
     let rounds = tube_pattern::rounds();
     let (n, pairs) = tube_pattern::tube_pairs();
@@ -65,11 +60,11 @@ fn main() {
             shares.push(share);
         }
     }
-    let s = median(seconds);
+    let s = tube_pattern::median(seconds);
     println!(
         "median of {rounds}: {s:.3} s = {:.1} GFLOP/s; dense peak {:.1} GFLOP/s; share {:.0} % (median of the rounds' shares)",
         flops / s / 1e9,
-        median(peaks),
-        100.0 * median(shares)
+        tube_pattern::median(peaks),
+        100.0 * tube_pattern::median(shares)
     );
 }

@@ -120,6 +120,12 @@ pub fn matmul_peak(par: Par) -> f64 {
     2.0 * (n as f64).powi(3) / best / 1e9
 }
 
+/// The median of `v` (the upper one of an even count).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
 /// The rounds a timing example repeats its measure (`ROUNDS`, default 5).
 pub fn rounds() -> usize {
     std::env::var("ROUNDS")
