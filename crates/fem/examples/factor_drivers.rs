@@ -17,10 +17,9 @@
 //! split's halves run, and prints each one's phases against the product on both threads.
 mod tube_pattern;
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::dyn_stack::MemBuffer;
 use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
-use faer::{Par, Side};
+use faer::Par;
 use std::time::Instant;
 use tubemem_fem::linsolve::multifrontal::{Multifrontal, Phases};
 
@@ -55,16 +54,7 @@ fn main() {
     let mut phases = Phases::default();
     for round in 0..=rounds {
         let t = Instant::now();
-        sym.factorize_numeric_ldlt::<f64>(
-            &mut theirs,
-            m.as_ref(),
-            Side::Lower,
-            LdltRegularization::default(),
-            Par::Seq,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .expect("faer");
+        tube_pattern::faer_ldlt(&m, &sym, &mut theirs, Par::Seq, &mut mem);
         let a = t.elapsed().as_secs_f64();
         let mut p = Phases::default();
         let t = Instant::now();

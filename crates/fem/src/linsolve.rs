@@ -71,6 +71,21 @@ pub(crate) fn symbolic_flops(symbolic: &SymbolicCholesky<usize>, n: usize) -> f6
     }
 }
 
+/// The entries of the factor in the columns before `stop` of the supernodal structure `s`
+/// (all of its values for `stop` = n; a partial factorization's factor otherwise).
+pub(crate) fn supernodal_entries(
+    s: &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>,
+    stop: usize,
+) -> usize {
+    let (begin, end, val) = (s.supernode_begin(), s.supernode_end(), s.col_ptr_for_val());
+    (0..s.n_supernodes())
+        .map(|k| {
+            let ncols = end[k] - begin[k];
+            (val[k + 1] - val[k]) / ncols * ncols.min(stop.saturating_sub(begin[k]))
+        })
+        .sum()
+}
+
 /// The flops of eliminating the columns before `stop` of the supernodal structure `s` (all
 /// of them for `stop` = n; a partial factorization's, [`multifrontal::Multifrontal::partial`],
 /// otherwise), counted as [`symbolic_flops`] counts them.

@@ -184,6 +184,27 @@ pub fn factor_seconds(
     (seconds, bytes)
 }
 
+/// faer's numeric LDLᵀ of `m` (lower triangle, ordered) on `s` into `l`, with the workspace
+/// `mem` (`s.factorize_numeric_ldlt_scratch` for `par`).
+pub fn faer_ldlt(
+    m: &SparseColMat<usize, f64>,
+    s: &SymbolicCholesky<usize>,
+    l: &mut [f64],
+    par: Par,
+    mem: &mut MemBuffer,
+) {
+    s.factorize_numeric_ldlt::<f64>(
+        l,
+        m.as_ref(),
+        Side::Lower,
+        LdltRegularization::default(),
+        par,
+        MemStack::new(mem),
+        Default::default(),
+    )
+    .expect("numeric");
+}
+
 /// [`factor_seconds`] with the factor's values.
 pub fn factor(
     m: &SparseColMat<usize, f64>,
@@ -197,16 +218,7 @@ pub fn factor(
     let mut best = f64::INFINITY;
     for round in 0..=rounds {
         let t = Instant::now();
-        s.factorize_numeric_ldlt::<f64>(
-            &mut l,
-            m.as_ref(),
-            Side::Lower,
-            LdltRegularization::default(),
-            par,
-            MemStack::new(&mut mem),
-            Default::default(),
-        )
-        .expect("numeric");
+        faer_ldlt(m, s, &mut l, par, &mut mem);
         if std::env::var("ROUNDS").is_ok() {
             eprintln!("round {round}: {:.3} s", t.elapsed().as_secs_f64());
         }

@@ -86,8 +86,8 @@ struct Half {
     driver: Option<Multifrontal>,
 }
 
-/// The supernodal structure of a half's symbolic factor (`Half::new` forces that layout, so
-/// the simplicial arm cannot be reached).
+/// The supernodal structure of a half's symbolic factor (`Half::new` makes no half of another
+/// layout, so the simplicial arm cannot be reached).
 fn supernodal_of(symbolic: &SymbolicCholesky<usize>) -> &SymbolicSupernodalCholesky<usize> {
     match symbolic.raw() {
         SymbolicCholeskyRaw::Supernodal(sn) => sn,
@@ -204,12 +204,11 @@ impl Half {
             },
         )
         .map_err(FactorizationError::Symbolic)?;
-        let last_begin = supernodal_of(&symbolic)
-            .supernode_begin()
-            .last()
-            .copied()
-            .unwrap_or(0);
-        if last_begin > members.len() {
+        // the layout forced above, with S's columns all in the last supernode; else no split
+        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else {
+            return Ok(None);
+        };
+        if sn.supernode_begin().last().copied().unwrap_or(0) > members.len() {
             return Ok(None);
         }
         Ok(Some(Self {
@@ -533,20 +532,7 @@ impl TreeSplit {
         let s = self.separator.len();
         self.halves
             .iter()
-            .map(|h| {
-                let sn = h.supernodal();
-                let (begin, end, val) = (
-                    sn.supernode_begin(),
-                    sn.supernode_end(),
-                    sn.col_ptr_for_val(),
-                );
-                (0..sn.n_supernodes())
-                    .map(|k| {
-                        let c = end[k] - begin[k];
-                        (val[k + 1] - val[k]) / c * c.min(h.members.len().saturating_sub(begin[k]))
-                    })
-                    .sum::<usize>()
-            })
+            .map(|h| crate::linsolve::supernodal_entries(h.supernodal(), h.members.len()))
             .sum::<usize>()
             + s * (s + 1) / 2
     }
