@@ -155,20 +155,18 @@ fn main() {
 /// every flop is spent.
 fn print_phases(label: &str, phases: &Phases, flops: f64) {
     let Phases {
-        matrix,
-        extend_own,
+        assembly,
         diagonal,
         copy,
         update,
         extend_update,
     } = *phases;
-    let total = matrix + extend_own + diagonal + copy + update + extend_update;
+    let total = assembly + diagonal + copy + update + extend_update;
     println!("  multifrontal by phase ({label}, {total:.3} s):");
     for (name, s) in [
         ("diagonal blocks (dense LDLᵀ, solve)", diagonal),
         ("update products", update),
-        ("zeroing, taking the matrix", matrix),
-        ("extend-add into own columns", extend_own),
+        ("zeroing, matrix, extend-add into own", assembly),
         ("extend-add into update matrices", extend_update),
         ("W copy and scaling", copy),
     ] {
@@ -177,6 +175,6 @@ fn print_phases(label: &str, phases: &Phases, flops: f64) {
     println!(
         "    the dense kernels' rate: {:.1} GFLOP/s; the memory-bound phases: {:.3} s",
         flops / (diagonal + update) / 1e9,
-        matrix + extend_own + extend_update + copy
+        assembly + extend_update + copy
     );
 }
