@@ -52,6 +52,10 @@ pub trait Observer {
     /// stages with `steps` converged steps in `seconds` (its failure, if any, comes as the
     /// run's warning).
     fn coarse_finished(&mut self, _stages: usize, _steps: usize, _seconds: f64) {}
+    /// A converged step of the coarse run of `[solver] mesh_sequencing`, between
+    /// [`Observer::coarse_started`] and [`Observer::coarse_finished`] (its own coarse run's
+    /// steps, at two levels and more, are not passed on).
+    fn coarse_step(&mut self, _view: &StepView) {}
     fn stage_started(&mut self, _plan: &StagePlan, _stages: usize) {}
     /// A converged step; an error stops the run.
     fn step(&mut self, _view: &StepView) -> Result<(), BoxError> {

@@ -53,12 +53,14 @@ pub fn coarse_case(case: &Case) -> Case {
 
 /// The converged steps of a coarse run: its mesh and, per stage, the fraction of the stage and
 /// the state at each converged step.
-struct Collector {
+struct Collector<'o, 'p> {
     mesh: Option<Mesh>,
     stages: Vec<Vec<(f64, State)>>,
+    /// the run's observers, told of each converged coarse step
+    observers: &'o mut [&'p mut dyn Observer],
 }
 
-impl Observer for Collector {
+impl Observer for Collector<'_, '_> {
     fn started(
         &mut self,
         _report: &RunReport,
@@ -75,6 +77,9 @@ impl Observer for Collector {
             self.stages.resize_with(i + 1, Vec::new);
         }
         self.stages[i].push((view.fraction, view.state.clone()));
+        for o in self.observers.iter_mut() {
+            o.coarse_step(view);
+        }
         Ok(())
     }
 }
@@ -109,17 +114,19 @@ impl Coarse {
         for o in observers.iter_mut() {
             o.coarse_started(around, coarse.mesh.along.unwrap_or(0));
         }
+        let started = std::time::Instant::now();
         let mut collector = Collector {
             mesh: None,
             stages: Vec::new(),
+            observers: &mut *observers,
         };
-        let started = std::time::Instant::now();
         let outcome = solve(&coarse, &mut collector);
+        let (mesh, stages) = (collector.mesh, collector.stages);
         let seconds = started.elapsed().as_secs_f64();
         if let Some(e @ AppError::Interrupted { .. }) = outcome.error {
             return Err(e);
         }
-        let Some(mesh) = collector.mesh else {
+        let Some(mesh) = mesh else {
             return Err(AppError::Sequencing {
                 around,
                 source: Box::new(outcome.error.unwrap_or(AppError::Case(
@@ -134,7 +141,7 @@ impl Coarse {
             .iter()
             .take_while(|s| matches!(s.outcome, StageOutcome::Finished(_)))
             .count();
-        let mut stages = collector.stages;
+        let mut stages = stages;
         stages.truncate(finished);
         let steps = stages.iter().map(Vec::len).sum();
         for o in observers.iter_mut() {

@@ -78,6 +78,19 @@ impl Observer for Console {
         );
     }
 
+    fn coarse_step(&mut self, v: &StepView) {
+        let r = v.record;
+        let _ = say!(
+            "  mesh sequencing: coarse stage {} step {}: ϖ = {:.5}, λs = {:.5}, {} Newton its ({:.0} %)",
+            r.stage,
+            r.step,
+            r.midspan.w,
+            r.midspan.lambda_s,
+            r.newton_iterations,
+            100.0 * v.fraction
+        );
+    }
+
     fn stage_started(&mut self, plan: &StagePlan, stages: usize) {
         let label = format!("stage {}/{} ({})", plan.index, stages, plan.describe());
         if self.terminal {

@@ -1282,7 +1282,14 @@ fn a_killed_sequenced_run_resumes_bit_identical() {
         stdout.contains("mesh sequencing: the case runs first"),
         "{stdout}"
     );
-    // the coarse run's end, with its two stages (inflation and squeeze)
+    // each converged step of the coarse run, then its end with its two stages (inflation
+    // and squeeze)
+    for line in [
+        "  mesh sequencing: coarse stage 1 step 1: ϖ = ",
+        "  mesh sequencing: coarse stage 2 step 1: ϖ = ",
+    ] {
+        assert!(stdout.contains(line), "{line}\n{stdout}");
+    }
     assert!(
         stdout.contains("mesh sequencing: the coarse run finished 2 stage(s) in "),
         "{stdout}"
