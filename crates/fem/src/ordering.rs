@@ -16,7 +16,8 @@
 //! each node's unknowns in one supernode. METIS (`METIS_NodeND`, through `metis-sys`, whose
 //! bundled METIS the C compiler builds) tries [`SEPARATORS`] separators at each split and keeps
 //! the smallest, from a fixed seed, so the ordering, and with it every result, is the same on
-//! every run and for any thread count.
+//! every run and for any thread count. Its order is then renumbered to a postorder of its
+//! elimination tree (`postordered`): the same fill, and the supernodes whole.
 //!
 //! The ordering changes the factor's fill and flops, not the matrix: the solution agrees to
 //! round-off and the inertia (the negative-pivot count, Sylvester's law) is the same
@@ -149,8 +150,99 @@ impl Quotient {
 }
 
 /// The nested-dissection permutation of the symmetric pattern `pairs` (row, col) on `n`
-/// unknowns: `perm[k]` is the unknown eliminated k-th.
+/// unknowns: `perm[k]` is the unknown eliminated k-th. METIS's order, renumbered to a
+/// postorder of its elimination tree (`postordered`): the same fill and flops, and the
+/// supernodes that METIS's order splits are whole.
 pub fn nested_dissection(n: usize, pairs: &[(usize, usize)]) -> Result<Vec<usize>, OrderingError> {
+    Ok(postordered(n, pairs, &metis_order(n, pairs)?))
+}
+
+/// The elimination tree of the pattern `pairs` on `n` unknowns eliminated in the order `perm`
+/// (`perm[k]` k-th), in elimination positions: `parent[k]`, or `usize::MAX` at a root (Liu's
+/// algorithm with path compression).
+pub(crate) fn elimination_tree(n: usize, pairs: &[(usize, usize)], perm: &[usize]) -> Vec<usize> {
+    let mut inv = vec![0usize; n];
+    for (k, &p) in perm.iter().enumerate() {
+        inv[p] = k;
+    }
+    // per position k, the positions i < k coupled to it (the rows of the lower triangle)
+    let mut start = vec![0usize; n + 1];
+    for &(r, c) in pairs {
+        let (i, k) = (inv[r].min(inv[c]), inv[r].max(inv[c]));
+        if i != k {
+            start[k + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut next = start.clone();
+    let mut below = vec![0usize; start[n]];
+    for &(r, c) in pairs {
+        let (i, k) = (inv[r].min(inv[c]), inv[r].max(inv[c]));
+        if i != k {
+            below[next[k]] = i;
+            next[k] += 1;
+        }
+    }
+    let mut parent = vec![usize::MAX; n];
+    let mut ancestor = vec![usize::MAX; n];
+    for k in 0..n {
+        for &i0 in &below[start[k]..start[k + 1]] {
+            // climb from i0 to its root so far, pointing the path at k
+            let mut i = i0;
+            while i < k {
+                let up = ancestor[i];
+                ancestor[i] = k;
+                if up == usize::MAX {
+                    parent[i] = k;
+                }
+                i = up;
+            }
+        }
+    }
+    parent
+}
+
+/// `perm` renumbered to a postorder of its elimination tree (each subtree's positions
+/// contiguous, its root last; children in their order in `perm`). The postorder is an
+/// equivalent order: the same factor's pattern up to the renumbering, so the same fill and
+/// flops. faer's supernodal analysis takes a custom order as it is, and finds a supernode
+/// only in consecutive columns, each the parent of the one before; METIS's order interleaves
+/// subtrees, so on the million-unknown tube it left 173 k supernodes, most of one node (issue
+/// #30's measurement), where the postorder gives 76,671 (faer's default relaxation; example
+/// `supernode_bound`). The test below checks the drop on a grid.
+pub(crate) fn postordered(n: usize, pairs: &[(usize, usize)], perm: &[usize]) -> Vec<usize> {
+    let parent = elimination_tree(n, pairs, perm);
+    // children lists in ascending order: pushed from the last
+    let mut head = vec![usize::MAX; n];
+    let mut sibling = vec![usize::MAX; n];
+    for k in (0..n).rev() {
+        if parent[k] != usize::MAX {
+            sibling[k] = head[parent[k]];
+            head[parent[k]] = k;
+        }
+    }
+    let mut order = Vec::with_capacity(n);
+    let mut pending: Vec<(usize, usize)> = Vec::new();
+    for root in (0..n).filter(|&k| parent[k] == usize::MAX) {
+        pending.push((root, head[root]));
+        while let Some(&mut (k, ref mut child)) = pending.last_mut() {
+            if *child == usize::MAX {
+                order.push(perm[k]);
+                pending.pop();
+            } else {
+                let c = *child;
+                *child = sibling[c];
+                pending.push((c, head[c]));
+            }
+        }
+    }
+    order
+}
+
+/// METIS's nested-dissection order of `pairs` on `n` unknowns (`perm[k]` k-th).
+fn metis_order(n: usize, pairs: &[(usize, usize)]) -> Result<Vec<usize>, OrderingError> {
     if n == 0 {
         return Ok(Vec::new());
     }
@@ -288,6 +380,99 @@ mod tests {
         }
         // the same on a second call (a fixed seed)
         assert_eq!(perm, nested_dissection(n, &pairs).unwrap());
+    }
+
+    /// Whether `parent` (positions) is a postorder's tree: each parent after its children,
+    /// and each subtree's positions contiguous with its root last.
+    fn is_postorder(parent: &[usize]) -> bool {
+        let n = parent.len();
+        let mut size = vec![1usize; n];
+        for k in 0..n {
+            if parent[k] != usize::MAX {
+                if parent[k] <= k {
+                    return false;
+                }
+                size[parent[k]] += size[k];
+            }
+        }
+        // the subtree of k is k + 1 − size[k] ..= k: a child's lies inside its parent's
+        (0..n)
+            .all(|k| parent[k] == usize::MAX || k + 1 - size[k] >= parent[k] + 1 - size[parent[k]])
+            && (0..n).all(|k| size[k] <= k + 1)
+    }
+
+    /// The number of entries of the LDLᵀ factor of `pairs` eliminated in the order `perm` (the
+    /// column counts of faer's simplicial symbolic factor).
+    /// faer's symbolic factor of `pairs` eliminated in the order `perm`, simplicial or
+    /// supernodal (faer's default relaxation).
+    fn symbolic(
+        n: usize,
+        pairs: &[(usize, usize)],
+        perm: &[usize],
+        threshold: faer::sparse::linalg::SupernodalThreshold,
+    ) -> faer::sparse::linalg::cholesky::SymbolicCholesky<usize> {
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let mut inv = vec![0usize; n];
+        for (k, &p) in perm.iter().enumerate() {
+            inv[p] = k;
+        }
+        let triplets: Vec<_> = pairs
+            .iter()
+            .map(|&(r, c)| faer::sparse::Triplet::new(inv[r].max(inv[c]), inv[r].min(inv[c]), 1.0))
+            .collect();
+        let m = faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
+            .unwrap();
+        let id: Vec<usize> = (0..n).collect();
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: threshold,
+            ..Default::default()
+        };
+        factorize_symbolic_cholesky(
+            m.symbolic(),
+            faer::Side::Lower,
+            SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(&id, &id, n)),
+            params,
+        )
+        .unwrap()
+    }
+
+    /// The entries of the (simplicial) factor of `pairs` in the order `perm`.
+    fn factor_entries(n: usize, pairs: &[(usize, usize)], perm: &[usize]) -> usize {
+        use faer::sparse::linalg::SupernodalThreshold;
+        symbolic(n, pairs, perm, SupernodalThreshold::FORCE_SIMPLICIAL).len_val()
+    }
+
+    /// faer's supernodes (default relaxation) of `pairs` in the order `perm`.
+    fn supernodes(n: usize, pairs: &[(usize, usize)], perm: &[usize]) -> usize {
+        use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+        use faer::sparse::linalg::SupernodalThreshold;
+        match symbolic(n, pairs, perm, SupernodalThreshold::FORCE_SUPERNODAL).raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => s.n_supernodes(),
+            SymbolicCholeskyRaw::Simplicial(_) => unreachable!("forced supernodal"),
+        }
+    }
+
+    #[test]
+    fn the_postorder_keeps_the_fill_and_makes_subtrees_contiguous() {
+        let (n, pairs) = grid(30);
+        let metis = metis_order(n, &pairs).unwrap();
+        let post = nested_dissection(n, &pairs).unwrap();
+        assert!(!is_postorder(&elimination_tree(n, &pairs, &metis)));
+        assert!(is_postorder(&elimination_tree(n, &pairs, &post)));
+        assert_eq!(
+            factor_entries(n, &pairs, &post),
+            factor_entries(n, &pairs, &metis)
+        );
+        // a postorder's postorder is itself
+        assert_eq!(postordered(n, &pairs, &post), post);
+        // faer finds supernodes in consecutive columns only: the postorder gives it fewer
+        let (before, after) = (supernodes(n, &pairs, &metis), supernodes(n, &pairs, &post));
+        assert!(
+            after < before,
+            "{after} supernodes against METIS's {before}"
+        );
     }
 
     #[test]
