@@ -65,13 +65,15 @@ struct Half {
     /// the half's unknowns (global indices) in elimination order; S follows them
     members: Vec<usize>,
     pattern: SymbolicSparseColMat<usize>,
-    /// per entry of M_i: the index of the value of K it takes (32 bits: the pattern of a
-    /// million unknowns has some 10⁷ entries, and half the bytes matter at that size)
+    /// the indices of the values of K that M_i's entries take, by their position in
+    /// `pattern` (32 bits: the pattern of a million unknowns has some 10⁷ entries, and half
+    /// the bytes matter at that size); a position takes more than one where K's pattern
+    /// repeats an entry (they are summed in K's order)
     source: Vec<u32>,
-    /// per entry of M_i: its position in `pattern` (duplicates summed)
-    slot: Vec<u32>,
-    /// the entries from this one on are S × S: they take half of K's value, the two halves
-    /// sharing C
+    /// per position of `pattern`, where its values start in `source` (the last: its length)
+    start: Vec<u32>,
+    /// the values from this one on in `source` are S × S: they take half of K's value, the
+    /// two halves sharing C
     halved_from: usize,
     symbolic: SymbolicCholesky<usize>,
     /// A_i's columns of M_i's factor and, where S's would be, T_i (its lower triangle), in
@@ -147,26 +149,18 @@ impl Half {
             at[k] = i;
         }
         let m = members.len() + separator.len();
-        // M_i's entries: the values they take (K's entries of the half and of S; S × S last,
-        // where the two halves share C), and the position of each in M_i's pattern
+        // M_i's entries: the values they take (K's entries of the half and of S) and their
+        // row and column in M_i
         let mut entries: Vec<(u32, usize, usize)> = Vec::new();
-        let mut shared = Vec::new();
         let too_large =
             |_| FactorizationError::Ordering(crate::ordering::OrderingError::TooLarge(n));
         for (e, &(r, c)) in pairs.iter().enumerate() {
             let (sr, sc) = (sides[r], sides[c]);
             if (sr == side || sr == 2) && (sc == side || sc == 2) {
                 let (a, b) = (at[r].max(at[c]), at[r].min(at[c]));
-                let e = u32::try_from(e).map_err(too_large)?;
-                if sr == 2 && sc == 2 {
-                    shared.push((e, a, b));
-                } else {
-                    entries.push((e, a, b));
-                }
+                entries.push((u32::try_from(e).map_err(too_large)?, a, b));
             }
         }
-        let halved_from = entries.len();
-        entries.extend(shared);
         // the pattern: by column, rows ascending, without duplicates
         let mut cells: Vec<(usize, usize)> = entries.iter().map(|&(_, r, c)| (c, r)).collect();
         cells.sort_unstable();
@@ -180,15 +174,27 @@ impl Half {
         }
         let row_idx: Vec<usize> = cells.iter().map(|&(_, r)| r).collect();
         drop(cells);
-        let mut source = Vec::with_capacity(entries.len());
-        let mut slot = Vec::with_capacity(entries.len());
+        // each entry's position in the pattern; K's values by position (a stable sort, so a
+        // repeated entry's values keep K's order): the gather then writes M_i's values in
+        // order, each once, and reads K's where they are
+        let mut placed = Vec::with_capacity(entries.len());
         for &(e, r, c) in &entries {
             let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-            let at = col_ptr[c] + rows.partition_point(|&x| x < r);
-            source.push(e);
-            slot.push(u32::try_from(at).map_err(too_large)?);
+            placed.push((col_ptr[c] + rows.partition_point(|&x| x < r), e));
         }
         drop(entries);
+        placed.sort_by_key(|&(at, _)| at);
+        let mut start = vec![0u32; row_idx.len() + 1];
+        for &(at, _) in &placed {
+            start[at + 1] += 1;
+        }
+        for at in 0..row_idx.len() {
+            start[at + 1] += start[at];
+        }
+        let source: Vec<u32> = placed.iter().map(|&(_, e)| e).collect();
+        drop(placed);
+        // S × S (the entries both of whose unknowns are S's) is the columns from S's first
+        let halved_from = start[col_ptr[members.len()]] as usize;
         let pattern = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
         // the order is the one built here: the identity as a custom ordering (faer 0.24's
         // `Identity` with the lower triangle analyses the diagonal alone); supernodal, so that
@@ -215,7 +221,7 @@ impl Half {
             members,
             pattern,
             source,
-            slot,
+            start,
             halved_from,
             l_values: Vec::new(),
             symbolic,
@@ -240,14 +246,17 @@ impl Half {
     /// [`Half::values`] into `vals`' storage; whether every value it took was finite.
     fn values_into(&self, values: &[f64], vals: &mut Vec<f64>) -> bool {
         vals.clear();
-        vals.resize(self.pattern.compute_nnz(), 0.0);
         let mut finite = true;
-        for (k, (&e, &at)) in self.source.iter().zip(&self.slot).enumerate() {
-            let w = if k < self.halved_from { 1.0 } else { 0.5 };
-            let v = values[e as usize];
-            finite &= v.is_finite();
-            vals[at as usize] += w * v;
-        }
+        vals.extend(self.start.windows(2).map(|w| {
+            let (from, to) = (w[0] as usize, w[1] as usize);
+            let mut sum = 0.0;
+            for k in from..to {
+                let v = values[self.source[k] as usize];
+                finite &= v.is_finite();
+                sum += if k < self.halved_from { v } else { 0.5 * v };
+            }
+            sum
+        }));
         finite
     }
 
