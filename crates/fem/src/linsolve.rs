@@ -217,10 +217,7 @@ impl SparseLdlt {
         let nested = |pattern: &SymbolicSparseColMat<usize>| -> Result<SymbolicCholesky<usize>, FactorizationError> {
             let perm = crate::ordering::nested_dissection(n, pairs)
                 .map_err(FactorizationError::Ordering)?;
-            let mut inverse = vec![0usize; n];
-            for (k, &p) in perm.iter().enumerate() {
-                inverse[p] = k;
-            }
+            let inverse = crate::ordering::inverse(&perm);
             factorize_symbolic_cholesky(
                 pattern.as_ref(),
                 Side::Lower,

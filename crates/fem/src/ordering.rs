@@ -161,29 +161,26 @@ pub fn nested_dissection(n: usize, pairs: &[(usize, usize)]) -> Result<Vec<usize
 /// (`perm[k]` k-th), in elimination positions: `parent[k]`, or `usize::MAX` at a root (Liu's
 /// algorithm with path compression).
 pub(crate) fn elimination_tree(n: usize, pairs: &[(usize, usize)], perm: &[usize]) -> Vec<usize> {
-    let mut inv = vec![0usize; n];
-    for (k, &p) in perm.iter().enumerate() {
-        inv[p] = k;
-    }
+    let inv = inverse(perm);
     // per position k, the positions i < k coupled to it (the rows of the lower triangle)
+    let coupled = || {
+        pairs
+            .iter()
+            .map(|&(r, c)| (inv[r].min(inv[c]), inv[r].max(inv[c])))
+            .filter(|&(i, k)| i != k)
+    };
     let mut start = vec![0usize; n + 1];
-    for &(r, c) in pairs {
-        let (i, k) = (inv[r].min(inv[c]), inv[r].max(inv[c]));
-        if i != k {
-            start[k + 1] += 1;
-        }
+    for (_, k) in coupled() {
+        start[k + 1] += 1;
     }
     for k in 0..n {
         start[k + 1] += start[k];
     }
     let mut next = start.clone();
     let mut below = vec![0usize; start[n]];
-    for &(r, c) in pairs {
-        let (i, k) = (inv[r].min(inv[c]), inv[r].max(inv[c]));
-        if i != k {
-            below[next[k]] = i;
-            next[k] += 1;
-        }
+    for (i, k) in coupled() {
+        below[next[k]] = i;
+        next[k] += 1;
     }
     let mut parent = vec![usize::MAX; n];
     let mut ancestor = vec![usize::MAX; n];
@@ -202,6 +199,15 @@ pub(crate) fn elimination_tree(n: usize, pairs: &[(usize, usize)], perm: &[usize
         }
     }
     parent
+}
+
+/// The inverse of the permutation `perm`: `inverse(perm)[perm[k]] = k`.
+pub(crate) fn inverse(perm: &[usize]) -> Vec<usize> {
+    let mut inv = vec![0usize; perm.len()];
+    for (k, &p) in perm.iter().enumerate() {
+        inv[p] = k;
+    }
+    inv
 }
 
 /// `perm` renumbered to a postorder of its elimination tree (each subtree's positions
@@ -401,8 +407,6 @@ mod tests {
             && (0..n).all(|k| size[k] <= k + 1)
     }
 
-    /// The number of entries of the LDLᵀ factor of `pairs` eliminated in the order `perm` (the
-    /// column counts of faer's simplicial symbolic factor).
     /// faer's symbolic factor of `pairs` eliminated in the order `perm`, simplicial or
     /// supernodal (faer's default relaxation).
     fn symbolic(
@@ -414,10 +418,7 @@ mod tests {
         use faer::sparse::linalg::cholesky::{
             factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
         };
-        let mut inv = vec![0usize; n];
-        for (k, &p) in perm.iter().enumerate() {
-            inv[p] = k;
-        }
+        let inv = inverse(perm);
         let triplets: Vec<_> = pairs
             .iter()
             .map(|&(r, c)| faer::sparse::Triplet::new(inv[r].max(inv[c]), inv[r].min(inv[c]), 1.0))

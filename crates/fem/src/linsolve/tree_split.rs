@@ -183,6 +183,8 @@ impl Half {
             placed.push((col_ptr[c] + rows.partition_point(|&x| x < r), e));
         }
         drop(entries);
+        // `start` counts them in 32 bits
+        u32::try_from(placed.len()).map_err(too_large)?;
         placed.sort_by_key(|&(at, _)| at);
         let mut start = vec![0u32; row_idx.len() + 1];
         for &(at, _) in &placed {
