@@ -6,7 +6,9 @@
 //! ```text
 //! cargo run --release -p tubemem-fem --example factor_drivers -- [AROUND ALONG]
 //! ```
-//! (default 448 × 560, the million-unknown benchmark's mesh; `ROUNDS=N`, default 5.) Prints
+//! (default 448 × 560, the million-unknown benchmark's mesh; `ROUNDS=N`, default 5;
+//! `RELAX=default|coarse|coarser`, the supernode relaxation of `tube_pattern::RELAXATIONS`,
+//! default faer's.) Prints the flops by kernel and by supernode width,
 //! each driver's median seconds, GFLOP/s and the memory it keeps beside the factor, the
 //! largest difference between the two factors, the entries of the update matrices the
 //! multifrontal driver forms against the factor's, and the multifrontal driver's time by phase
@@ -28,7 +30,8 @@ fn main() {
     let (n, pairs) = tube_pattern::tube_pairs();
     let perm = tubemem_fem::ordering::nested_dissection(n, &pairs).expect("ordering");
     let m = tube_pattern::dominant_matrix(n, &pairs, &perm);
-    let sym = tube_pattern::symbolic(&m, None);
+    let relax = std::env::var("RELAX").unwrap_or_else(|_| "default".into());
+    let sym = tube_pattern::symbolic(&m, Some(tube_pattern::relaxation(&relax)));
     let SymbolicCholeskyRaw::Supernodal(sn) = sym.raw() else {
         panic!("supernodal layout forced")
     };
@@ -45,6 +48,7 @@ fn main() {
                 .sum::<f64>()
         })
         .sum();
+    print_flops(sn);
     let req = sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
     let mut mem = MemBuffer::new(req);
     let mut driver = Multifrontal::new(sn, m.symbolic()).expect("driver");
@@ -79,7 +83,7 @@ fn main() {
         .fold(0.0, f64::max);
     let (a, b) = (tube_pattern::median(t_faer), tube_pattern::median(t_ours));
     println!(
-        "{n} unknowns, nested dissection, {} supernodes, {:.1} GFLOP per factorization, one thread, medians of {rounds}:",
+        "{n} unknowns, nested dissection, relaxation {relax}: {} supernodes, {:.1} GFLOP per factorization, one thread, medians of {rounds}:",
         sn.n_supernodes(),
         flops / 1e9
     );
@@ -147,6 +151,46 @@ fn main() {
                 tube_pattern::matmul_peak(Par::rayon(0))
             );
         }
+    }
+}
+
+/// The flops of `sn`'s supernodes (c columns, r rows below) by kernel, leading terms: the
+/// diagonal blocks' LDLᵀ (c³/3), the solves below them (r c²) and the update products (r² c),
+/// and by the supernodes' width (powers of two): the dense kernels' shapes.
+fn print_flops(sn: &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>) {
+    // [LDLᵀ, solve, update] per width band 2^b ≤ c < 2^(b+1), the last band c ≥ 128
+    let mut bands = [[0.0f64; 3]; 8];
+    let mut count = [0usize; 8];
+    for s in 0..sn.n_supernodes() {
+        let c = sn.supernode_end()[s] - sn.supernode_begin()[s];
+        let r = (sn.col_ptr_for_val()[s + 1] - sn.col_ptr_for_val()[s]) / c - c;
+        let (c, r, b) = (c as f64, r as f64, (c.ilog2() as usize).min(7));
+        count[b] += 1;
+        let band = &mut bands[b];
+        band[0] += c * c * c / 3.0;
+        band[1] += r * c * c;
+        band[2] += r * r * c;
+    }
+    let total = |k: usize| bands.iter().map(|b| b[k]).sum::<f64>() / 1e9;
+    println!(
+        "  flops by kernel (leading terms): diagonal LDLᵀ {:.1}, solves {:.1}, update products {:.1} GFLOP",
+        total(0),
+        total(1),
+        total(2)
+    );
+    println!("  by supernode width c: supernodes, GFLOP of LDLᵀ + solves, of update products");
+    for (b, band) in bands.iter().enumerate() {
+        let width = if b == 7 {
+            "c ≥ 128".to_string()
+        } else {
+            format!("{} ≤ c < {}", 1 << b, 2 << b)
+        };
+        println!(
+            "    {width:12} {:6} {:7.1} {:7.1}",
+            count[b],
+            (band[0] + band[1]) / 1e9,
+            band[2] / 1e9
+        );
     }
 }
 

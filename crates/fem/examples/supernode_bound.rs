@@ -210,16 +210,9 @@ fn main() {
     };
     println!("{n} unknowns (nested dissection); faer matmul peak on 1 thread: {peak:.1} GFLOP/s");
     // faer's default relaxation, then coarser ones
-    let default: &[(usize, f64)] = &[(4, 1.0), (16, 0.8), (48, 0.1), (usize::MAX, 0.05)];
-    let coarse: &[(usize, f64)] = &[(8, 1.0), (32, 0.8), (96, 0.2), (usize::MAX, 0.1)];
-    let coarser: &[(usize, f64)] = &[(16, 1.0), (64, 0.8), (192, 0.3), (usize::MAX, 0.15)];
     let which = std::env::var("RELAX").unwrap_or_else(|_| "default,coarse,coarser".into());
     let mut rates: BTreeMap<Work, f64> = BTreeMap::new();
-    for (name, relax) in [
-        ("default", default),
-        ("coarse", coarse),
-        ("coarser", coarser),
-    ] {
+    for (name, relax) in tube_pattern::RELAXATIONS {
         if !which.split(',').any(|w| w == name) {
             continue;
         }

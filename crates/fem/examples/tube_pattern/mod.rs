@@ -144,6 +144,33 @@ pub fn tube_pairs() -> (usize, Vec<(usize, usize)>) {
     pairs(&mesh)
 }
 
+/// The supernode relaxations the examples compare (`RELAX=…`), each (columns, fraction of
+/// explicit zeros allowed up to that many columns): faer's default, then two coarser ones
+/// (more explicit zeros, wider supernodes).
+pub const RELAXATIONS: [(&str, &[(usize, f64)]); 3] = [
+    (
+        "default",
+        &[(4, 1.0), (16, 0.8), (48, 0.1), (usize::MAX, 0.05)],
+    ),
+    (
+        "coarse",
+        &[(8, 1.0), (32, 0.8), (96, 0.2), (usize::MAX, 0.1)],
+    ),
+    (
+        "coarser",
+        &[(16, 1.0), (64, 0.8), (192, 0.3), (usize::MAX, 0.15)],
+    ),
+];
+
+/// The relaxation of [`RELAXATIONS`] named `name`.
+pub fn relaxation(name: &str) -> &'static [(usize, f64)] {
+    RELAXATIONS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .unwrap_or_else(|| panic!("RELAX={name}: one of default, coarse, coarser"))
+        .1
+}
+
 /// faer's supernodal symbolic factor of `m` (lower triangle, already ordered) with the
 /// supernode relaxation `relax` (faer's default if None).
 pub fn symbolic(
