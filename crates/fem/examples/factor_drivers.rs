@@ -20,6 +20,7 @@
 mod tube_pattern;
 
 use faer::dyn_stack::MemBuffer;
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 use faer::Par;
 use std::time::Instant;
@@ -38,8 +39,8 @@ fn main() {
     // flops as the solver counts them: Σ over columns of c (c + 2), c the entries below
     let flops: f64 = (0..sn.n_supernodes())
         .map(|s| {
-            let cols = sn.supernode_end()[s] - sn.supernode_begin()[s];
-            let rows = (sn.col_ptr_for_val()[s + 1] - sn.col_ptr_for_val()[s]) / cols;
+            let (cols, below) = shape(sn, s);
+            let rows = cols + below;
             (0..cols)
                 .map(|j| {
                     let c = (rows - j - 1) as f64;
@@ -154,16 +155,24 @@ fn main() {
     }
 }
 
+/// Supernode `s` of `sn`: its columns and the rows below its diagonal block.
+fn shape(sn: &SymbolicSupernodalCholesky<usize>, s: usize) -> (usize, usize) {
+    let c = sn.supernode_end()[s] - sn.supernode_begin()[s];
+    (
+        c,
+        (sn.col_ptr_for_val()[s + 1] - sn.col_ptr_for_val()[s]) / c - c,
+    )
+}
+
 /// The flops of `sn`'s supernodes (c columns, r rows below) by kernel, leading terms: the
 /// diagonal blocks' LDLᵀ (c³/3), the solves below them (r c²) and the update products (r² c),
 /// and by the supernodes' width (powers of two): the dense kernels' shapes.
-fn print_flops(sn: &faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky<usize>) {
+fn print_flops(sn: &SymbolicSupernodalCholesky<usize>) {
     // [LDLᵀ, solve, update] per width band 2^b ≤ c < 2^(b+1), the last band c ≥ 128
     let mut bands = [[0.0f64; 3]; 8];
     let mut count = [0usize; 8];
     for s in 0..sn.n_supernodes() {
-        let c = sn.supernode_end()[s] - sn.supernode_begin()[s];
-        let r = (sn.col_ptr_for_val()[s + 1] - sn.col_ptr_for_val()[s]) / c - c;
+        let (c, r) = shape(sn, s);
         let (c, r, b) = (c as f64, r as f64, (c.ilog2() as usize).min(7));
         count[b] += 1;
         let band = &mut bands[b];
