@@ -69,6 +69,8 @@ use thiserror::Error;
 use tubemem_material::{MaterialError, MaterialSpec, Wrinkling};
 use tubemem_mesh::{ElementKind, Symmetry};
 
+use crate::units::{Dimension, Units};
+
 /// Why a case was rejected: the TOML reader's message (with line and column), or the table,
 /// stage and key at fault.
 #[derive(Debug, Error)]
@@ -480,9 +482,9 @@ pub struct PlaneSpec {
     #[serde(deserialize_with = "two_components")]
     #[schemars(with = "[f64; 2]")]
     pub normal: [f64; 2],
-    /// d at the stage's start
+    /// d at the stage's start, a length (m under `[units] system = "SI"`, R otherwise)
     pub offset: f64,
-    /// d at the stage's end
+    /// d at the stage's end, a length (m under SI, R otherwise)
     pub target: f64,
 }
 
@@ -538,23 +540,31 @@ pub enum ControlKind {
 #[derive(Debug, Clone, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StageSpec {
+    /// "inflate" (the gas let in), "squeeze" (two plates y = ±r closed on the tube) or
+    /// "confine" (any planes moved in)
     pub kind: Kind,
     /// inflate: "pressure", "volume" or "arc-length"; squeeze and confine (the gas closed):
     /// none (load steps in the planes' travel) or "arc-length"
     pub control: Option<ControlKind>,
-    /// squeeze only: the final half-gap ρ = r/R between the plates
+    /// squeeze only: the final half-gap between the plates as the ratio ρ = r/R (a ratio: the
+    /// same number in every unit system); or give `target_gap`
     pub target_rho: Option<f64>,
-    /// squeeze and confine: penetration (in R) at the gas pressure that sets the penalty
-    /// κ = ϖJ/tol (default 1e-3 for the penalty alone; 1e-6 as the augmented contact's
-    /// regularization), or the penalty itself
+    /// squeeze only: the final half-gap r between the plates as a length (m under `[units]
+    /// system = "SI"`, R otherwise), instead of `target_rho`
+    pub target_gap: Option<f64>,
+    /// squeeze and confine: the penetration at the gas pressure that sets the penalty κ =
+    /// ϖJ/tol, a length (m under SI, R otherwise; default 1e-3 R for the penalty alone, 1e-6
+    /// R as the augmented contact's regularization)
     pub penetration_tolerance: Option<f64>,
+    /// squeeze and confine: the contact penalty κ itself, a pressure per length of
+    /// penetration (Pa/m under SI, μH/R² otherwise), instead of `penetration_tolerance`
     pub penalty: Option<f64>,
     /// squeeze and confine: how the planes are enforced, "augmented" (the default: the penalty
     /// with Uzawa multiplier updates until the gap is within `gap_tolerance`) or "penalty" (the
     /// penalty alone, the membrane sits about `penetration_tolerance` inside)
     pub contact_method: Option<ContactMethod>,
-    /// augmented contact: the largest gap (in R) the multiplier updates leave where a plane
-    /// pushes (default 1e-9)
+    /// augmented contact: the largest gap the multiplier updates leave where a plane pushes,
+    /// a length (m under SI, R otherwise; default 1e-9 R)
     pub gap_tolerance: Option<f64>,
     /// augmented contact: the multiplier updates allowed in one step (default 50)
     pub max_augmentations: Option<usize>,
@@ -562,12 +572,19 @@ pub struct StageSpec {
     /// weighted by its share of the element's area; the default of the augmented contact) or
     /// "gauss" (its Gauss points; the default of the penalty)
     pub contact_points: Option<tubemem_fem::contact::ContactPoints>,
+    /// inflate: the gas pressure to reach, a pressure (Pa under `[units] system = "SI"`; the
+    /// reduced pressure ϖ = pR/(μH) otherwise)
     pub target_pressure: Option<f64>,
+    /// inflate: the mid-span hoop stretch λs* to reach (a ratio), the pressure following as
+    /// the multiplier of the constraint
     pub target_stretch: Option<f64>,
+    /// inflate: the enclosed volume over its reference value to reach (a ratio)
     pub target_volume_ratio: Option<f64>,
     /// confine only: the planes
     #[serde(default)]
     pub plane: Vec<PlaneSpec>,
+    /// the initial number of load steps (a count; the steps adapt afterwards: a step that
+    /// does not converge is halved)
     #[serde(default = "default_steps")]
     pub steps: usize,
     /// arc-length stages: "follow-stable" switches branch at a bifurcation where the path
@@ -640,34 +657,66 @@ impl StagePlan {
 }
 
 impl Target {
-    /// The stage label in words, for progress lines.
+    /// The stage label in words, for progress lines (dimensionless).
     pub fn describe(&self) -> String {
+        self.describe_in(&Units::dimensionless())
+    }
+
+    /// The target as a user reads it in `units`: `ϖ = 0.65`, or `p = 4600 Pa (ϖ = 0.744)`;
+    /// `ρ = 0.8`, with the half-gap as a length under SI.
+    fn value_in(&self, units: &Units) -> String {
+        let n = |v: f64| tubemem_material::Num(crate::units::round_sig(v));
+        match *self {
+            Target::Pressure(p) if units.is_si() => {
+                format!("p = {}", units.show(Dimension::Pressure, p))
+            }
+            Target::Pressure(p) => format!("ϖ = {}", n(p)),
+            Target::Stretch(s) => format!("mid-span λs = {}", n(s)),
+            Target::VolumeRatio(r) => format!("V/V0 = {}", n(r)),
+            Target::Rho(r) if units.is_si() => format!(
+                "ρ = {} (half-gap {} {})",
+                n(r),
+                n(units.from_core(Dimension::Length, r)),
+                units.unit(Dimension::Length)
+            ),
+            Target::Rho(r) => format!("ρ = {}", n(r)),
+            Target::Confine(k) => format!("{k} planes to their targets"),
+        }
+    }
+
+    /// The stage label in words, for progress lines, its target in `units`.
+    pub fn describe_in(&self, units: &Units) -> String {
+        let v = self.value_in(units);
         match self {
-            Target::Pressure(p) => format!("inflate, pressure control to ϖ = {p}"),
-            Target::Stretch(s) => format!("inflate, mid-span stretch control to λs = {s}"),
-            Target::VolumeRatio(r) => format!("inflate, volume control to V/V0 = {r}"),
-            Target::Rho(r) => format!("squeeze, closed gas, plates to ρ = {r}"),
-            Target::Confine(n) => format!("confine, closed gas, {n} planes to their targets"),
+            Target::Pressure(_) => format!("inflate, pressure control to {v}"),
+            Target::Stretch(_) => format!("inflate, stretch control to {v}"),
+            Target::VolumeRatio(_) => format!("inflate, volume control to {v}"),
+            Target::Rho(_) => format!("squeeze, closed gas, plates to {v}"),
+            Target::Confine(_) => format!("confine, closed gas, {v}"),
         }
     }
 }
 
 impl StagePlan {
-    /// The stage label in words, for progress lines.
+    /// The stage label in words, for progress lines (dimensionless).
     pub fn describe(&self) -> String {
+        self.describe_in(&Units::dimensionless())
+    }
+
+    /// The stage label in words, its target in `units`.
+    pub fn describe_in(&self, units: &Units) -> String {
         if !self.arc_length {
-            return self.target.describe();
+            return self.target.describe_in(units);
         }
+        let v = self.target.value_in(units);
         match self.target {
-            Target::Pressure(p) => format!("inflate, arc-length continuation to ϖ = {p}"),
-            Target::Stretch(s) => format!("inflate, arc-length continuation to mid-span λs = {s}"),
-            Target::VolumeRatio(r) => format!("inflate, arc-length continuation to V/V0 = {r}"),
-            Target::Rho(r) => {
-                format!("squeeze, closed gas, arc-length continuation of the plates to ρ = {r}")
+            Target::Pressure(_) | Target::Stretch(_) | Target::VolumeRatio(_) => {
+                format!("inflate, arc-length continuation to {v}")
             }
-            Target::Confine(n) => format!(
-                "confine, closed gas, arc-length continuation of {n} planes to their targets"
-            ),
+            Target::Rho(_) => {
+                format!("squeeze, closed gas, arc-length continuation of the plates to {v}")
+            }
+            Target::Confine(_) => format!("confine, closed gas, arc-length continuation of {v}"),
         }
     }
 }
@@ -719,12 +768,18 @@ pub const DEFAULT_PENETRATION_TOLERANCE: f64 = 1e-3;
 pub const DEFAULT_REGULARIZATION_TOLERANCE: f64 = 1e-6;
 
 impl StageSpec {
-    /// Resolve the stage (`i` is 0-based).
-    pub fn plan(&self, i: usize) -> Result<StagePlan, CaseError> {
-        let target = self.target(i)?;
+    /// Resolve the stage (`i` is 0-based), its dimensional keys read in `units` and converted
+    /// to the dimensionless core ([`crate::units`]).
+    pub fn plan(&self, i: usize, units: &Units) -> Result<StagePlan, CaseError> {
+        let target = self.target(i, units)?;
         let augmented = self.contact_method != Some(ContactMethod::Penalty);
-        let penalty = match (self.kind, self.penalty, self.penetration_tolerance) {
-            (Kind::Squeeze | Kind::Confine, Some(k), _) => Some(PenaltySpec::Value(k)),
+        let tolerance = self
+            .penetration_tolerance
+            .map(|t| units.to_core(Dimension::Length, t));
+        let penalty = match (self.kind, self.penalty, tolerance) {
+            (Kind::Squeeze | Kind::Confine, Some(k), _) => {
+                Some(PenaltySpec::Value(units.to_core(Dimension::Stiffness, k)))
+            }
             (Kind::Squeeze | Kind::Confine, None, t) => {
                 Some(PenaltySpec::Tolerance(t.unwrap_or(if augmented {
                     DEFAULT_REGULARIZATION_TOLERANCE
@@ -742,6 +797,7 @@ impl StageSpec {
                 Some(tubemem_fem::contact::Enforcement::Augmented {
                     gap_tolerance: self
                         .gap_tolerance
+                        .map(|t| units.to_core(Dimension::Length, t))
                         .unwrap_or(tubemem_fem::contact::DEFAULT_GAP_TOLERANCE),
                     max_augmentations: self
                         .max_augmentations
@@ -768,18 +824,27 @@ impl StageSpec {
 
     /// The stage's target, after every check of the keys that combine into it. Its length: one
     /// arm per stage kind and control, each checking its own keys and naming them in its error.
-    fn target(&self, i: usize) -> Result<Target, CaseError> {
+    fn target(&self, i: usize, units: &Units) -> Result<Target, CaseError> {
         if self.branch.is_some() && self.control != Some(ControlKind::ArcLength) {
             invalid!(
                 "[[stage]] {}: `branch` belongs to control = \"arc-length\" stages (only a continuation has a path to leave)",
                 i + 1
             );
         }
+        let rho = match (self.target_rho, self.target_gap) {
+            (Some(_), Some(_)) => invalid!(
+                "[[stage]] {}: `target_rho` (the half-gap over R, a ratio) and `target_gap` (the half-gap, a length in {}) say the same thing: give one",
+                i + 1,
+                units.unit(Dimension::Length)
+            ),
+            (r, g) => r.or(g.map(|g| units.to_core(Dimension::Length, g))),
+        };
         let which = (
-            self.target_pressure,
+            self.target_pressure
+                .map(|p| units.to_core(Dimension::Pressure, p)),
             self.target_stretch,
             self.target_volume_ratio,
-            self.target_rho,
+            rho,
         );
         let t = match (self.kind, self.control, which) {
             (Kind::Inflate, Some(ControlKind::Pressure), (Some(p), None, None, None)) => Target::Pressure(p),
@@ -805,14 +870,14 @@ impl StageSpec {
                 i + 1
             ),
             (Kind::Squeeze, None | Some(ControlKind::ArcLength), (None, None, None, Some(r))) => Target::Rho(r),
-            (Kind::Squeeze, _, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho`", i + 1),
+            (Kind::Squeeze, _, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho` (the plates' half-gap over R) or `target_gap` (the half-gap as a length)", i + 1),
             (Kind::Confine, Some(ControlKind::Pressure | ControlKind::Volume), _) => invalid!(
                 "[[stage]] {}: a confine stage keeps the gas closed (Boyle); its only `control` is \"arc-length\" (the planes' travel continued along the path)",
                 i + 1
             ),
             (Kind::Confine, None | Some(ControlKind::ArcLength), (None, None, None, None)) => Target::Confine(self.plane.len()),
             (Kind::Confine, _, _) => invalid!(
-                "[[stage]] {}: kind = \"confine\" moves its [[stage.plane]]s to their `target`s; it takes no target_pressure, target_stretch, target_volume_ratio or target_rho",
+                "[[stage]] {}: kind = \"confine\" moves its [[stage.plane]]s to their `target`s; it takes no target_pressure, target_stretch, target_volume_ratio, target_rho or target_gap",
                 i + 1
             ),
         };
@@ -868,12 +933,20 @@ impl StageSpec {
                 invalid!("[[stage]] {}: the planes at their targets: {e}", i + 1);
             }
         }
+        let rho_key = if self.target_gap.is_some() {
+            "target_gap"
+        } else {
+            "target_rho"
+        };
         if let Target::Rho(r) = t {
             if r.is_finite() && r <= 0.0 {
                 invalid!(
-                    "[[stage]] {}: `target_rho` = {}: no equilibrium there — the plates would have to pass through the tube (ρ → 0 presses it flat, its two walls meeting at y = 0; give ρ > 0)",
+                    "[[stage]] {}: `{rho_key}` = {}: no equilibrium there — the plates would have to pass through the tube (ρ → 0 presses it flat, its two walls meeting at y = 0; give ρ > 0)",
                     i + 1,
-                    tubemem_material::Num(r)
+                    units.show(
+                        if self.target_gap.is_some() { Dimension::Length } else { Dimension::Ratio },
+                        r
+                    )
                 );
             }
         }
@@ -887,14 +960,19 @@ impl StageSpec {
                 s.is_finite() && (1.0..=tubemem_gps::MAX_STRETCH).contains(&s),
             ),
             Target::VolumeRatio(r) => ("target_volume_ratio", r, r.is_finite() && r >= 1.0),
-            Target::Rho(r) => ("target_rho", r, r.is_finite() && r > 0.0),
+            Target::Rho(r) => (rho_key, r, r.is_finite() && r > 0.0),
             Target::Confine(n) => ("plane", n as f64, n >= 1),
         };
         if !ok {
+            let d = match t {
+                Target::Pressure(_) => Dimension::Pressure,
+                Target::Rho(_) if self.target_gap.is_some() => Dimension::Length,
+                _ => Dimension::Ratio,
+            };
             invalid!(
                 "[[stage]] {}: `{name}` = {} is out of range (pressure ≥ 0, stretch in [1, 1e6], volume ratio ≥ 1, rho > 0)",
                 i + 1,
-                tubemem_material::Num(v)
+                units.show(d, v)
             );
         }
         if self.steps == 0 {
@@ -936,32 +1014,46 @@ impl StageSpec {
                 i + 1
             );
         }
-        if let Some(t) = self.gap_tolerance {
-            if !(t.is_finite() && t > 0.0 && t < 0.1) {
+        for (key, given) in [
+            ("gap_tolerance", self.gap_tolerance),
+            ("penetration_tolerance", self.penetration_tolerance),
+        ] {
+            let Some(t) = given else { continue };
+            let core = units.to_core(Dimension::Length, t);
+            if !(core.is_finite() && core > 0.0 && core < 0.1) {
                 invalid!(
-                    "[[stage]] {}: `gap_tolerance` = {t}: must be in (0, 0.1) (in R)",
-                    i + 1
+                    "[[stage]] {}: `{key}` = {}: must be in (0, 0.1 R){}",
+                    i + 1,
+                    units.written(Dimension::Length, t),
+                    if units.is_si() {
+                        format!(
+                            " = (0, {} m), R = {} m",
+                            tubemem_material::Num(0.1 * units.factor(Dimension::Length)),
+                            tubemem_material::Num(units.factor(Dimension::Length))
+                        )
+                    } else {
+                        String::new()
+                    }
                 );
             }
         }
         if self.max_augmentations == Some(0) {
             invalid!("[[stage]] {}: `max_augmentations` must be ≥ 1", i + 1);
         }
-        if let Some(t) = self.penetration_tolerance {
-            if !(t.is_finite() && t > 0.0 && t < 0.1) {
-                invalid!(
-                    "[[stage]] {}: `penetration_tolerance` = {t}: must be in (0, 0.1) (in R)",
-                    i + 1
-                );
-            }
-        }
         if let Some(k) = self.penalty {
             if !(k.is_finite() && k > 0.0) {
                 invalid!(
-                    "[[stage]] {}: `penalty` = {k}: must be finite and > 0",
-                    i + 1
+                    "[[stage]] {}: `penalty` = {}: must be finite and > 0",
+                    i + 1,
+                    units.written(Dimension::Stiffness, k)
                 );
             }
+        }
+        if self.target_gap.is_some() && self.kind != Kind::Squeeze {
+            invalid!(
+                "[[stage]] {}: `target_gap` belongs to squeeze stages",
+                i + 1
+            );
         }
         Ok(t)
     }
@@ -1040,7 +1132,8 @@ impl Case {
             ),
             _ => "no mesh".into(),
         };
-        let stages: Vec<String> = self.plan.iter().map(|p| p.describe()).collect();
+        let units = self.units();
+        let stages: Vec<String> = self.plan.iter().map(|p| p.describe_in(&units)).collect();
         format!(
             "L/R = {}, {} caps; {law}; {mesh}; {}",
             tubemem_material::Num(g.length / g.radius),
@@ -1054,6 +1147,31 @@ impl Case {
         self.units?;
         let mu = self.material.shear_modulus();
         tubemem_gps::Scales::new(self.geometry.radius, self.geometry.thickness?, mu).ok()
+    }
+
+    /// The case's unit system ([`crate::units`]): SI with its scales under `[units] system =
+    /// "SI"`, dimensionless otherwise.
+    pub fn units(&self) -> Units {
+        self.scales().map_or(Units::dimensionless(), Units::si)
+    }
+
+    /// The `[[stage.plane]]`s of stage `index` (0-based) in the dimensionless core: offsets
+    /// and targets per R, read in the case's units.
+    pub fn planes(&self, index: usize) -> Vec<PlaneSpec> {
+        let units = self.units();
+        self.stages
+            .get(index)
+            .map(|s| {
+                s.plane
+                    .iter()
+                    .map(|p| PlaneSpec {
+                        normal: p.normal,
+                        offset: units.to_core(Dimension::Length, p.offset),
+                        target: units.to_core(Dimension::Length, p.target),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
     }
 
     /// The hash of the case text the case was parsed from.
@@ -1240,9 +1358,10 @@ impl Case {
         if self.stages.is_empty() {
             invalid!("the case has no [[stage]]");
         }
+        let units = self.units();
         let mut plan = Vec::with_capacity(self.stages.len());
         for (i, s) in self.stages.iter().enumerate() {
-            plan.push(s.plan(i)?);
+            plan.push(s.plan(i, &units)?);
             if matches!(s.kind, Kind::Squeeze | Kind::Confine) && i == 0 {
                 invalid!(
                     "[[stage]] 1: a squeeze or confine stage needs an inflated tube: put an inflate stage before it"
@@ -1270,9 +1389,9 @@ impl Case {
                     if let Some((h, what)) = &height {
                         if r >= *h {
                             invalid!(
-                                "[[stage]] {}: `target_rho` = {}: the plates must close on the tube, below {what} (ρ < {})",
+                                "[[stage]] {}: the plates' half-gap ρ = {}: the plates must close on the tube, below {what} (ρ < {})",
                                 k + 1,
-                                tubemem_material::Num(r),
+                                units.show(Dimension::Ratio, r),
                                 tubemem_material::Num(*h)
                             );
                         }

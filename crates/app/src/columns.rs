@@ -35,12 +35,13 @@ pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volu
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
 arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
 augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,\
-mesh_refits";
+mesh_refits,plate_force";
 
 /// The SI columns steps.csv adds after [`STEPS_HEADER`] with `[units] system = "SI"`: the
-/// mid-span pressure p = ϖ μH/R, the resultants n μH, and in a squeeze the plate force per
-/// length force · πμH and the plates' half-gap ρR.
-pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m";
+/// mid-span pressure p = ϖ μH/R, the resultants n μH, in a squeeze the plate force per
+/// length force · πμH and the plates' half-gap ρR, then the total force on one plate, and
+/// GPS's pressure and force per length at the step.
+pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m,plate_force_n,gps_pressure_pa,gps_force_n_per_m";
 
 /// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
 /// bifurcation, as steps.csv's `critical`).
@@ -100,7 +101,7 @@ const PROFILES_COLUMNS: [Column; 13] = [
     RING[8], RING[9],
 ];
 
-const STEPS_COLUMNS: [Column; 39] = [
+const STEPS_COLUMNS: [Column; 40] = [
     STAGE,
     STEP,
     c("w", "reduced mid-span pressure ϖ = pR/(μH) (eq. 67)"),
@@ -164,9 +165,13 @@ const STEPS_COLUMNS: [Column; 39] = [
         "the largest |p_c/ϖ − 1| over the flat zone's interior next to Z = 0 (empty: no element wholly in contact)",
     ),
     c("mesh_refits", "edge-tracked contact: the mesh moves and re-solves of the step"),
+    c(
+        "plate_force",
+        "squeeze: the total force on one plate (the whole tube, caps included, all symmetry copies) over μHR: the integral of the contact pressure over the plate",
+    ),
 ];
 
-const SI_COLUMNS: [Column; 5] = [
+const SI_COLUMNS: [Column; 8] = [
     c(
         "pressure_pa",
         "with [units] system = \"SI\": the mid-span pressure p = ϖμH/R (Pa)",
@@ -180,6 +185,18 @@ const SI_COLUMNS: [Column; 5] = [
     c(
         "half_gap_m",
         "with SI units, squeeze rows: the plates' half-gap ρR (m)",
+    ),
+    c(
+        "plate_force_n",
+        "with SI units, squeeze rows: the total force on one plate, plate_force·μHR (N)",
+    ),
+    c(
+        "gps_pressure_pa",
+        "with SI units: GPS's pressure at the step, gps_w·μH/R (Pa)",
+    ),
+    c(
+        "gps_force_n_per_m",
+        "with SI units, squeeze rows: GPS's plate force per length, gps_force·πμH (N/m)",
     ),
 ];
 

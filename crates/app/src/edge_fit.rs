@@ -108,8 +108,8 @@ pub(crate) fn contact_edges(
                 .map_err(|e| AppError::gps(context("section between the plates"), e))?
         }
         _ => {
-            let walls = case.stages[k]
-                .plane
+            let walls = case
+                .planes(k)
                 .iter()
                 .map(|p| p.wall_at(1.0))
                 .collect::<std::result::Result<Vec<_>, _>>()

@@ -46,6 +46,7 @@ pub mod run;
 pub mod sequencing;
 pub mod stage;
 pub mod stats;
+pub mod units;
 pub mod verify;
 
 use std::path::PathBuf;

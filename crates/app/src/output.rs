@@ -164,6 +164,7 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
             .and_then(|c| c.values.flat_pressure_deviation),
     );
     v.push(r.edge_tracking.as_ref().map(|t| t.refits as f64));
+    v.push(r.contact.as_ref().map(|c| c.values.total_force));
     v
 }
 
@@ -177,14 +178,23 @@ pub(crate) fn steps_header(units: bool) -> String {
 }
 
 /// The [`SI_HEADER`] values of a step (empty where the step has none).
-pub fn si_values(s: &tubemem_gps::Scales, r: &StepRecord) -> [Option<f64>; 5] {
+pub fn si_values(s: &tubemem_gps::Scales, r: &StepRecord) -> [Option<f64>; 8] {
     let v = crate::report::SiValues::of(s, &r.midspan, r.contact.as_ref().map(|c| &c.values));
+    let cf = &r.closed_form;
+    let (gps_w, gps_force) = match (&cf.gps_inflation, &cf.gps_flattening) {
+        (Some(g), _) => (Some(g.w), None),
+        (None, Some(g)) => (Some(g.w), Some(g.force)),
+        _ => (None, None),
+    };
     [
         Some(v.pressure_pa),
         Some(v.n_s_n_per_m),
         Some(v.n_z_n_per_m),
         v.force_n_per_m,
         v.half_gap_m,
+        v.plate_force_n,
+        gps_w.map(|w| s.pressure(w)),
+        gps_force.map(|f| s.force_per_length(f)),
     ]
 }
 
@@ -210,6 +220,12 @@ pub(crate) fn format_row(r: &StepRecord) -> String {
         .collect();
     fields.join(",")
 }
+
+/// The VTU field data `units` of a case in SI: what its points and fields are in.
+pub const VTU_UNITS_SI: &str = "SI: points and displacement in m, n_1 and n_2 in N/m, contact_pressure in Pa; lambda_s, lambda_z and wrinkled are ratios and codes";
+
+/// The VTU field data `units` of a dimensionless case.
+pub const VTU_UNITS_DIMENSIONLESS: &str = "dimensionless: points and displacement in R, n_1 and n_2 in μH, contact_pressure in μH/R (as ϖ); lambda_s, lambda_z and wrinkled are ratios and codes";
 
 /// What to do with an output folder that already holds a run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -422,6 +438,8 @@ pub struct RunWriter {
     vtu_bytes: u64,
     /// which steps get a frame
     vtu: crate::case::OutputSpec,
+    /// the case's unit system: the VTU's points and fields are written in it
+    units: crate::units::Units,
 }
 
 impl RunWriter {
@@ -597,6 +615,7 @@ impl RunWriter {
             resumed: false,
             checkpoint_every: 1,
             vtu_bytes: 0,
+            units: crate::units::Units::dimensionless(),
             vtu: crate::case::OutputSpec::default(),
         })
     }
@@ -657,24 +676,34 @@ impl RunWriter {
         state: &State,
         contact: Option<&tubemem_fem::contact::Contact>,
     ) -> Result<(), BoxError> {
+        use crate::units::Dimension;
         let cells = cell_values(model, state)?;
+        // the case's units: lengths in m and resultants in N/m under SI, R and μH otherwise
+        let (length, resultant, pressure) = (
+            self.units.factor(Dimension::Length),
+            self.units.factor(Dimension::Resultant),
+            self.units.factor(Dimension::Pressure),
+        );
         let disp: Vec<f64> = state
             .x
             .iter()
             .zip(&model.mesh().nodes)
-            .flat_map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]])
+            .flat_map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]].map(|d| d * length))
             .collect();
-        let pick = |f: fn(&tubemem_fem::post::CellValues) -> f64| {
+        let pick = |f: &dyn Fn(&tubemem_fem::post::CellValues) -> f64| {
             cells.iter().map(f).collect::<Vec<f64>>()
         };
         let (hoop, axial, n1, n2) = (
-            pick(|c| c.hoop_stretch),
-            pick(|c| c.axial_stretch),
-            pick(|c| c.n1),
-            pick(|c| c.n2),
+            pick(&|c| c.hoop_stretch),
+            pick(&|c| c.axial_stretch),
+            pick(&|c| c.n1 * resultant),
+            pick(&|c| c.n2 * resultant),
         );
-        let wrinkled = pick(|c| regime_code(c.regime()));
-        let pc = cell_contact_pressure(model, state, contact);
+        let wrinkled = pick(&|c| regime_code(c.regime()));
+        let pc: Vec<f64> = cell_contact_pressure(model, state, contact)
+            .into_iter()
+            .map(|p| p * pressure)
+            .collect();
         let name = format!("step_{:05}.vtu", self.frames);
         // a frame is about as large as the last one: refuse before the series passes the cap
         let last = self.vtu_bytes / (self.frames.max(1) as u64);
@@ -697,7 +726,10 @@ impl RunWriter {
             &[]
         };
         let m = Mirror::new(axes, &model.mesh().nodes);
-        let (points, quads) = m.geometry(&state.x, &model.mesh().cells());
+        let (mut points, quads) = m.geometry(&state.x, &model.mesh().cells());
+        if length != 1.0 {
+            points.iter_mut().for_each(|p| *p = p.map(|c| c * length));
+        }
         let disp = m.vector_field(&disp);
         let cellf: Vec<Vec<f64>> = [&hoop, &axial, &n1, &n2, &wrinkled, &pc]
             .iter()
@@ -733,6 +765,15 @@ impl RunWriter {
                     FieldValue::Text(env!("CARGO_PKG_VERSION")),
                 ),
                 ("case_hash", FieldValue::Text(&self.case_hash)),
+                // what the points and fields are in
+                (
+                    "units",
+                    FieldValue::Text(if self.units.is_si() {
+                        VTU_UNITS_SI
+                    } else {
+                        VTU_UNITS_DIMENSIONLESS
+                    }),
+                ),
                 // the steps.csv row, stage and step of the frame (0, 0, 0: the reference state)
                 ("steps_csv_row", FieldValue::Numbers(&[tag.0 as f64])),
                 ("stage", FieldValue::Numbers(&[tag.1 as f64])),
@@ -980,6 +1021,10 @@ impl Observer for RunWriter {
         model: &Model,
         state: &State,
     ) -> Result<(), BoxError> {
+        self.units = report.scales.map_or(
+            crate::units::Units::dimensionless(),
+            crate::units::Units::si,
+        );
         self.write_manifest(report, "running", None)?;
         if self.resumed {
             return Ok(());

@@ -578,7 +578,8 @@ pub struct Summary<'a> {
 }
 
 /// A state in SI units (`[units] system = "SI"`): p = ϖ μH/R (eq. 67), N = n μH, the plate
-/// force per length F = force · πμH (eq. 80), lengths times R.
+/// force per length F = force · πμH (eq. 80), lengths times R, the total plate force times
+/// μHR.
 #[derive(Clone, Copy, Debug, Serialize, schemars::JsonSchema, Deserialize, PartialEq)]
 pub struct SiValues {
     pub pressure_pa: f64,
@@ -588,6 +589,9 @@ pub struct SiValues {
     pub force_n_per_m: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub half_gap_m: Option<f64>,
+    /// the total force on one plate (the whole tube, caps included), N
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plate_force_n: Option<f64>,
 }
 
 impl SiValues {
@@ -603,6 +607,8 @@ impl SiValues {
             n_z_n_per_m: s.resultant(m.n_z),
             force_n_per_m: contact.map(|c| s.force_per_length(c.force)),
             half_gap_m: contact.map(|c| c.rho * s.radius),
+            plate_force_n: contact
+                .map(|c| c.total_force * s.shear_modulus * s.thickness * s.radius),
         }
     }
 }

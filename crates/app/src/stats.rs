@@ -112,6 +112,13 @@ pub struct EndFit {
     pub k: f64,
     /// root-mean-square residual over max |e − c|: how well the law describes the family
     pub relative_residual: f64,
+    /// the inverse law's truncation: |c' − c|, c' the constant of the law with its next term,
+    /// c + A/(L/R) + B/(L/R)², fitted to the same family (the cap's gas keeps a share that
+    /// falls as 1/(L + L₀), whose expansion has that term). It bounds how far the fitted c,
+    /// the family's limit at infinite length, moves with the law; `None` for the exponential
+    /// law, or with fewer than three lengths
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truncation: Option<f64>,
 }
 
 impl EndFit {
@@ -198,13 +205,56 @@ pub fn fit_end_law(law: EndLaw, l: &[f64], e: &[f64]) -> Option<EndFit> {
     };
     let scale = e.iter().map(|v| (v - c).abs()).fold(0.0, f64::max);
     let rms = (ss / l.len() as f64).sqrt();
+    let truncation = match law {
+        EndLaw::Inverse => quadratic_constant(l, e).map(|c3| (c3 - c).abs()),
+        EndLaw::Exponential => None,
+    };
     Some(EndFit {
         law,
         c,
         a,
         k,
         relative_residual: if scale > 0.0 { rms / scale } else { 0.0 },
+        truncation,
     })
+}
+
+/// The constant c of the least-squares fit e ≈ c + A/L + B/L² (three or more lengths; `None`
+/// where the normal equations are singular: fewer than three distinct lengths).
+fn quadratic_constant(l: &[f64], e: &[f64]) -> Option<f64> {
+    let mut m = [[0.0f64; 3]; 3];
+    let mut b = [0.0f64; 3];
+    for (&x, &y) in l.iter().zip(e) {
+        let g = [1.0, 1.0 / x, 1.0 / (x * x)];
+        for i in 0..3 {
+            b[i] += g[i] * y;
+            for j in 0..3 {
+                m[i][j] += g[i] * g[j];
+            }
+        }
+    }
+    // Gaussian elimination with partial pivoting on the 3 × 3 normal equations
+    for col in 0..3 {
+        let piv = (col..3).max_by(|&i, &j| m[i][col].abs().total_cmp(&m[j][col].abs()))?;
+        if m[piv][col].abs() <= 1e-300 {
+            return None;
+        }
+        m.swap(col, piv);
+        b.swap(col, piv);
+        for row in col + 1..3 {
+            let f = m[row][col] / m[col][col];
+            for k in col..3 {
+                m[row][k] -= f * m[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0f64; 3];
+    for row in (0..3).rev() {
+        let s: f64 = (row + 1..3).map(|k| m[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / m[row][row];
+    }
+    x[0].is_finite().then_some(x[0])
 }
 
 #[cfg(test)]
@@ -264,5 +314,29 @@ mod tests {
         let f = fit_end_law(EndLaw::Inverse, &l, &e).unwrap();
         assert!((f.a + 0.26).abs() < 1e-12 && f.relative_residual < 1e-12);
         assert!((f.length_for(1e-3) - 260.0).abs() < 1e-9);
+        // an exact inverse law has no truncation
+        assert!(f.truncation.unwrap() < 1e-12, "{f:?}");
+    }
+
+    /// The gas the caps keep falls as A/(L + L₀) = A/L − A L₀/L² + …: fitted with c + A/L
+    /// alone over L, 1.5L, 2L, its constant c is off by the second term, and the truncation
+    /// (the change of c when B/L² is added) measures that shift: within 5 % of the true offset
+    /// of the 2-term c from the limit c₀ (the rest is the third term, A L₀²/L³).
+    #[test]
+    fn the_inverse_laws_truncation_measures_the_next_term() {
+        let (c0, a, l0) = (5e-5, -0.23, 1.5);
+        let l = [18.18, 27.27, 36.36];
+        let e: Vec<f64> = l.iter().map(|x| c0 + a / (x + l0)).collect();
+        let f = fit_end_law(EndLaw::Inverse, &l, &e).unwrap();
+        let offset = (f.c - c0).abs();
+        let t = f.truncation.unwrap();
+        assert!(
+            offset > 1e-4,
+            "the 2-term c must be visibly off here: {offset}"
+        );
+        assert!(
+            (t / offset - 1.0).abs() < 0.05,
+            "truncation {t} against offset {offset}"
+        );
     }
 }

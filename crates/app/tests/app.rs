@@ -1345,7 +1345,11 @@ fn the_study_gates_the_squeeze_force_and_gives_one_verdict_with_and_without_quic
                 counts.lock().unwrap().push((done, total));
             }
         };
-        let s = run_study(&case, &out, quick, &opts, &progress).unwrap();
+        let study = tubemem_app::verify::study::StudyOptions {
+            quick,
+            ..Default::default()
+        };
+        let s = run_study(&case, &out, &study, &opts, &progress).unwrap();
         let mut counts = counts.into_inner().unwrap();
         counts.sort();
         assert_eq!(
@@ -1428,7 +1432,11 @@ fn the_study_of_24_around_refines_upward() {
         python: Some("/nonexistent/python".into()),
         ..Default::default()
     };
-    let s = run_study(&case, &d.join("out"), true, &opts, &|_| {}).unwrap();
+    let study = tubemem_app::verify::study::StudyOptions {
+        quick: true,
+        ..Default::default()
+    };
+    let s = run_study(&case, &d.join("out"), &study, &opts, &|_| {}).unwrap();
     let conv = s.results.iter().find(|r| r.name == "convergence").unwrap();
     assert_eq!(conv.status, Status::Pass, "{}", conv.message);
     assert_eq!(conv.details["around"], serde_json::json!([24, 48, 96]));

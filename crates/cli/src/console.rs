@@ -8,6 +8,7 @@ use std::io::IsTerminal;
 use tubemem_app::case::StagePlan;
 use tubemem_app::observer::{BoxError, Observer, StepView};
 use tubemem_app::report::{rel, ClosedFormState, LocalSection, RunReport, StageOutcome};
+use tubemem_app::units::{Dimension, Units};
 use tubemem_fem::model::{Model, State};
 
 /// Prints a run's progress and results.
@@ -21,6 +22,9 @@ pub struct Console {
     /// `--log FILE`: one line per converged step, like an Abaqus .sta file
     log: Option<std::io::BufWriter<std::fs::File>>,
     started: std::time::Instant,
+    /// the case's unit system (from the report at the start): SI values beside the
+    /// dimensionless ones
+    units: Units,
 }
 
 impl Console {
@@ -48,12 +52,14 @@ impl Default for Console {
             pending: None,
             log: None,
             started: std::time::Instant::now(),
+            units: Units::dimensionless(),
         }
     }
 }
 
 impl Observer for Console {
     fn started(&mut self, report: &RunReport, _m: &Model, _s: &State) -> Result<(), BoxError> {
+        self.units = report.scales.map_or(Units::dimensionless(), Units::si);
         say!(
             "tubemem run: {} — {} elements, {} equations ({} model), {}",
             report.case,
@@ -92,7 +98,12 @@ impl Observer for Console {
     }
 
     fn stage_started(&mut self, plan: &StagePlan, stages: usize) {
-        let label = format!("stage {}/{} ({})", plan.index, stages, plan.describe());
+        let label = format!(
+            "stage {}/{} ({})",
+            plan.index,
+            stages,
+            plan.describe_in(&self.units)
+        );
         if self.terminal {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             bar.set_style(
@@ -116,8 +127,15 @@ impl Observer for Console {
         self.warn(v.report)?;
         let r = v.record;
         let res = r.residuals.last().copied().unwrap_or(f64::NAN);
+        let si = match self.units.scales() {
+            Some(_) => format!(
+                " (p = {:.5e} Pa)",
+                self.units.from_core(Dimension::Pressure, r.midspan.w)
+            ),
+            None => String::new(),
+        };
         let msg = format!(
-            "step {}: ϖ = {:.5}, λs = {:.5}, {} Newton its, residual {res:.1e}",
+            "step {}: ϖ = {:.5}{si}, λs = {:.5}, {} Newton its, residual {res:.1e}",
             r.step, r.midspan.w, r.midspan.lambda_s, r.newton_iterations
         );
         match &self.bar {
@@ -163,6 +181,34 @@ impl Observer for Console {
             "stage {}: ϖ = {:.6} (GPS {:.6}, {:+.3}%; PS {:.6}), λs = {:.6} (GPS {:.6}), λz = {:.6} (GPS {:.6}; PS 1), N_s = {:.6}, N_z = {:.6}, N_sz = {:.1e}",
             s.index, ms.w, w, 100.0 * rel(ms.w, w), ps_w, ms.lambda_s, ls, ms.lambda_z, lz, ms.n_s, ms.n_z, ms.n_sz
         )?;
+        if let Some(sc) = report.scales {
+            let u = &self.units;
+            let si = tubemem_app::report::SiValues::of(
+                &sc,
+                ms,
+                stage
+                    .steps
+                    .last()
+                    .and_then(|st| st.contact.as_ref())
+                    .map(|c| &c.values),
+            );
+            let mut line = format!(
+                "         in SI: p = {:.6e} Pa (GPS {:.6e} Pa), N_s = {:.6e} N/m, N_z = {:.6e} N/m",
+                si.pressure_pa,
+                u.from_core(Dimension::Pressure, w),
+                si.n_s_n_per_m,
+                si.n_z_n_per_m
+            );
+            if let (Some(f), Some(h), Some(total)) =
+                (si.force_n_per_m, si.half_gap_m, si.plate_force_n)
+            {
+                line.push_str(&format!(
+                    ", half-gap {h:.6e} m, plate force per length {f:.6e} N/m (GPS {:.6e} N/m), total force on one plate {total:.6e} N",
+                    u.from_core(Dimension::ForcePerLength, force)
+                ));
+            }
+            say!("{line}")?;
+        }
         if let Some(why) = &s.gps_not_applicable {
             say!("         ✗ the comparison with GPS does not apply: {why}")?;
         }
@@ -231,8 +277,12 @@ impl Observer for Console {
             } else {
                 "plug"
             };
+            let si = match self.units.scales() {
+                Some(_) => format!(" ({:.4e} m)", self.units.from_core(Dimension::Length, d)),
+                None => String::new(),
+            };
             say!(
-                "         λs is within 0.1 % of its mid-span value from {d:.3} R inside the {end}"
+                "         λs is within 0.1 % of its mid-span value from {d:.3} R{si} inside the {end}"
             )?;
         }
         Ok(())

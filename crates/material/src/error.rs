@@ -89,6 +89,17 @@ pub enum MaterialError {
         "stretch beyond the locking limit of the {law} law: I1 = {i1:.6} but the law requires I1 < {limit:.6}"
     )]
     Locking { law: String, i1: f64, limit: f64 },
+    /// The state lies beyond the stretch at which the law loses stability (its membrane
+    /// tangent stops being positive definite: a fitted law with a negative coefficient).
+    #[error(
+        "the {law} law is stable only for I1 < {limit:.6} (equibiaxial stretch {stretch:.5}; its membrane tangent loses positive definiteness there): I1 = {i1:.6} is beyond it"
+    )]
+    Unstable {
+        law: String,
+        i1: f64,
+        limit: f64,
+        stretch: f64,
+    },
     /// A parameter (of a law with named or indexed parameters) outside its admissible range.
     /// (The text fields of this and the next two variants are boxed `str`s, so that the error
     /// stays as small as the paper's laws' errors.)

@@ -114,6 +114,13 @@ pub trait MembraneLaw: Send + Sync + std::fmt::Debug {
     fn locking_limit(&self) -> Option<f64> {
         None
     }
+    /// The largest I1 = tr C + 1/det C below which the law is stable (its membrane tangent
+    /// positive definite at every state), for laws that lose stability at large stretch (a
+    /// Yeoh law with C30 < 0); `None` for laws stable at every stretch. Beyond it the law
+    /// returns [`MaterialError::Unstable`].
+    fn stable_limit(&self) -> Option<f64> {
+        None
+    }
     /// W(a, b) and its derivatives. Called with a > 0, b > 0 only; returns
     /// [`MaterialError::Locking`] beyond a finite-extensibility limit.
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError>;
@@ -417,6 +424,9 @@ impl MembraneLaw for Box<dyn MembraneLaw> {
     }
     fn locking_limit(&self) -> Option<f64> {
         (**self).locking_limit()
+    }
+    fn stable_limit(&self) -> Option<f64> {
+        (**self).stable_limit()
     }
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
         (**self).derivatives_ab(a, b)

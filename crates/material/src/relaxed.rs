@@ -103,6 +103,9 @@ impl<L: MembraneLaw> MembraneLaw for Relaxed<L> {
     fn locking_limit(&self) -> Option<f64> {
         self.law.locking_limit()
     }
+    fn stable_limit(&self) -> Option<f64> {
+        self.law.stable_limit()
+    }
     fn derivatives_ab(&self, a: f64, b: f64) -> Result<EnergyDerivatives, MaterialError> {
         match self.regime(a, b)? {
             Regime::Taut => self.law.derivatives_ab(a, b),

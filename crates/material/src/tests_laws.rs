@@ -416,10 +416,13 @@ fn bad_laws_are_refused_with_their_reason() {
     let cases: Vec<(Built, &str)> = vec![
         (Yeoh::new(0.0, 0.0, 0.0).map(|l| Box::new(l) as _), "`c10`"),
         (
-            Yeoh::new(0.5, -1.0, 0.1).map(|l| Box::new(l) as _),
-            "C20² < 3 C10 C30",
+            Yeoh::new(0.5, -100.0, 0.1).map(|l| Box::new(l) as _),
+            "unstable already at small stretch",
         ),
-        (Yeoh::new(0.5, 0.0, -0.1).map(|l| Box::new(l) as _), "`c30`"),
+        (
+            Yeoh::new(0.5, 0.0, f64::NAN).map(|l| Box::new(l) as _),
+            "`c30`",
+        ),
         (Gent::new(1.0, 0.0).map(|l| Box::new(l) as _), "`jm`"),
         (
             GentGent::new(1.0, 10.0, -1.0).map(|l| Box::new(l) as _),
@@ -586,4 +589,78 @@ fn the_relaxation_of_every_new_law_is_tension_free_and_its_derivatives_check() {
             );
         }
     }
+}
+
+/// Issue #60 item 5: Yeoh with C30 < 0 (Elsayed et al. 2014's Ecoflex fits and many others) is
+/// accepted, stable up to the I1 where its membrane tangent stops being positive definite, and
+/// refuses states beyond it. The limit is held two ways: (1) it is at most the equibiaxial
+/// ray's own limit, solved here from the closed form of the tangent on that ray,
+/// W′(2 + 10λ⁻⁶) + 2W″(2λ − 2λ⁻⁵)² = 0 (the eigenvalue of ∂²W/∂λα∂λβ along (1, 1)), and
+/// (2) the law's own Hessian (`principal`, through the chain rule of `derivatives_ab`) is
+/// positive definite at 2000 states spread below the limit.
+#[test]
+fn yeoh_with_a_negative_c30_is_stable_up_to_its_limit_and_refuses_beyond() {
+    let (c10, c20, c30) = (0.5, 0.02, -2e-4);
+    let law = Yeoh::new(c10, c20, c30).unwrap();
+    let limit = law.stable_limit().expect("C30 < 0 has a limit");
+    // W'(x), W''(x) per μ (μ = 2 C10 = 1)
+    let w1 = |x: f64| c10 + 2.0 * c20 * x + 3.0 * c30 * x * x;
+    let w2 = |x: f64| 2.0 * c20 + 6.0 * c30 * x;
+    let eq = |l: f64| {
+        let x = 2.0 * l * l + l.powi(-4) - 3.0;
+        w1(x) * (2.0 + 10.0 * l.powi(-6)) + 2.0 * w2(x) * (2.0 * l - 2.0 * l.powi(-5)).powi(2)
+    };
+    let (mut lo, mut hi) = (1.0f64, 10.0f64);
+    assert!(eq(lo) > 0.0 && eq(hi) < 0.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if eq(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let equibiaxial_limit = 2.0 * lo * lo + lo.powi(-4);
+    assert!(
+        limit <= equibiaxial_limit * (1.0 + 1e-9) && limit > 3.5,
+        "limit I1 = {limit}, equibiaxial ray's {equibiaxial_limit}"
+    );
+    // below the limit: positive-definite Hessians (a deterministic spread of states)
+    let mut seed = 12345u64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut checked = 0;
+    while checked < 2000 {
+        let l1 = 1.0 + 4.0 * next();
+        let l2 = l1.powf(-0.5 + 1.5 * next());
+        let i1 = l1 * l1 + l2 * l2 + 1.0 / (l1 * l1 * l2 * l2);
+        if i1 >= limit * (1.0 - 1e-6) {
+            continue;
+        }
+        let h = law.principal(l1, l2).unwrap().hess;
+        assert!(
+            h[0][0] > 0.0 && h[0][0] * h[1][1] - h[0][1] * h[1][0] > 0.0,
+            "λ = ({l1}, {l2}), I1 = {i1}: {h:?}"
+        );
+        checked += 1;
+    }
+    // beyond it: refused, naming the limit
+    let l = (0.5 * (limit + 1.0)).sqrt();
+    let e = law.principal(l * 1.01, l * 1.01).unwrap_err();
+    assert!(
+        matches!(e, MaterialError::Unstable { .. })
+            && e.to_string().contains("stable only for I1 <"),
+        "{e}"
+    );
+    // the shipped case's law (C20 < 0 with C20² < 3 C10 C30) stays stable far beyond its use
+    let shipped = Yeoh::new(0.5, -0.01, 0.001).unwrap();
+    assert!(
+        shipped.stable_limit().is_none_or(|x| x > 100.0),
+        "{:?}",
+        shipped.stable_limit()
+    );
 }

@@ -14,9 +14,10 @@ use std::path::PathBuf;
 /// checks do not raise (read `failed` and each check's `status`). The `reference` checks run
 /// the scikit-fem references in `python` (default: this interpreter, where
 /// `pip install ./python_ref` puts them) or from the `python_ref` folder given (default
-/// `TUBEMEM_PYTHON_REF`, else a checkout's above the case or the working folder).
+/// `TUBEMEM_PYTHON_REF`, else a checkout's above the case or the working folder). `epsilon`
+/// (with `case=`) is the accuracy asked for, relative (default 1e-3), as `--epsilon`.
 #[pyfunction]
-#[pyo3(signature = (suites=None, out=PathBuf::from("tubemem-verify"), case=None, quick=false, jobs=0, filter=None, update_gold=false, python=None, python_ref=None))]
+#[pyo3(signature = (suites=None, out=PathBuf::from("tubemem-verify"), case=None, quick=false, jobs=0, filter=None, update_gold=false, python=None, python_ref=None, epsilon=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn verify<'py>(
     py: Python<'py>,
@@ -29,6 +30,7 @@ pub(crate) fn verify<'py>(
     update_gold: bool,
     python: Option<PathBuf>,
     python_ref: Option<PathBuf>,
+    epsilon: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     use tubemem_app::verify::{self as v, report::Results, VerifyOptions};
     let python = match python {
@@ -52,7 +54,13 @@ pub(crate) fn verify<'py>(
     let (names, results, verdict) = match (case, suites) {
         (Some(c), None) => {
             let s = py
-                .detach(|| v::study::run_study(&c, &out, quick, &opts, &quiet))
+                .detach(|| {
+                    let study = v::study::StudyOptions {
+                        quick,
+                        epsilon: epsilon.unwrap_or(v::study::DEFAULT_EPSILON),
+                    };
+                    v::study::run_study(&c, &out, &study, &opts, &quiet)
+                })
                 .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
             (
                 vec![format!("study of {}", c.display())],

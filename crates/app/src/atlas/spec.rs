@@ -262,6 +262,8 @@ pub fn member_case(
         ));
     }
     geometry.insert("length".into(), toml::Value::Float(length * radius));
+    // the atlas's plane offsets are per R; a member case in SI reads its lengths in metres
+    let length_unit = if t.contains_key("units") { radius } else { 1.0 };
     let mesh = t
         .entry("mesh")
         .or_insert_with(|| toml::Value::Table(toml::Table::new()))
@@ -314,8 +316,8 @@ pub fn member_case(
                         ),
                     );
                     let (a, b) = p.offset.map_or((from, rho), |d| (d, d));
-                    t.insert("offset".into(), toml::Value::Float(a));
-                    t.insert("target".into(), toml::Value::Float(b));
+                    t.insert("offset".into(), toml::Value::Float(a * length_unit));
+                    t.insert("target".into(), toml::Value::Float(b * length_unit));
                     toml::Value::Table(t)
                 })
                 .collect();
@@ -470,7 +472,15 @@ fn check(s: &AtlasSpec, template: &toml::Table) -> Result<(), AtlasError> {
             ));
         }
     }
-    for key in ["kind", "target_rho", "steps", "plane", "target", "offset"] {
+    for key in [
+        "kind",
+        "target_rho",
+        "target_gap",
+        "steps",
+        "plane",
+        "target",
+        "offset",
+    ] {
         if s.squeeze.contains_key(key) {
             return Err(bad(
                 &format!("atlas.squeeze.{key}"),

@@ -137,7 +137,7 @@ fn run_inner(
         for o in observers.iter_mut() {
             o.stage_started(plan, stages);
         }
-        let kind = crate::stage::kind_of(plan, &case.stages[i - 1].plane);
+        let kind = crate::stage::kind_of(plan, &case.planes(i - 1));
         let resume_here = options.resume.as_ref().filter(|c| c.context.stage == i);
         let start = runner.stage_start(kind.as_ref(), plan, stages, report, resume_here)?;
         drive_stage(

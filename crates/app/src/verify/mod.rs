@@ -354,6 +354,15 @@ pub fn run_check_with(
                         .collect::<Vec<_>>()
                         .join("; ");
                 }
+                // nothing held to a tolerance (every measure reported): say what was measured
+                if r.message.is_empty() {
+                    r.message = r
+                        .measures
+                        .iter()
+                        .map(|m| format!("{}: {}", m.quantity, m.note))
+                        .collect::<Vec<_>>()
+                        .join("; ");
+                }
             } else {
                 r.status = Status::Fail;
                 r.message = failed.join("; ");
@@ -407,6 +416,9 @@ pub enum VerifyError {
     /// a study the case cannot have
     #[error("{0}")]
     Study(&'static str),
+    /// the study's ε is not an accuracy
+    #[error("--epsilon {0}: the accuracy asked for must be a relative number in (0, 0.5)")]
+    Epsilon(f64),
 }
 
 /// A kind's error message: the whole chain.

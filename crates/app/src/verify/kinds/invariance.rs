@@ -79,8 +79,15 @@ fn core(
 fn invariance(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
     let eps = c.spec.epsilon.unwrap_or(1e-3);
     let report = member(c, &c.case_text, &dir.join("run"), r)?;
-    let half = 0.5 * report.geometry.length;
-    let length = report.geometry.length;
+    // the profiles' reference z is in R (the dimensionless core), whatever the case's units:
+    // the tube's length is taken in R too, L/R
+    let length = report.geometry.length / report.geometry.radius;
+    let half = 0.5 * length;
+    let units = report.scales.map_or(
+        crate::units::Units::dimensionless(),
+        crate::units::Units::si,
+    );
+    let in_units = |v: f64| units.show(crate::units::Dimension::Length, v);
     let mut per_step = vec![];
     let mut worst: Option<(f64, &StepRecord, String)> = None;
     let mut pts = vec![];
@@ -103,11 +110,18 @@ fn invariance(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult)
         };
         let minus = minus.unwrap_or(plus);
         let fraction = (plus + minus) / length;
+        // a core longer than the tube is a unit mix-up, never a result (issue #60)
+        if !(0.0..=1.0 + 1e-9).contains(&fraction) {
+            return Err(format!(
+                "stage {} step {}: the invariant core {:.6} R is not within the tube's length {:.6} R: the profile and the tube's length disagree in their units",
+                s.stage, s.step, plus + minus, length
+            ));
+        }
         per_step.push(serde_json::json!({
-            "stage": s.stage, "step": s.step, "core_length": (plus + minus) / report.geometry.radius,
+            "stage": s.stage, "step": s.step, "core_length": plus + minus,
             "core_fraction": fraction,
-            "boundary_layer_plus": (half - plus) / report.geometry.radius,
-            "boundary_layer_minus": (half - minus) / report.geometry.radius,
+            "boundary_layer_plus": half - plus,
+            "boundary_layer_minus": half - minus,
             "limited_by": why,
         }));
         pts.push(((i + 1) as f64, fraction));
@@ -128,13 +142,13 @@ fn invariance(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult)
         pass: tol.as_ref().is_none_or(|t| fraction >= t.value),
         at_least: tol.is_some(),
         note: format!(
-            "smallest over {} steps, at stage {} step {}: the middle {:.2} R of {:.2} R stay within ε = {eps:e} of mid-span (then {why} leaves it); boundary layer {:.2} R at each cap",
+            "smallest over {} steps, at stage {} step {}: the middle {} of {} stay within ε = {eps:e} of mid-span (then {why} leaves it); boundary layer {} at each cap",
             per_step.len(),
             s.stage,
             s.step,
-            fraction * length / report.geometry.radius,
-            length / report.geometry.radius,
-            (1.0 - fraction) * 0.5 * length / report.geometry.radius,
+            in_units(fraction * length),
+            in_units(length),
+            in_units((1.0 - fraction) * 0.5 * length),
         ),
     });
     if tol.is_none() {
