@@ -1368,7 +1368,34 @@ impl Case {
                 );
             }
         }
-        self.material.build().map_err(CaseError::Material)?;
+        let law = self.material.build().map_err(CaseError::Material)?;
+        // a law stable only up to some stretch (a Yeoh law with a negative coefficient): every
+        // inflation target's GPS state must lie below it
+        if let Some(limit) = law.stable_limit() {
+            for (k, p) in plan.iter().enumerate() {
+                let Target::Stretch(ls) = p.target else {
+                    continue;
+                };
+                let Ok(st) = tubemem_gps::inflate(law.as_ref(), tubemem_gps::Hypothesis::Gps, ls)
+                else {
+                    continue;
+                };
+                let lz = st.lambda_z;
+                let i1 = ls * ls + lz * lz + 1.0 / (ls * ls * lz * lz);
+                if i1 >= limit {
+                    invalid!(
+                        "[[stage]] {}: `target_stretch` = {}: [material] {} is stable only for I1 < {:.5} (its membrane tangent loses positive definiteness there), and the GPS state at λs* = {} (λz = {:.5}) has I1 = {:.5}: lower the target, or fit the law over the stretches the tube reaches",
+                        k + 1,
+                        tubemem_material::Num(ls),
+                        law.name(),
+                        limit,
+                        tubemem_material::Num(ls),
+                        lz,
+                        i1
+                    );
+                }
+            }
+        }
         // a squeeze must close the plates on the tube: where the plan fixes the half-height at
         // its start (a stretch-controlled inflation ends with the mid-span ring at λs* R, a
         // squeeze with the plates at ρR), `target_rho` must be below it

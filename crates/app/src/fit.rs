@@ -2,13 +2,18 @@
 //! table, or a model name and starting values estimated from the data), the fit
 //! ([`tubemem_material::fit`]), its figure and its report.
 //!
-//! A data file is CSV: a header line, then one `stretch,nominal_stress` pair per line; lines
-//! starting with `#` are comments. Stresses are in any unit: the fitted moduli come out in it.
+//! A data file is CSV: a header naming its columns, then one row per point; lines starting
+//! with `#` are comments. The columns are found by name: `stretch` (or `lambda`), and the
+//! nominal stress, `nominal_stress` or `stress`, whose unit the name gives as a suffix
+//! (`nominal_stress_mpa`, `stress_kpa`, `stress_pa`) or in brackets (`stress (MPa)`). Stresses
+//! in a known unit are read in pascals, so the fitted moduli come out in Pa, ready for a case
+//! with `[units] system = "SI"`; a header that names no unit keeps the data's numbers, and the
+//! report says so. Every file of one fit must agree.
 
 use crate::figures::{save, Figure, FigureOptions, Markers, Series, Stroke};
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
-use tubemem_material::fit::{fit, nominal_stress, FitResult, Mode, TestData};
+use tubemem_material::fit::{fit_with, nominal_stress, FitOptions, FitResult, Mode, TestData};
 use tubemem_material::{MaterialError, MaterialSpec};
 
 /// Why a fit could not be made.
@@ -35,10 +40,81 @@ pub enum FitError {
     Fit(#[source] tubemem_material::fit::FitError),
     #[error("the fit's figure")]
     Figure(#[source] Box<crate::AppError>),
+    /// the files of one fit give their stresses in different units, or some name none
+    #[error("{0}")]
+    Units(String),
 }
 
-/// Read a test's CSV file: a header, then `stretch,nominal_stress` rows.
-pub fn read_test(path: &Path, mode: Mode) -> Result<TestData, FitError> {
+/// A stress unit a data file's header names, with its factor to pascals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StressUnit {
+    pub name: &'static str,
+    pub pascals: f64,
+}
+
+/// The stress units a header may name (case-insensitive).
+pub const STRESS_UNITS: [StressUnit; 5] = [
+    StressUnit {
+        name: "Pa",
+        pascals: 1.0,
+    },
+    StressUnit {
+        name: "kPa",
+        pascals: 1e3,
+    },
+    StressUnit {
+        name: "MPa",
+        pascals: 1e6,
+    },
+    StressUnit {
+        name: "GPa",
+        pascals: 1e9,
+    },
+    StressUnit {
+        name: "psi",
+        pascals: 6_894.757_293_168,
+    },
+];
+
+/// The unit a stress column's name gives (`nominal_stress_mpa`, `stress (kPa)`), if any.
+pub fn unit_of_column(name: &str) -> Option<StressUnit> {
+    let n = name.trim().to_ascii_lowercase();
+    let tail = n
+        .rsplit(['_', '(', '[', ' '])
+        .next()
+        .unwrap_or("")
+        .trim_end_matches([')', ']']);
+    STRESS_UNITS
+        .iter()
+        .copied()
+        .find(|u| u.name.to_ascii_lowercase() == tail)
+}
+
+/// One test's data as read: the points (stresses in Pa where the unit is known) and the unit.
+#[derive(Clone, Debug)]
+pub struct TestFile {
+    pub data: TestData,
+    pub unit: Option<StressUnit>,
+}
+
+/// The longest excerpt of a data line a message quotes.
+const EXCERPT: usize = 60;
+
+fn excerpt(line: &str) -> String {
+    if line.chars().count() <= EXCERPT {
+        line.to_string()
+    } else {
+        format!("{}…", line.chars().take(EXCERPT).collect::<String>())
+    }
+}
+
+/// Read a test's CSV file: a header naming a `stretch` and a stress column (with its unit),
+/// then rows. `unit` states the stress unit where the header names none (`--stress-unit`).
+pub fn read_test_file(
+    path: &Path,
+    mode: Mode,
+    unit: Option<StressUnit>,
+) -> Result<TestFile, FitError> {
     let text = std::fs::read_to_string(path).map_err(|source| FitError::Read {
         path: path.to_path_buf(),
         source,
@@ -55,36 +131,120 @@ pub fn read_test(path: &Path, mode: Mode) -> Result<TestData, FitError> {
     let Some((h, header)) = rows.next() else {
         return Err(err(1, "the file has no header and no data".into()));
     };
-    if header.split(',').count() < 2 {
+    let names: Vec<String> = header
+        .split(',')
+        .map(|c| c.trim().to_ascii_lowercase())
+        .collect();
+    let stretch_col = names
+        .iter()
+        .position(|c| c.starts_with("stretch") || c.starts_with("lambda"));
+    let stress_col = names
+        .iter()
+        .position(|c| c.starts_with("nominal_stress") || c.starts_with("stress"));
+    let (Some(sc), Some(pc)) = (stretch_col, stress_col) else {
         return Err(err(
             h + 1,
-            format!("the header `{header}` must name two columns: stretch,nominal_stress"),
+            format!(
+                "the header `{}` must name a `stretch` column and a `nominal_stress` (or `stress`) column, with the stress's unit as a suffix, e.g. `stretch,nominal_stress_mpa` (a file without a header is refused: its first row would be taken for one)",
+                excerpt(header)
+            ),
         ));
-    }
+    };
+    let named = unit_of_column(&names[pc]);
+    let unit = match (named, unit) {
+        (Some(n), Some(u)) if n != u => {
+            return Err(err(
+                h + 1,
+                format!(
+                    "the header names the stress in {} and --stress-unit says {}: give one",
+                    n.name, u.name
+                ),
+            ))
+        }
+        (n, u) => n.or(u),
+    };
+    let factor = unit.map_or(1.0, |u| u.pascals);
     let (mut stretch, mut stress) = (vec![], vec![]);
     for (k, line) in rows {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        if f.len() < 2 {
+        if f.len() != names.len() {
             return Err(err(
                 k + 1,
-                format!("`{line}`: two numbers, stretch and nominal stress, are needed"),
+                format!(
+                    "`{}` has {} fields and the header {}{}",
+                    excerpt(line),
+                    f.len(),
+                    names.len(),
+                    if f.len() > names.len() {
+                        " (a decimal comma? write 1.5, not 1,5)"
+                    } else {
+                        ""
+                    }
+                ),
             ));
         }
         let num = |s: &str, what: &str| {
             s.parse::<f64>()
-                .map_err(|_| err(k + 1, format!("{what} `{s}` is not a number")))
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    err(
+                        k + 1,
+                        format!("{what} `{}` is not a finite number", excerpt(s)),
+                    )
+                })
         };
-        stretch.push(num(f[0], "the stretch")?);
-        stress.push(num(f[1], "the stress")?);
+        stretch.push(num(f[sc], "the stretch")?);
+        let p = num(f[pc], "the stress")? * factor;
+        if !p.is_finite() {
+            return Err(err(k + 1, "the stress overflows in pascals".into()));
+        }
+        stress.push(p);
     }
     if stretch.is_empty() {
         return Err(err(h + 1, "the file has no data rows".into()));
     }
-    Ok(TestData {
-        mode,
-        stretch,
-        stress,
+    Ok(TestFile {
+        data: TestData {
+            mode,
+            stretch,
+            stress,
+        },
+        unit,
     })
+}
+
+/// Read a test's CSV file (see [`read_test_file`]), the stresses as the file gives them
+/// converted to Pa where its header names the unit.
+pub fn read_test(path: &Path, mode: Mode) -> Result<TestData, FitError> {
+    read_test_file(path, mode, None).map(|t| t.data)
+}
+
+/// The one stress unit of a fit's files: all name the same one (the data are then in Pa), or
+/// none does (the data's own numbers); a mix is refused.
+pub fn common_unit(files: &[(PathBuf, TestFile)]) -> Result<Option<StressUnit>, FitError> {
+    let named: Vec<_> = files.iter().filter(|(_, f)| f.unit.is_some()).collect();
+    if named.is_empty() {
+        return Ok(None);
+    }
+    if named.len() < files.len() {
+        let bare: Vec<String> = files
+            .iter()
+            .filter(|(_, f)| f.unit.is_none())
+            .map(|(p, _)| p.display().to_string())
+            .collect();
+        return Err(FitError::Units(format!(
+            "one unit per fit: {} names no stress unit while {} does ({}); name it in the header (e.g. nominal_stress_mpa) or with --stress-unit",
+            bare.join(", "),
+            named[0].0.display(),
+            named[0].1.unit.map_or("", |u| u.name)
+        )));
+    }
+    // named units may differ (MPa and kPa): each file was read in Pa
+    Ok(Some(StressUnit {
+        name: "Pa",
+        pascals: 1.0,
+    }))
 }
 
 /// A starting law for `model` from the data: the small-strain modulus from the point nearest
@@ -145,9 +305,18 @@ pub fn default_start(model: &str, data: &[TestData]) -> Result<MaterialSpec, Fit
         .map_err(|e| FitError::NoStart(model.into(), format!("(internal: {e})")))
 }
 
-/// Fit `start` to `data`.
+/// Fit `start` to `data` (every parameter free, the default starts).
 pub fn run_fit(start: &MaterialSpec, data: &[TestData]) -> Result<FitResult, FitError> {
-    fit(start, data).map_err(|e| match e {
+    run_fit_with(start, data, &FitOptions::default())
+}
+
+/// Fit `start` to `data` with fixed and bounded parameters and the starts of `opts`.
+pub fn run_fit_with(
+    start: &MaterialSpec,
+    data: &[TestData],
+    opts: &FitOptions,
+) -> Result<FitResult, FitError> {
+    fit_with(start, data, opts).map_err(|e| match e {
         tubemem_material::fit::FitError::Start(m) => FitError::Start(m),
         other => FitError::Fit(other),
     })
@@ -161,7 +330,7 @@ const MODE_COLORS: [RGBColor; 3] = [
 
 /// The fit's figure: each test's data (markers) and the fitted law (a curve over the data's
 /// range), nominal stress against stretch.
-pub fn fit_figure(result: &FitResult, data: &[TestData]) -> Figure {
+pub fn fit_figure(result: &FitResult, data: &[TestData], unit: Option<StressUnit>) -> Figure {
     let law = result.spec.build().ok();
     let mut series = vec![];
     let mut markers = vec![];
@@ -204,7 +373,10 @@ pub fn fit_figure(result: &FitResult, data: &[TestData]) -> Figure {
             result.points
         ),
         "stretch λ",
-        "nominal stress P",
+        &match unit {
+            Some(u) => format!("nominal stress P ({})", u.name),
+            None => "nominal stress P (the data's unit: the headers name none)".to_string(),
+        },
         series,
     );
     fig.markers = markers;
@@ -213,11 +385,15 @@ pub fn fit_figure(result: &FitResult, data: &[TestData]) -> Figure {
         .iter()
         .map(|p| {
             format!(
-                "{} = {:.5e} ± {:.2e}{}",
+                "{} = {:.5e}{}{}",
                 p.name,
                 p.value,
-                p.std_error,
-                if p.determined {
+                p.std_error.map_or(String::new(), |e| format!(" ± {e:.2e}")),
+                if p.fixed {
+                    " (fixed)"
+                } else if p.at_bound.is_some() {
+                    " (at its bound)"
+                } else if p.determined {
                     ""
                 } else {
                     " (not determined)"
@@ -232,15 +408,25 @@ pub fn fit_figure(result: &FitResult, data: &[TestData]) -> Figure {
 pub fn save_figure(
     result: &FitResult,
     data: &[TestData],
+    unit: Option<StressUnit>,
     stem: &Path,
     opts: &FigureOptions,
 ) -> Result<Vec<PathBuf>, FitError> {
-    save(&fit_figure(result, data), stem, opts).map_err(|e| FitError::Figure(Box::new(e)))
+    save(&fit_figure(result, data, unit), stem, opts).map_err(|e| FitError::Figure(Box::new(e)))
 }
 
-/// The fitted law as a case file's `[material]` table.
-pub fn material_table(spec: &MaterialSpec) -> String {
+/// The fitted law as a case file's `[material]` table, with a comment saying which unit its
+/// moduli are in: Pa where the data named their unit (ready for `[units] system = "SI"`),
+/// else the data's own.
+pub fn material_table(spec: &MaterialSpec, unit: Option<StressUnit>) -> String {
     let v = toml::Value::try_from(spec).ok();
     let body = v.and_then(|v| toml::to_string(&v).ok()).unwrap_or_default();
-    format!("[material]\n{body}")
+    let note = match unit {
+        Some(u) => format!(
+            "# moduli in {} (SI): for a case with [units] system = \"SI\" (a dimensionless case takes them as they are: only their ratios matter)",
+            u.name
+        ),
+        None => "# moduli in the data's stress unit (its headers name none): for a case with [units] system = \"SI\", convert them to Pa".to_string(),
+    };
+    format!("{note}\n[material]\n{body}")
 }

@@ -1,27 +1,45 @@
 //! `tubemem fit`: a law's parameters from uniaxial, equibiaxial and pure-shear test data.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
-use tubemem_app::fit::{default_start, material_table, read_test, run_fit, save_figure};
-use tubemem_material::fit::Mode;
+use tubemem_app::fit::{
+    common_unit, default_start, material_table, read_test_file, run_fit_with, save_figure,
+    StressUnit, STRESS_UNITS,
+};
+use tubemem_material::fit::{FitOptions, Mode, DEFAULT_STARTS};
 
 #[derive(Args, Debug, Clone)]
 pub struct FitArgs {
     /// The law: a model name (its starting values estimated from the data), or the keys of a
     /// material table with starting values, e.g. 'model = "ogden", mu = [0.1, 0.01], alpha =
-    /// [2, 5]', or a TOML file with a material table. Every number of the table is fitted.
+    /// [2, 5]', or a TOML file with a material table. Every number of the table is fitted,
+    /// but those given to --fix.
     #[arg(long)]
     pub law: String,
-    /// Uniaxial test: CSV of stretch, nominal stress (a header line, then one pair a line).
+    /// Uniaxial test: CSV with a header naming a `stretch` and a `nominal_stress` column, the
+    /// stress's unit as its suffix (`stretch,nominal_stress_mpa`), then one row per point.
     #[arg(long)]
     pub uniaxial: Option<PathBuf>,
-    /// Equibiaxial test: CSV of stretch, nominal stress.
+    /// Equibiaxial test: CSV as --uniaxial.
     #[arg(long)]
     pub equibiaxial: Option<PathBuf>,
-    /// Pure-shear (planar tension) test: CSV of stretch, nominal stress.
+    /// Pure-shear (planar tension) test: CSV as --uniaxial.
     #[arg(long)]
     pub pure_shear: Option<PathBuf>,
+    /// The stresses' unit where the headers name none: Pa, kPa, MPa, GPa or psi. With a unit
+    /// the fit works in Pa and prints the table for a case in SI.
+    #[arg(long, value_name = "UNIT")]
+    pub stress_unit: Option<String>,
+    /// Hold a parameter at a value, e.g. --fix c30=0 (repeatable).
+    #[arg(long, value_name = "NAME=VALUE")]
+    pub fix: Vec<String>,
+    /// Bound a parameter, e.g. --bound c20=-1e4:1e4 (repeatable; an open side as -inf or inf).
+    #[arg(long, value_name = "NAME=LOW:HIGH")]
+    pub bound: Vec<String>,
+    /// Starts tried besides the law's own (the best sum of squares is kept).
+    #[arg(long, default_value_t = DEFAULT_STARTS)]
+    pub starts: usize,
     /// Print the result as JSON (parameters, standard errors, correlation, warnings).
     #[arg(long)]
     pub json: bool,
@@ -30,29 +48,89 @@ pub struct FitArgs {
     pub plot: Option<PathBuf>,
 }
 
+/// `NAME=VALUE` of --fix.
+fn fixed(s: &str) -> Result<(String, f64)> {
+    let (n, v) = s
+        .split_once('=')
+        .with_context(|| format!("--fix {s}: give NAME=VALUE, e.g. --fix c30=0"))?;
+    let v: f64 = v
+        .trim()
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite())
+        .with_context(|| format!("--fix {s}: `{}` is not a finite number", v.trim()))?;
+    Ok((n.trim().to_string(), v))
+}
+
+/// `NAME=LOW:HIGH` of --bound.
+fn bounded(s: &str) -> Result<(String, (f64, f64))> {
+    let parse = |t: &str| -> Option<f64> {
+        match t.trim() {
+            "-inf" => Some(f64::NEG_INFINITY),
+            "inf" | "+inf" => Some(f64::INFINITY),
+            x => x.parse().ok().filter(|v: &f64| v.is_finite()),
+        }
+    };
+    let (n, range) = s
+        .split_once('=')
+        .with_context(|| format!("--bound {s}: give NAME=LOW:HIGH, e.g. --bound c20=-1:1"))?;
+    let (lo, hi) = range
+        .split_once(':')
+        .and_then(|(a, b)| Some((parse(a)?, parse(b)?)))
+        .with_context(|| {
+            format!("--bound {s}: LOW:HIGH must be two numbers (or -inf, inf), e.g. -1:1")
+        })?;
+    Ok((n.trim().to_string(), (lo, hi)))
+}
+
 pub fn run(a: FitArgs) -> Result<()> {
-    let mut data = vec![];
+    let unit: Option<StressUnit> = match &a.stress_unit {
+        None => None,
+        Some(u) => Some(
+            STRESS_UNITS
+                .iter()
+                .copied()
+                .find(|s| s.name.eq_ignore_ascii_case(u.trim()))
+                .with_context(|| {
+                    format!(
+                        "--stress-unit {u}: one of {}",
+                        STRESS_UNITS.map(|s| s.name).join(", ")
+                    )
+                })?,
+        ),
+    };
+    let mut files = vec![];
     for (path, mode) in [
         (&a.uniaxial, Mode::Uniaxial),
         (&a.equibiaxial, Mode::Equibiaxial),
         (&a.pure_shear, Mode::PureShear),
     ] {
         if let Some(p) = path {
-            data.push(read_test(p, mode)?);
+            files.push((p.clone(), read_test_file(p, mode, unit)?));
         }
     }
-    if data.is_empty() {
+    if files.is_empty() {
         bail!("give test data: --uniaxial, --equibiaxial and/or --pure-shear CSV files");
     }
-    let start = if a.law.contains('=') || std::path::Path::new(&a.law).is_file() {
+    let unit = common_unit(&files)?;
+    let data: Vec<_> = files.into_iter().map(|(_, f)| f.data).collect();
+    // a model name, unless it is a table (has `=`) or a file; a bare name is never read as a
+    // file of that name in the working folder
+    let table = a.law.contains('=') || a.law.ends_with(".toml");
+    let start = if table {
         crate::material_args::law_of(&a.law)?
     } else {
         default_start(a.law.trim(), &data)?
     };
-    let result = run_fit(&start, &data)?;
+    let opts = FitOptions {
+        fixed: a.fix.iter().map(|s| fixed(s)).collect::<Result<_>>()?,
+        bounds: a.bound.iter().map(|s| bounded(s)).collect::<Result<_>>()?,
+        starts: a.starts,
+    };
+    let result = run_fit_with(&start, &data, &opts)?;
     if let Some(stem) = &a.plot {
-        let opts = tubemem_app::figures::FigureOptions::default();
-        for p in save_figure(&result, &data, stem, &opts)? {
+        let figure_opts = tubemem_app::figures::FigureOptions::default();
+        for p in save_figure(&result, &data, unit, stem, &figure_opts)? {
             // standard output stays one JSON object with --json
             if a.json {
                 eprintln!("wrote {}", p.display());
@@ -61,34 +139,57 @@ pub fn run(a: FitArgs) -> Result<()> {
             }
         }
     }
+    let unit_name = unit.map_or("(data)", |u| u.name);
     if a.json {
         crate::say!("{}", serde_json::to_string_pretty(&result)?)?;
-        return Ok(());
-    }
-    crate::say!(
-        "{} points, residual standard deviation {:.3e} (largest residual {:.2} % of the largest stress); {} after {} evaluations",
-        result.points,
-        result.residual_std,
-        100.0 * result.max_relative_residual,
-        result.termination,
-        result.evaluations
-    )?;
-    for p in &result.parameters {
+    } else {
         crate::say!(
-            "  {:<20} {:>14.6e} ± {:.2e}{}",
-            p.name,
-            p.value,
-            p.std_error,
-            if p.determined {
-                ""
+            "{}: {} points, residual standard deviation {:.3e} {unit_name} (largest residual {:.2} % of the largest stress)\n{}",
+            if result.converged {
+                "converged"
             } else {
-                "   not determined by the data"
-            }
+                "NOT CONVERGED"
+            },
+            result.points,
+            result.residual_std,
+            100.0 * result.max_relative_residual,
+            result.stop_reason
         )?;
+        for p in &result.parameters {
+            let se = match (p.fixed, p.std_error) {
+                (true, _) => "fixed".to_string(),
+                (_, Some(e)) => format!("± {e:.2e}"),
+                (_, None) => "± —".to_string(),
+            };
+            let u = if tubemem_material::fit::is_modulus(&p.name) {
+                unit_name
+            } else {
+                ""
+            };
+            crate::say!(
+                "  {:<20} {:>14.6e} {u:<8} {se}{}",
+                p.name,
+                p.value,
+                match (&p.at_bound, p.determined) {
+                    (Some(b), _) => format!("   at its {b} bound"),
+                    (None, false) => format!(
+                        "   not determined by the data (rank {} of {})",
+                        result.rank, result.free_parameters
+                    ),
+                    _ => String::new(),
+                }
+            )?;
+        }
+        for w in &result.warnings {
+            crate::say!("warning: {w}")?;
+        }
+        crate::say!("\n{}", material_table(&result.spec, unit))?;
     }
-    for w in &result.warnings {
-        crate::say!("warning: {w}")?;
+    if !result.converged {
+        bail!(
+            "the fit did not converge: {} (the best iterate is printed above, not a fitted law)",
+            result.stop_reason
+        );
     }
-    crate::say!("\n{}", material_table(&result.spec))?;
     Ok(())
 }

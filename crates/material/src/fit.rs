@@ -78,10 +78,17 @@ pub struct FittedParameter {
     /// as the material table names it: `c10`, `mu[1]`, `parameters.jm`
     pub name: String,
     pub value: f64,
-    /// one standard error (NaN where the covariance does not exist)
-    pub std_error: f64,
+    /// one standard error (`None`: a fixed parameter, or one the data do not determine: the
+    /// Jacobian's rank is short along it)
+    pub std_error: Option<f64>,
     /// false: the data do not determine it (see the module docs)
     pub determined: bool,
+    /// held at its value (`FitOptions::fixed`), not fitted
+    #[serde(default)]
+    pub fixed: bool,
+    /// "lower" or "upper": the fit ended on this bound of the parameter
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at_bound: Option<String>,
 }
 
 /// A fit's outcome.
@@ -90,18 +97,86 @@ pub struct FitResult {
     /// the law with the fitted parameters
     pub spec: MaterialSpec,
     pub parameters: Vec<FittedParameter>,
-    /// the correlation matrix of the parameters, in their order
-    pub correlation: Vec<Vec<f64>>,
+    /// the correlation matrix of the fitted (free) parameters, in their order (`None` where a
+    /// parameter has no standard error)
+    pub correlation: Vec<Vec<Option<f64>>>,
     /// √(Σr²/(m − n)), in the stress's units
     pub residual_std: f64,
     /// the largest |P_model − P_data| / max |P_data| of the fit
     pub max_relative_residual: f64,
     pub points: usize,
-    /// how Levenberg–Marquardt stopped, and after how many evaluations
+    /// whether the fit converged: Levenberg–Marquardt stopped on a convergence test at the
+    /// best start, and the result is stationary there (every free parameter's Jacobian column
+    /// at most [`STATIONARITY`] from orthogonal to the residual, in cosine; at a bound, the
+    /// gradient may point outward)
+    pub converged: bool,
+    /// why the best start's Levenberg–Marquardt stopped, and the stationarity measured
+    pub stop_reason: String,
+    /// how Levenberg–Marquardt stopped (its own words), and after how many evaluations, at
+    /// the best start
     pub termination: String,
     pub evaluations: usize,
+    /// the largest |Jₖᵀr| / (‖Jₖ‖ ‖r‖) over the free parameters not held at a bound
+    pub gradient_cosine: f64,
+    /// the starts tried, and how many of them reached the best sum of squares (to 1e-6)
+    pub starts: usize,
+    pub starts_agreeing: usize,
+    /// the rank of the column-scaled Jacobian of the free parameters (singular values above
+    /// 1e-6 of the largest), and their number
+    pub rank: usize,
+    pub free_parameters: usize,
     /// what the user should know: undetermined parameters, a fit that did not converge
     pub warnings: Vec<String>,
+}
+
+/// A fit is stationary where every free parameter's Jacobian column is within this cosine of
+/// orthogonal to the residual: 1e-5. At a least-squares minimum the residual is orthogonal to
+/// the columns (the normal equations); the converged fits of the tests reach 1e-9 or less,
+/// and a fit handed back at a start that is not a minimum has cosines of order 0.1 to 1.
+pub const STATIONARITY: f64 = 1e-5;
+
+/// The starts [`fit`] tries besides the one given: 8 (the given start, one with its moduli
+/// scaled to the data, and log-uniform draws within a decade of it, deterministic).
+pub const DEFAULT_STARTS: usize = 8;
+
+/// What a fit may hold or bound.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// parameters held at a value, by name (`c30` → 0)
+    pub fixed: std::collections::BTreeMap<String, f64>,
+    /// bounds (low, high) by name; ±∞ for an open side
+    pub bounds: std::collections::BTreeMap<String, (f64, f64)>,
+    /// starts tried besides the given one
+    pub starts: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            fixed: Default::default(),
+            bounds: Default::default(),
+            starts: DEFAULT_STARTS,
+        }
+    }
+}
+
+/// The parameters in stress units, by their table name (`mu[1]` as `mu`): scaling all of them
+/// by s scales every nominal stress by s.
+const MODULI: [&str; 8] = [
+    "shear_modulus",
+    "c10",
+    "c20",
+    "c30",
+    "c2",
+    "mu",
+    "young_modulus",
+    "c1",
+];
+
+/// Whether a fitted parameter (`mu[1]`, `c10`) is in stress units (the others are ratios).
+pub fn is_modulus(name: &str) -> bool {
+    let base = name.split('[').next().unwrap_or(name);
+    MODULI.contains(&base)
 }
 
 /// The nominal stress of `law` (its units: the law's modulus) in test `mode` at stretch `l`.
@@ -183,11 +258,64 @@ fn slot<'a>(v: &'a mut Value, path: &[PathStep]) -> Option<&'a mut Value> {
     Some(cur)
 }
 
-/// The least-squares problem: the spec as JSON, its fitted slots, the data.
+/// A parameter's bounds, and the map from the unbounded coordinate u the optimizer moves to the
+/// parameter x (lmfit's transforms, after MINPACK-1's users): both sides x = lo + (hi − lo)(1 +
+/// sin u)/2; a lower side x = lo − 1 + √(u² + 1); an upper side x = hi + 1 − √(u² + 1).
+#[derive(Clone, Copy, Debug)]
+struct Bound {
+    lo: f64,
+    hi: f64,
+}
+
+impl Bound {
+    fn x(&self, u: f64) -> f64 {
+        match (self.lo.is_finite(), self.hi.is_finite()) {
+            (true, true) => self.lo + (self.hi - self.lo) * 0.5 * (1.0 + u.sin()),
+            (true, false) => self.lo - 1.0 + (u * u + 1.0).sqrt(),
+            (false, true) => self.hi + 1.0 - (u * u + 1.0).sqrt(),
+            (false, false) => u,
+        }
+    }
+    fn u(&self, x: f64) -> f64 {
+        match (self.lo.is_finite(), self.hi.is_finite()) {
+            (true, true) => (2.0 * (x - self.lo) / (self.hi - self.lo) - 1.0)
+                .clamp(-1.0, 1.0)
+                .asin(),
+            (true, false) => ((x - self.lo + 1.0).powi(2) - 1.0).max(0.0).sqrt(),
+            (false, true) => ((self.hi - x + 1.0).powi(2) - 1.0).max(0.0).sqrt(),
+            (false, false) => x,
+        }
+    }
+    /// dx/du at u
+    fn slope(&self, u: f64) -> f64 {
+        match (self.lo.is_finite(), self.hi.is_finite()) {
+            (true, true) => (self.hi - self.lo) * 0.5 * u.cos(),
+            (true, false) => u / (u * u + 1.0).sqrt(),
+            (false, true) => -u / (u * u + 1.0).sqrt(),
+            (false, false) => 1.0,
+        }
+    }
+    /// "lower" or "upper" where `x` sits on a finite bound (to 1e-9 relative)
+    fn at(&self, x: f64) -> Option<&'static str> {
+        let near =
+            |b: f64| b.is_finite() && (x - b).abs() <= 1e-9 * b.abs().max(1e-300).max(x.abs());
+        if near(self.lo) {
+            Some("lower")
+        } else if near(self.hi) {
+            Some("upper")
+        } else {
+            None
+        }
+    }
+}
+
+/// The least-squares problem: the spec as JSON, its fitted slots, the data; the optimizer moves
+/// the unbounded coordinates `u` of the free parameters ([`Bound`]).
 struct Problem<'a> {
     template: Value,
     paths: Vec<Vec<PathStep>>,
     data: &'a [TestData],
+    bounds: Vec<Bound>,
     x: DVector<f64>,
     /// the residual of a refused trial: large and finite
     penalty: f64,
@@ -245,25 +373,39 @@ impl Problem<'_> {
     }
 }
 
+impl Problem<'_> {
+    /// The parameters x of the unbounded coordinates u.
+    fn x_of(&self, u: &[f64]) -> Vec<f64> {
+        u.iter().zip(&self.bounds).map(|(u, b)| b.x(*u)).collect()
+    }
+}
+
+/// The optimizer's view: `x` holds the unbounded coordinates u.
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
     type ParameterStorage = Owned<f64, Dyn>;
 
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.x.copy_from(x);
+    fn set_params(&mut self, u: &DVector<f64>) {
+        self.x.copy_from(u);
     }
     fn params(&self) -> DVector<f64> {
         self.x.clone()
     }
     fn residuals(&self) -> Option<DVector<f64>> {
         let r = self
-            .residuals_at(self.x.as_slice())
+            .residuals_at(&self.x_of(self.x.as_slice()))
             .unwrap_or_else(|| vec![self.penalty; self.count()]);
         Some(DVector::from_vec(r))
     }
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        self.jacobian_at(self.x.as_slice())
+        let u = self.x.as_slice();
+        let mut j = self.jacobian_at(&self.x_of(u))?;
+        for (k, (uk, b)) in u.iter().zip(&self.bounds).enumerate() {
+            let d = b.slope(*uk);
+            j.column_mut(k).iter_mut().for_each(|v| *v *= d);
+        }
+        Some(j)
     }
 }
 
@@ -312,10 +454,43 @@ fn check_data(data: &[TestData], n: usize) -> Result<(), FitError> {
     Ok(())
 }
 
-/// Fit `start`'s numbers to `data`.
+/// Fit `start`'s numbers to `data` ([`FitOptions::default`]: every number free, unbounded
+/// but by the law's own ranges, [`DEFAULT_STARTS`] starts).
 pub fn fit(start: &MaterialSpec, data: &[TestData]) -> Result<FitResult, FitError> {
-    start.build().map_err(FitError::Start)?;
-    let template = serde_json::to_value(start).map_err(|e| {
+    fit_with(start, data, &FitOptions::default())
+}
+
+/// A deterministic stream of numbers in [0, 1) (a linear congruential generator, Knuth's
+/// MMIX constants): the starts are the same on every machine and run.
+struct Draws(u64);
+
+impl Draws {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// One start's outcome: the parameters, the sum of squares, LM's report.
+struct Run {
+    x: Vec<f64>,
+    ssr: f64,
+    successful: bool,
+    termination: String,
+    evaluations: usize,
+}
+
+/// Fit `start`'s numbers to `data`, holding `opts.fixed`, within `opts.bounds`, from the given
+/// start and `opts.starts` more, keeping the best sum of squares.
+pub fn fit_with(
+    start: &MaterialSpec,
+    data: &[TestData],
+    opts: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let mut template = serde_json::to_value(start).map_err(|e| {
         FitError::Data(format!(
             "the starting law cannot be written as a table: {e}"
         ))
@@ -324,36 +499,130 @@ pub fn fit(start: &MaterialSpec, data: &[TestData]) -> Result<FitResult, FitErro
     if named.is_empty() {
         return Err(FitError::NoParameters);
     }
-    let n = named.len();
+    let names: Vec<&str> = named.iter().map(|(n, _)| n.as_str()).collect();
+    let unknown = |what: &str, n: &str| {
+        FitError::Data(format!(
+            "{what} `{n}`: the {} law has no parameter `{n}`; its parameters are {}",
+            start.model(),
+            names.join(", ")
+        ))
+    };
+    for (n, v) in &opts.fixed {
+        let (_, path) = named
+            .iter()
+            .find(|(m, _)| m == n)
+            .ok_or_else(|| unknown("fixed", n))?;
+        if !v.is_finite() {
+            return Err(FitError::Data(format!(
+                "fixed `{n}` = {v}: a fixed value must be a finite number"
+            )));
+        }
+        if let Some(slot) = slot(&mut template, path) {
+            *slot = serde_json::Number::from_f64(*v)
+                .map(Value::Number)
+                .unwrap_or(Value::Null);
+        }
+    }
+    for (n, (lo, hi)) in &opts.bounds {
+        if !names.contains(&n.as_str()) {
+            return Err(unknown("bound", n));
+        }
+        if opts.fixed.contains_key(n) {
+            return Err(FitError::Data(format!(
+                "`{n}` is both fixed and bounded: give one"
+            )));
+        }
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
+            return Err(FitError::Data(format!(
+                "bound `{n}` = [{lo}, {hi}]: the low end must be below the high end"
+            )));
+        }
+    }
+    let spec0: MaterialSpec = serde_json::from_value(template.clone())
+        .map_err(|e| FitError::Data(format!("the fixed values do not make a law: {e}")))?;
+    spec0.build().map_err(FitError::Start)?;
+    let free: Vec<usize> = (0..named.len())
+        .filter(|&k| !opts.fixed.contains_key(&named[k].0))
+        .collect();
+    if free.is_empty() {
+        return Err(FitError::Data(
+            "every parameter is fixed: nothing is left to fit".into(),
+        ));
+    }
+    let n = free.len();
     check_data(data, n)?;
     let mut v = template.clone();
-    let x0: Vec<f64> = named
+    let x_all: Vec<f64> = named
         .iter()
         .map(|(_, p)| slot(&mut v, p).and_then(|x| x.as_f64()).unwrap_or(f64::NAN))
+        .collect();
+    let bounds: Vec<Bound> = free
+        .iter()
+        .map(|&k| {
+            let (lo, hi) = opts
+                .bounds
+                .get(&named[k].0)
+                .copied()
+                .unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+            Bound { lo, hi }
+        })
+        .collect();
+    // a start outside its bounds starts on the nearer bound
+    let x0: Vec<f64> = free
+        .iter()
+        .zip(&bounds)
+        .map(|(&k, b)| x_all[k].clamp(b.lo, b.hi))
         .collect();
     let scale = data
         .iter()
         .flat_map(|t| t.stress.iter())
         .fold(0.0f64, |a, &p| a.max(p.abs()))
         .max(f64::MIN_POSITIVE);
-    let problem = Problem {
+    let mut problem = Problem {
         template,
-        paths: named.iter().map(|(_, p)| p.clone()).collect(),
+        paths: free.iter().map(|&k| named[k].1.clone()).collect(),
         data,
-        x: DVector::from_vec(x0),
+        bounds: bounds.clone(),
+        x: DVector::from_vec(vec![0.0; n]),
         penalty: 1e6 * scale,
     };
-    let (problem, report) = LevenbergMarquardt::new()
-        .with_patience(200)
-        .minimize(problem);
-    let x: Vec<f64> = problem.x.iter().copied().collect();
-    let mut warnings = vec![];
-    if !report.termination.was_successful() {
-        warnings.push(format!(
-            "Levenberg–Marquardt stopped without converging ({:?}): the parameters are its last iterate",
-            report.termination
-        ));
+    let free_names: Vec<&str> = free.iter().map(|&k| named[k].0.as_str()).collect();
+    let starts = starts_of(&problem, &x0, &free_names, opts.starts);
+    let mut runs: Vec<Run> = vec![];
+    for s in &starts {
+        let u: Vec<f64> = s.iter().zip(&bounds).map(|(x, b)| b.u(*x)).collect();
+        problem.x = DVector::from_vec(u);
+        let (solved, report) = LevenbergMarquardt::new()
+            .with_patience(200)
+            .minimize(problem);
+        problem = solved;
+        let x = problem.x_of(problem.x.as_slice());
+        let ssr = problem
+            .residuals_at(&x)
+            .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
+        runs.push(Run {
+            x,
+            ssr,
+            successful: report.termination.was_successful(),
+            termination: format!("{:?}", report.termination),
+            evaluations: report.number_of_evaluations,
+        });
     }
+    let best = runs
+        .iter()
+        .filter(|r| r.ssr.is_finite())
+        .min_by(|a, b| a.ssr.total_cmp(&b.ssr))
+        .ok_or_else(|| {
+            FitError::Data(format!(
+                "no start reached a law that can be evaluated at every data point ({} starts tried)",
+                runs.len()
+            ))
+        })?;
+    let agreeing = runs
+        .iter()
+        .filter(|r| (r.ssr - best.ssr).abs() <= 1e-6 * best.ssr.max(f64::MIN_POSITIVE))
+        .count();
+    let x = best.x.clone();
     let spec = problem
         .spec_at(&x)
         .ok_or_else(|| FitError::Data("the fitted parameters do not make a law".into()))?;
@@ -364,30 +633,104 @@ pub fn fit(start: &MaterialSpec, data: &[TestData]) -> Result<FitResult, FitErro
     let ssr: f64 = r.iter().map(|v| v * v).sum();
     let s2 = ssr / (m - n) as f64;
     let max_rel = r.iter().fold(0.0f64, |a, v| a.max(v.abs())) / scale;
-    // covariance and identifiability from the Jacobian at the solution
+    let at_bound: Vec<Option<&'static str>> =
+        x.iter().zip(&bounds).map(|(x, b)| b.at(*x)).collect();
     let jac = problem.jacobian_at(&x);
-    let (std, corr, undetermined) = match &jac {
-        Some(j) => uncertainty(j, &x, s2),
-        None => (vec![f64::NAN; n], vec![vec![f64::NAN; n]; n], vec![true; n]),
+    // stationarity: each free column's cosine with the residual (a column at a bound may
+    // have the residual's gradient pointing outward)
+    let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let gradient_cosine = match &jac {
+        Some(j) if rn > 0.0 => (0..n)
+            .filter(|&k| at_bound[k].is_none())
+            .map(|k| {
+                let col = j.column(k);
+                let norm = col.norm();
+                if norm > 0.0 {
+                    (col.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>() / (norm * rn)).abs()
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max),
+        Some(_) => 0.0,
+        None => f64::INFINITY,
     };
-    let parameters: Vec<FittedParameter> = named
-        .iter()
-        .zip(&x)
-        .zip(&std)
-        .zip(&undetermined)
-        .map(
-            |((((name, _), &value), &std_error), &flat)| FittedParameter {
-                name: name.clone(),
-                value,
-                std_error,
-                determined: !flat && std_error.is_finite() && std_error <= value.abs(),
-            },
-        )
-        .collect();
-    for p in parameters.iter().filter(|p| !p.determined) {
+    let stationary = gradient_cosine <= STATIONARITY;
+    let converged = best.successful && stationary;
+    let stop_reason = format!(
+        "{} at the best of {} starts ({} of them reached its sum of squares to 1e-6), after {} evaluations; the largest cosine between a parameter's Jacobian column and the residual is {:.1e} ({} {:.0e})",
+        if best.successful {
+            "Levenberg–Marquardt converged"
+        } else {
+            "Levenberg–Marquardt stopped without converging"
+        },
+        runs.len(),
+        agreeing,
+        best.evaluations,
+        gradient_cosine,
+        if stationary { "≤" } else { ">" },
+        STATIONARITY
+    );
+    let mut warnings = vec![];
+    if !converged {
         warnings.push(format!(
-            "the data do not determine `{}` (fitted {:.4e} ± {:.2e}): add data that exercise it (larger stretches, another test mode) or fix it",
-            p.name, p.value, p.std_error
+            "the fit did not converge ({}): the parameters are the best iterate found, not a minimum; try other starts, fix or bound parameters, or add data",
+            if best.successful {
+                "the result is not stationary: the residual still has a component along a parameter"
+            } else {
+                best.termination.as_str()
+            }
+        ));
+    }
+    let (std, corr, flat, rank) = match &jac {
+        Some(j) => uncertainty(j, &x, s2, &at_bound),
+        None => (vec![None; n], vec![vec![None; n]; n], vec![true; n], 0),
+    };
+    let mut parameters = vec![];
+    let mut fi = 0;
+    for (k, (name, _)) in named.iter().enumerate() {
+        if let Some(&v) = opts.fixed.get(name) {
+            parameters.push(FittedParameter {
+                name: name.clone(),
+                value: v,
+                std_error: None,
+                determined: true,
+                fixed: true,
+                at_bound: None,
+            });
+            continue;
+        }
+        let _ = k;
+        let value = x[fi];
+        let se = std[fi];
+        parameters.push(FittedParameter {
+            name: name.clone(),
+            value,
+            std_error: se,
+            determined: !flat[fi] && se.is_some_and(|e| e <= value.abs()),
+            fixed: false,
+            at_bound: at_bound[fi].map(String::from),
+        });
+        fi += 1;
+    }
+    for p in parameters.iter().filter(|p| p.at_bound.is_some()) {
+        warnings.push(format!(
+            "`{}` ended on its {} bound ({:.4e}): the data push it there; its standard error is not given",
+            p.name,
+            p.at_bound.as_deref().unwrap_or(""),
+            p.value
+        ));
+    }
+    for p in parameters
+        .iter()
+        .filter(|p| !p.determined && !p.fixed && p.at_bound.is_none())
+    {
+        warnings.push(format!(
+            "the data do not determine `{}` (fitted {:.4e}{}; the Jacobian's rank is {rank} of {n}): add data that exercise it (larger stretches, another test mode) or fix it (--fix {}=VALUE)",
+            p.name,
+            p.value,
+            p.std_error.map_or(String::new(), |e| format!(" ± {e:.2e}")),
+            p.name
         ));
     }
     Ok(FitResult {
@@ -397,18 +740,101 @@ pub fn fit(start: &MaterialSpec, data: &[TestData]) -> Result<FitResult, FitErro
         residual_std: s2.sqrt(),
         max_relative_residual: max_rel,
         points: m,
-        termination: format!("{:?}", report.termination),
-        evaluations: report.number_of_evaluations,
+        converged,
+        stop_reason,
+        termination: best.termination.clone(),
+        evaluations: best.evaluations,
+        gradient_cosine,
+        starts: runs.len(),
+        starts_agreeing: agreeing,
+        rank,
+        free_parameters: n,
         warnings,
     })
 }
 
-/// (standard errors, correlation, in an unresolved direction) from the Jacobian `j` at `x`.
-/// The columns are scaled to unit length first (D = diag(1/‖J_k‖)), so that the singular values
-/// of J D measure how far the columns are from dependent, whatever the parameters' sizes; the
-/// covariance is then s² D (Dᵀ JᵀJ D)⁻¹ D.
+/// The starts: the given one; the same with its moduli scaled to the data (the least-squares
+/// factor s of P_data ≈ s P_model: a start in MPa for data in Pa); then `more` − 1 draws,
+/// each parameter log-uniform within a decade of its start (a zero one uniform within ±0.1 of
+/// the largest modulus), moduli scaled by s; each inside its bounds and a law.
+fn starts_of(problem: &Problem, x0: &[f64], names: &[&str], more: usize) -> Vec<Vec<f64>> {
+    let mut out = vec![x0.to_vec()];
+    let valid = |x: &[f64]| problem.residuals_at(x).is_some();
+    let inside = |x: &[f64]| {
+        x.iter()
+            .zip(&problem.bounds)
+            .all(|(v, b)| *v >= b.lo && *v <= b.hi)
+    };
+    // the data-scaled start
+    let s = problem.residuals_at(x0).and_then(|r| {
+        // r = P_model − P_data, so P_model = r + P_data
+        let p: Vec<f64> = problem
+            .data
+            .iter()
+            .flat_map(|t| t.stress.iter().copied())
+            .collect();
+        let (pm_pd, pm_pm) = r.iter().zip(&p).fold((0.0, 0.0), |(a, b), (r, pd)| {
+            let pm = r + pd;
+            (a + pm * pd, b + pm * pm)
+        });
+        let s = pm_pd / pm_pm;
+        (s.is_finite() && s > 0.0).then_some(s)
+    });
+    let scaled = |x: &[f64], s: f64| -> Vec<f64> {
+        x.iter()
+            .zip(names)
+            .map(|(v, n)| if is_modulus(n) { v * s } else { *v })
+            .collect()
+    };
+    if let Some(s) = s {
+        let x = scaled(x0, s);
+        if valid(&x) && inside(&x) {
+            out.push(x);
+        }
+    }
+    let largest = x0
+        .iter()
+        .zip(names)
+        .filter(|(_, n)| is_modulus(n))
+        .fold(0.0f64, |a, (v, _)| a.max(v.abs()));
+    let mut draws = Draws(0x7475_6265_6d65_6d21);
+    let mut tries = 0;
+    while out.len() < more + 1 && tries < 50 * (more + 1) {
+        tries += 1;
+        let x: Vec<f64> = x0
+            .iter()
+            .zip(names)
+            .map(|(v, n)| {
+                if *v != 0.0 {
+                    v * 10f64.powf(2.0 * draws.next() - 1.0)
+                } else if is_modulus(n) {
+                    0.1 * largest * (2.0 * draws.next() - 1.0)
+                } else {
+                    2.0 * draws.next() - 1.0
+                }
+            })
+            .collect();
+        let x = scaled(&x, s.unwrap_or(1.0));
+        if valid(&x) && inside(&x) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// (standard errors, correlation, in an unresolved direction, the rank) from the Jacobian `j`
+/// at `x`. The columns are scaled to unit length first (D = diag(1/‖J_k‖)), so that the
+/// singular values of J D measure how far the columns are from dependent, whatever the
+/// parameters' sizes. The covariance is s² D (Dᵀ JᵀJ D)⁺ D with the pseudo-inverse over the
+/// singular values above 1e-6 of the largest (the rank): a parameter in a direction below
+/// that, or held at a bound, has no standard error (`None`), never NaN.
 #[allow(clippy::type_complexity)]
-fn uncertainty(j: &DMatrix<f64>, x: &[f64], s2: f64) -> (Vec<f64>, Vec<Vec<f64>>, Vec<bool>) {
+fn uncertainty(
+    j: &DMatrix<f64>,
+    x: &[f64],
+    s2: f64,
+    at_bound: &[Option<&str>],
+) -> (Vec<Option<f64>>, Vec<Vec<Option<f64>>>, Vec<bool>, usize) {
     let n = x.len();
     let mut flat = vec![false; n];
     let mut d = vec![0.0; n];
@@ -427,9 +853,18 @@ fn uncertainty(j: &DMatrix<f64>, x: &[f64], s2: f64) -> (Vec<f64>, Vec<Vec<f64>>
     let svd = js.clone().svd(false, true);
     let sv = &svd.singular_values;
     let smax = sv.iter().fold(0.0f64, |a, &v| a.max(v));
+    let mut rank = 0;
+    let mut cov = DMatrix::<f64>::zeros(n, n);
     if let Some(vt) = &svd.v_t {
         for (r, &s) in sv.iter().enumerate() {
-            if s <= 1e-6 * smax {
+            if s > 1e-6 * smax && s.is_finite() {
+                rank += 1;
+                for a in 0..n {
+                    for b in 0..n {
+                        cov[(a, b)] += vt[(r, a)] * vt[(r, b)] / (s * s);
+                    }
+                }
+            } else {
                 for k in 0..n {
                     if vt[(r, k)].abs() > 0.3 {
                         flat[k] = true;
@@ -437,20 +872,23 @@ fn uncertainty(j: &DMatrix<f64>, x: &[f64], s2: f64) -> (Vec<f64>, Vec<Vec<f64>>
                 }
             }
         }
+    } else {
+        flat.iter_mut().for_each(|f| *f = true);
     }
-    let jtj = js.transpose() * &js;
-    let mut std = vec![f64::NAN; n];
-    let mut corr = vec![vec![f64::NAN; n]; n];
-    match jtj.try_inverse() {
-        Some(c) => {
-            for a in 0..n {
-                std[a] = (s2 * c[(a, a)]).max(0.0).sqrt() * d[a];
-                for b in 0..n {
-                    corr[a][b] = c[(a, b)] / (c[(a, a)] * c[(b, b)]).sqrt();
-                }
-            }
-        }
-        None => flat.iter_mut().for_each(|f| *f = true),
-    }
-    (std, corr, flat)
+    let has = |a: usize| !flat[a] && at_bound[a].is_none() && cov[(a, a)] > 0.0;
+    let std: Vec<Option<f64>> = (0..n)
+        .map(|a| has(a).then(|| (s2 * cov[(a, a)]).max(0.0).sqrt() * d[a]))
+        .collect();
+    let corr = (0..n)
+        .map(|a| {
+            (0..n)
+                .map(|b| {
+                    (has(a) && has(b))
+                        .then(|| cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt())
+                        .filter(|v| v.is_finite())
+                })
+                .collect()
+        })
+        .collect();
+    (std, corr, flat, rank)
 }

@@ -172,17 +172,25 @@ fn test_data(py: Python<'_>, mode: Mode, arg: &Bound<'_, PyAny>, what: &str) -> 
 /// Fit a law's parameters to test data: `law` a model name (starting values estimated from
 /// the data), a material dict with starting values, or a `Material`; `uniaxial`,
 /// `equibiaxial`, `pure_shear` each a CSV path, an (N, 2) array or a (stretch, stress) pair.
-/// Returns a dict: `material` (the fitted `Material`), `parameters` (name, value, std_error,
-/// determined), `correlation`, `residual_std`, `max_relative_residual`, `points`,
-/// `termination`, `evaluations` and `warnings` (a parameter the data do not determine).
+/// `fix` holds parameters at values (`{"c30": 0.0}`), `bounds` bounds them (`{"c20": (-1.0,
+/// 1.0)}`), `starts` is the number of starts tried besides the law's own. Returns a dict:
+/// `material` (the fitted `Material`), `converged` (False: the best iterate, not a fitted law;
+/// `stop_reason` says why), `parameters` (name, value, std_error — None where fixed or not
+/// determined —, determined, fixed, at_bound), `correlation`, `rank`, `residual_std`,
+/// `max_relative_residual`, `points`, `starts`, `starts_agreeing`, `termination`,
+/// `evaluations` and `warnings`.
 #[pyfunction]
-#[pyo3(signature = (law, uniaxial=None, equibiaxial=None, pure_shear=None))]
+#[pyo3(signature = (law, uniaxial=None, equibiaxial=None, pure_shear=None, fix=None, bounds=None, starts=tubemem_material::fit::DEFAULT_STARTS))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn fit<'py>(
     py: Python<'py>,
     law: &Bound<'py, PyAny>,
     uniaxial: Option<&Bound<'py, PyAny>>,
     equibiaxial: Option<&Bound<'py, PyAny>>,
     pure_shear: Option<&Bound<'py, PyAny>>,
+    fix: Option<std::collections::BTreeMap<String, f64>>,
+    bounds: Option<std::collections::BTreeMap<String, (f64, f64)>>,
+    starts: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut data = vec![];
     for (arg, mode, what) in [
@@ -205,7 +213,14 @@ pub(crate) fn fit<'py>(
         Err(_) => spec_of(law)?,
     };
     let result = py
-        .detach(|| tubemem_app::fit::run_fit(&start, &data))
+        .detach(|| {
+            let opts = tubemem_material::fit::FitOptions {
+                fixed: fix.unwrap_or_default(),
+                bounds: bounds.unwrap_or_default(),
+                starts,
+            };
+            tubemem_app::fit::run_fit_with(&start, &data, &opts)
+        })
         .map_err(|e| {
             let msg = format!("fit: {}", tubemem_app::error_chain(&e));
             match e {

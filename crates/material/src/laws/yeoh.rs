@@ -19,8 +19,8 @@ impl Yeoh {
     /// C10 > 0 and finite C20, C30. Negative coefficients are accepted (fitted silicone laws
     /// have them: Ecoflex's C30 < 0): such a law is stable only up to the I1 where its membrane
     /// tangent stops being positive definite ([`Yeoh::stable_limit`], found by
-    /// [`stability_limit`]), and refuses states beyond it. A law unstable already at the
-    /// reference state is refused.
+    /// [`stability_limit`]), and refuses states beyond it (every Yeoh law with C10 > 0 is
+    /// stable at the reference state, where ∇I1 = 0).
     pub fn new(c10: f64, c20: f64, c30: f64) -> Result<Self, MaterialError> {
         super::check_positive("c10", c10)?;
         for (name, v) in [("c20", c20), ("c30", c30)] {
@@ -34,19 +34,18 @@ impl Yeoh {
         }
         let mu = 2.0 * c10;
         let w = [c10 / mu, c20 / mu, c30 / mu];
-        let limit = stability_limit(|x| {
-            (
-                w[0] + x * (2.0 * w[1] + 3.0 * w[2] * x),
-                2.0 * w[1] + 6.0 * w[2] * x,
-            )
-        });
-        if limit.is_some_and(|x| x <= 1e-6) {
-            return Err(MaterialError::InvalidParameter {
-                name: if c30 < 0.0 { "c30" } else { "c20" },
-                value: if c30 < 0.0 { c30 } else { c20 },
-                requirement: "the law is unstable already at small stretch (its membrane tangent is not positive definite near I1 = 3)",
-            });
-        }
+        // W′ > 0 and W″ ≥ 0 everywhere: stable at every stretch, nothing to scan
+        let convex = c20 >= 0.0 && c30 >= 0.0;
+        let limit = (!convex)
+            .then(|| {
+                stability_limit(|x| {
+                    (
+                        w[0] + x * (2.0 * w[1] + 3.0 * w[2] * x),
+                        2.0 * w[1] + 6.0 * w[2] * x,
+                    )
+                })
+            })
+            .flatten();
         Ok(Self {
             c: [c10, c20, c30],
             limit,
@@ -56,53 +55,90 @@ impl Yeoh {
 
 /// The I1 − 3 where an energy of I1 alone, with W′(x) and W″(x) (x = I1 − 3) given by `w`,
 /// first loses stability: W′ ≤ 0 (the membrane no longer pulls), or its membrane tangent
-/// ∂²W/∂λα∂λβ = W″ ∇I1 ∇I1ᵀ + W′ ∇²I1 stops being positive definite at some state
-/// (λ1, λ2) with that I1. States are scanned on rays λ2 = λ1^t, t from −½ (uniaxial) to 1
-/// (equibiaxial), λ1 growing geometrically to I1 = [`SCANNED_I1`]; the first failure on each
-/// ray is bisected to 1e-12 in ln λ1. `None`: stable everywhere scanned.
+/// H = W″ ∇I1 ∇I1ᵀ + W′ ∇²I1 (in the principal stretches) stops being positive definite at
+/// some state with that I1. ∇²I1 is positive definite at every state, so H is where W′ > 0
+/// and W″ ≥ 0; where W″ < 0 it is iff W′ + W″ q > 0, q = ∇I1ᵀ(∇²I1)⁻¹∇I1, and the worst state
+/// of an I1 is the one of largest q, [`q_max`]. `None`: stable up to I1 = [`SCANNED_I1`].
 pub fn stability_limit(w: impl Fn(f64) -> (f64, f64)) -> Option<f64> {
-    let stable = |l1: f64, t: f64| -> (bool, f64) {
-        let l2 = l1.powf(t);
-        let j2 = 1.0 / (l1 * l1 * l2 * l2);
-        let i1 = l1 * l1 + l2 * l2 + j2;
-        let (w1, w2) = w(i1 - 3.0);
-        // ∇I1 and ∇²I1 in (λ1, λ2)
-        let g = [2.0 * l1 - 2.0 * j2 / l1, 2.0 * l2 - 2.0 * j2 / l2];
-        let k = [
-            [2.0 + 6.0 * j2 / (l1 * l1), 4.0 * j2 / (l1 * l2)],
-            [4.0 * j2 / (l1 * l2), 2.0 + 6.0 * j2 / (l2 * l2)],
-        ];
-        let h = |i: usize, j: usize| w2 * g[i] * g[j] + w1 * k[i][j];
-        let ok = w1 > 0.0 && h(0, 0) > 0.0 && h(0, 0) * h(1, 1) - h(0, 1) * h(1, 0) > 0.0;
-        (ok, i1 - 3.0)
+    let table = q_table();
+    // on each interval of the table, q at its worse end: the limit errs on the safe side
+    let fails = |x: f64, q: f64| {
+        let (w1, w2) = w(x);
+        !(w1 > 0.0 && w1 + w2.min(0.0) * q > 0.0)
     };
-    let top = (SCANNED_I1 / 2.0).sqrt().ln();
-    let n = 2000;
-    let mut limit: Option<f64> = None;
-    for r in 0..=30 {
-        let t = -0.5 + 1.5 * r as f64 / 30.0;
-        let mut prev = 0.0f64;
-        for k in 1..=n {
-            let s = top * k as f64 / n as f64;
-            if stable(s.exp(), t).0 {
-                prev = s;
-                continue;
-            }
-            let (mut lo, mut hi) = (prev, s);
-            while hi - lo > 1e-12 {
-                let mid = 0.5 * (lo + hi);
-                if stable(mid.exp(), t).0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            let x = stable(lo.exp(), t).1;
-            limit = Some(limit.map_or(x, |m: f64| m.min(x)));
-            break;
+    let mut prev = 0.0;
+    for pair in table.windows(2) {
+        let ((_, qa), (xb, qb)) = (pair[0], pair[1]);
+        let q = qa.max(qb);
+        if !fails(xb, q) {
+            prev = xb;
+            continue;
         }
+        let (mut lo, mut hi) = (prev, xb);
+        if fails(lo, q) {
+            return Some(lo);
+        }
+        while hi - lo > 1e-12 * hi.max(1e-12) {
+            let mid = 0.5 * (lo + hi);
+            if fails(mid, q) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        return Some(lo);
     }
-    limit
+    None
+}
+
+/// q_max(x) on a grid of x = I1 − 3 from 0 to [`SCANNED_I1`] − 3: (x, the largest q =
+/// ∇I1ᵀ(∇²I1)⁻¹∇I1 over the states with that I1, on rays λ2 = λ1^t, t from −½ (uniaxial) to 1
+/// (equibiaxial)), computed once.
+fn q_table() -> &'static [(f64, f64)] {
+    static TABLE: std::sync::OnceLock<Vec<(f64, f64)>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let q_at = |l1: f64, t: f64| -> (f64, f64) {
+            let l2 = l1.powf(t);
+            let j2 = 1.0 / (l1 * l1 * l2 * l2);
+            let g = [2.0 * l1 - 2.0 * j2 / l1, 2.0 * l2 - 2.0 * j2 / l2];
+            let k = [
+                [2.0 + 6.0 * j2 / (l1 * l1), 4.0 * j2 / (l1 * l2)],
+                [4.0 * j2 / (l1 * l2), 2.0 + 6.0 * j2 / (l2 * l2)],
+            ];
+            let det = k[0][0] * k[1][1] - k[0][1] * k[1][0];
+            let q =
+                (k[1][1] * g[0] * g[0] - 2.0 * k[0][1] * g[0] * g[1] + k[0][0] * g[1] * g[1]) / det;
+            (l1 * l1 + l2 * l2 + j2 - 3.0, q)
+        };
+        let n = 400;
+        let xmax = SCANNED_I1 - 3.0;
+        (0..=n)
+            .map(|i| {
+                // geometric in x from 1e-6, with x = 0 first
+                let x = if i == 0 {
+                    0.0
+                } else {
+                    1e-6 * (xmax / 1e-6).powf((i - 1) as f64 / (n - 1) as f64)
+                };
+                let mut q = 0.0f64;
+                for r in 0..=30 {
+                    let t = -0.5 + 1.5 * r as f64 / 30.0;
+                    // λ1 ≥ 1 with I1 − 3 = x on this ray (I1 grows with λ1 there)
+                    let (mut lo, mut hi) = (0.0f64, (SCANNED_I1).sqrt().ln() + 1.0);
+                    for _ in 0..80 {
+                        let mid = 0.5 * (lo + hi);
+                        if q_at(mid.exp(), t).0 < x {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    q = q.max(q_at(hi.exp(), t).1);
+                }
+                (x, q)
+            })
+            .collect()
+    })
 }
 
 impl Yeoh {
