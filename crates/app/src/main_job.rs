@@ -5,7 +5,9 @@
 //! 2. The 3D FE run: the capped tube inflated to λs* = 1.3, the gas closed in, squeezed to
 //!    ρ = 0.8; a table of the FE mid-span values against GPS and PS at every squeeze step, taken
 //!    from the run's typed report.
-//! 3. The figures (Figs. 5–7, λz) with the FE points overlaid.
+//! 3. The paper's Fig. 7 companion: the same law's tube inflated through the bulge to λs* = 6
+//!    and squeezed to ρ = 3 (`cases/squeeze_abb30_ls6.0_fig7.toml`).
+//! 4. The figures (Figs. 5–7, λz) with the FE points of both runs overlaid.
 
 use crate::case::Case;
 use crate::observer::Observer;
@@ -21,6 +23,9 @@ use tubemem_material::laws::AnssariBenamBucchi;
 
 /// The embedded default case.
 pub const DEFAULT_CASE: &str = include_str!("../../../cases/squeeze_abb30_ls1.3_quad9.toml");
+
+/// The embedded Fig. 7 companion (λs* = 6).
+pub const FIG7_CASE: &str = include_str!("../../../cases/squeeze_abb30_ls6.0_fig7.toml");
 
 /// One squeeze step of the main job's table.
 pub struct SqueezeRow {
@@ -40,6 +45,9 @@ pub struct MainJob {
     pub limits: Limits,
     pub run_dir: PathBuf,
     pub report: RunReport,
+    /// the Fig. 7 companion's run folder and report
+    pub fig7_dir: PathBuf,
+    pub fig7_report: RunReport,
     pub rows: Vec<SqueezeRow>,
     pub figures: Vec<PathBuf>,
 }
@@ -101,18 +109,35 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
                 .map(|l| l.force),
         });
     }
-    // the FE points from the report itself, not read back from the files just written
-    let overlay = figures::Overlay::from_report(&report, "embedded default case", &run_dir);
+    // Fig. 7's FE points: the companion run from λs* = 6
+    let fig7 = Case::parse(FIG7_CASE)?;
+    let fig7_dir = out.join("squeeze_ls6");
+    let mut writer = RunWriter::create(&fig7_dir, FolderMode::Overwrite, fig7.hash(), &[])?;
+    let mut all: Vec<&mut dyn Observer> = vec![&mut writer];
+    all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
+    let fig7_report = run(
+        &fig7,
+        "embedded Fig. 7 companion: cases/squeeze_abb30_ls6.0_fig7.toml",
+        &mut all,
+    )
+    .into_result()?;
+    // the FE points from the reports themselves, not read back from the files just written
+    let overlays = [
+        figures::Overlay::from_report(&report, "embedded default case", &run_dir),
+        figures::Overlay::from_report(&fig7_report, "fig7 companion", &fig7_dir),
+    ];
     let figures = figures::write_all(
         &out.join("figures"),
         Some(figures::PAPER_LAW),
-        &[overlay],
+        &overlays,
         &figures::FigureOptions::default(),
     )?;
     Ok(MainJob {
         limits,
         run_dir,
         report,
+        fig7_dir,
+        fig7_report,
         rows,
         figures,
     })

@@ -466,7 +466,8 @@ fn run_writes_steps_summary_profiles_and_vtu() {
          gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,\
          local_lambda_s,local_lambda_z,local_chi,local_force,\
          arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
-         augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,mesh_refits"
+         augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,mesh_refits,\
+         plate_force"
     );
     let empty_for_inflation = [
         "rho",
@@ -828,6 +829,50 @@ fn main_job_runs_the_embedded_squeeze() {
     assert!(d
         .join("tubemem-out/figures/fig6_force_displacement_ls1.3.png")
         .exists());
+    // issue #60 item 7: one file and one curve per start, and the FE points on Figs. 5–7 (the
+    // 9-node run's measured λs* is 1.300002: it belongs to the λs* = 1.3 curves it targeted)
+    let wrote: Vec<&str> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("wrote "))
+        .collect();
+    let mut unique = wrote.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), wrote.len(), "a file written twice: {wrote:?}");
+    let figs = d.join("tubemem-out/figures");
+    let names: Vec<String> = std::fs::read_dir(&figs)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    assert!(
+        !names.iter().any(|n| n.starts_with("fig8")),
+        "a start of its own for λs* = 1.300002: {names:?}"
+    );
+    for fig in [
+        "fig5_pressure_stretch.svg",
+        "fig6_force_displacement_ls1.3.svg",
+        "fig7_force_displacement_ls6.0.svg",
+    ] {
+        let svg = std::fs::read_to_string(figs.join(fig)).unwrap();
+        // the texts of the figure (each on its own line in plotters' SVG) but the numbers
+        let texts: Vec<&str> = svg
+            .split("</text>")
+            .filter_map(|t| t.rsplit_once('>').map(|(_, x)| x.trim()))
+            .filter(|x| !x.is_empty() && x.parse::<f64>().is_err())
+            .collect();
+        assert!(
+            texts.iter().any(|t| t.starts_with("FE: ")),
+            "{fig} has no FE points: {texts:?}"
+        );
+        let mut sorted = texts.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(
+            sorted.len(),
+            texts.len(),
+            "{fig}: a legend entry twice: {texts:?}"
+        );
+    }
 }
 
 /// Reliability: write errors on standard output (`> /dev/full`) are a clear error with exit 1,

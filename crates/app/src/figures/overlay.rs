@@ -16,6 +16,11 @@ pub struct SqueezePoint {
     pub force: f64,
     /// the run's λs* (mid-span stretch when the squeeze started)
     pub initial_stretch: f64,
+    /// the λs* the case inflated to (`target_stretch` of the inflation before the squeeze):
+    /// the start whose curves the point belongs to. The FE's measured λs* differs from it by
+    /// the ring polygon's discretization (the 9-node tube of the main job: 1.5e-6), not by a
+    /// different start
+    pub target_stretch: Option<f64>,
     /// GPS flattening from the run's λs* at the same ρ, when it has a solution
     pub gps_force: Option<f64>,
 }
@@ -45,9 +50,25 @@ impl Overlay {
             inflation: vec![],
             squeeze: vec![],
         };
+        // the target λs* of the last stretch-controlled inflation before each stage
+        let mut target = vec![None; report.stages.len() + 1];
+        let mut last = None;
+        for st in &report.stages {
+            match st.plan.target {
+                crate::case::Target::Stretch(l) => last = Some(l),
+                crate::case::Target::Pressure(_) | crate::case::Target::VolumeRatio(_) => {
+                    last = None
+                }
+                _ => {}
+            }
+            if let Some(t) = target.get_mut(st.plan.index) {
+                *t = last;
+            }
+        }
         for s in report.steps() {
             match &s.contact {
                 Some(c) => o.squeeze.push(SqueezePoint {
+                    target_stretch: target.get(s.stage).copied().flatten(),
                     lambda_s: s.midspan.lambda_s,
                     w: s.midspan.w,
                     rho: c.values.rho,
@@ -96,6 +117,27 @@ impl Overlay {
                 .position(|h| *h == name)
                 .ok_or_else(|| overlay(&path, format!("no column `{name}`")))
         };
+        // each stage's target λs* (summary.json `stages[k].target`), carried to the squeezes
+        // after a stretch-controlled inflation, as from a report
+        let mut targets: Vec<Option<f64>> = vec![None];
+        let mut last = None;
+        for st in summary
+            .get("stages")
+            .and_then(|s| s.as_array())
+            .into_iter()
+            .flatten()
+        {
+            let t = st.get("target");
+            match t.and_then(|t| t.get("key")).and_then(|k| k.as_str()) {
+                Some("target_stretch") => {
+                    last = t.and_then(|t| t.get("value")).and_then(|v| v.as_f64())
+                }
+                Some("target_pressure" | "target_volume_ratio") => last = None,
+                _ => {}
+            }
+            targets.push(last);
+        }
+        let cstage = col("stage").ok();
         let (cw, cls, crho, cdisp, cforce, cgps) = (
             col("w")?,
             col("lambda_s")?,
@@ -143,6 +185,10 @@ impl Overlay {
                     displacement: d,
                     force: num(cforce)?,
                     initial_stretch: d + rho,
+                    target_stretch: cstage
+                        .and_then(|c| f.get(c))
+                        .and_then(|v| v.parse::<usize>().ok())
+                        .and_then(|st| targets.get(st).copied().flatten()),
                     gps_force: match cgps {
                         Some(c) if f.get(c).is_some_and(|v| !v.is_empty()) => Some(num(c)?),
                         _ => None,
@@ -284,6 +330,13 @@ pub(super) fn points_file(dir: &Path, k: usize, o: &Overlay) -> (PathBuf, Vec<u8
 /// Two squeezes start from the same λs* (one figure, one pair of curves) within this relative
 /// difference: a stretch-controlled inflation ends at its target to Newton's tolerance.
 pub(super) const SAME_START: f64 = 1e-6;
+
+impl SqueezePoint {
+    /// The start whose curves the point belongs to: the case's target λs*, else the measured.
+    pub fn start(&self) -> f64 {
+        self.target_stretch.unwrap_or(self.initial_stretch)
+    }
+}
 
 pub(super) fn same_start(a: f64, b: f64) -> bool {
     (a / b - 1.0).abs() <= SAME_START

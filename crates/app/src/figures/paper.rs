@@ -45,7 +45,7 @@ impl Curves {
         let mut starts = vec![(1.3, Stroke::Dashed), (6.0, Stroke::Dotted)];
         for o in overlays {
             for p in &o.squeeze {
-                let l = p.initial_stretch;
+                let l = p.start();
                 if l.is_finite() && !starts.iter().any(|(x, _)| same_start(l, *x)) {
                     starts.push((l, Stroke::Dashed));
                 }
@@ -285,7 +285,7 @@ fn pressure_figures(c: &Curves, overlays: &[Overlay], name: &str) -> (Figure, Fi
     let fig5 = Figure {
         markers,
         ..Figure::new(
-            format!("Fig. 5 — reduced pressure vs hoop stretch ({name})"),
+            format!("Fig. 5 — pressure vs hoop stretch ({name})"),
             "hoop stretch λs",
             "reduced pressure ϖ = pR/(μH)",
             series,
@@ -333,7 +333,7 @@ fn force_figure(
         let pts: Vec<&SqueezePoint> = run
             .squeeze
             .iter()
-            .filter(|s| same_start(s.initial_stretch, ls0))
+            .filter(|s| same_start(s.start(), ls0))
             .collect();
         if pts.is_empty() {
             continue;
