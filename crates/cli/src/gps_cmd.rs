@@ -1,5 +1,5 @@
 //! `tubemem gps …` and the default job.
-use crate::material_args::MaterialArgs;
+use crate::material_args::{add_si, MaterialArgs, UnitArgs};
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use serde::Serialize;
@@ -54,10 +54,13 @@ pub enum GpsCommand {
 pub struct ConfineArgs {
     #[command(flatten)]
     material: MaterialArgs,
+    #[command(flatten)]
+    units: UnitArgs,
     #[arg(long, value_enum, default_value = "gps")]
     hypothesis: Hyp,
     /// A wall {x : n·x = d} as nx,ny,d, the membrane on the side n·x ≤ d (n need not be unit
-    /// length; the axis must be inside: d > 0). Repeat for each wall.
+    /// length; the axis must be inside: d > 0); d per R, or in m with --radius and
+    /// --thickness. Repeat for each wall.
     #[arg(
         long = "plane",
         value_name = "NX,NY,D",
@@ -69,7 +72,8 @@ pub struct ConfineArgs {
     /// from first contact to their offsets d; `--target-stretch` is an alias).
     #[arg(long, conflicts_with = "pressure", visible_alias = "target-stretch")]
     initial_stretch: Option<f64>,
-    /// A given reduced pressure ϖ instead (no gas law).
+    /// A given pressure instead (no gas law): the reduced pressure ϖ, or in Pa with --radius
+    /// and --thickness.
     #[arg(long)]
     pressure: Option<f64>,
     /// With --initial-stretch: the path's number of states (≥ 2), written to --csv.
@@ -112,17 +116,32 @@ fn confine_json(s: &tubemem_gps::confine::ConfineState) -> Result<serde_json::Va
 }
 
 fn run_confine(a: ConfineArgs) -> Result<()> {
+    use tubemem_app::units::Dimension;
     use tubemem_gps::confine::{confine_at_pressure, confine_path, section_outline};
     let law = a.material.build()?;
+    let units = a.units.units(law.as_ref())?;
     let hyp: Hypothesis = a.hypothesis.into();
+    // with SI units the offsets are lengths in m: the closed form takes them per R
     let walls = a
         .planes
         .iter()
-        .map(|p| parse_plane(p))
+        .map(|p| {
+            let w = parse_plane(p)?;
+            Ok(tubemem_gps::confine::Wall::new(
+                w.normal[0],
+                w.normal[1],
+                units.to_core(Dimension::Length, w.offset),
+            )?)
+        })
         .collect::<Result<Vec<_>>>()?;
     let path = match (a.initial_stretch, a.pressure) {
         (Some(ls0), None) => confine_path(law.as_ref(), hyp, &walls, ls0, a.points.unwrap_or(2))?,
-        (None, Some(w)) => vec![confine_at_pressure(law.as_ref(), hyp, &walls, w)?],
+        (None, Some(p)) => vec![confine_at_pressure(
+            law.as_ref(),
+            hyp,
+            &walls,
+            units.to_core(Dimension::Pressure, p),
+        )?],
         _ => bail!("give --initial-stretch λs* (the gas closed in) or --pressure ϖ"),
     };
     let Some(last) = path.last() else {
@@ -187,11 +206,12 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
         )?;
         crate::say!("wrote {}", fig.display())?;
     }
-    let v = confine_json(last)?;
+    let mut v = confine_json(last)?;
+    add_si(&mut v, &units);
     if a.json {
         crate::say!("{v}")?;
     } else if a.csv.is_none() {
-        print_state(last, false)?;
+        print_state(last, false, &units)?;
     }
     Ok(())
 }
@@ -279,6 +299,8 @@ fn draw_section(
 pub struct InflateArgs {
     #[command(flatten)]
     material: MaterialArgs,
+    #[command(flatten)]
+    units: UnitArgs,
     #[arg(long, value_enum, default_value = "gps")]
     hypothesis: Hyp,
     /// Hoop stretch λs (≥ 1) for a single state.
@@ -306,6 +328,8 @@ pub struct InflateArgs {
 pub struct FlattenArgs {
     #[command(flatten)]
     material: MaterialArgs,
+    #[command(flatten)]
+    units: UnitArgs,
     #[arg(long, value_enum, default_value = "gps")]
     hypothesis: Hyp,
     /// The inflated hoop stretch λs* at which the gas is closed in (the case file's
@@ -334,6 +358,8 @@ pub struct FlattenArgs {
 pub struct LimitsArgs {
     #[command(flatten)]
     material: MaterialArgs,
+    #[command(flatten)]
+    units: UnitArgs,
     #[arg(long, value_enum, default_value = "gps")]
     hypothesis: Hyp,
     #[arg(long)]
@@ -349,8 +375,13 @@ fn ensure_finite(values: &[f64]) -> Result<()> {
     }
 }
 
-fn print_state<T: Serialize>(state: &T, json: bool) -> Result<()> {
-    let v = serde_json::to_value(state)?;
+fn print_state<T: Serialize>(
+    state: &T,
+    json: bool,
+    units: &tubemem_app::units::Units,
+) -> Result<()> {
+    let mut v = serde_json::to_value(state)?;
+    add_si(&mut v, units);
     if json {
         crate::say!("{v}")?;
     } else if let Some(map) = v.as_object() {
@@ -399,7 +430,7 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
                 (Some(ls), None, None, None) if a.from.is_none() => {
                     let s = inflate(law.as_ref(), hyp, ls)?;
                     ensure_finite(&inflation_values(&s))?;
-                    print_state(&s, a.json)
+                    print_state(&s, a.json, &a.units.units(law.as_ref())?)
                 }
                 (None, Some(to), Some(points), Some(csv)) => {
                     let from = a.from.unwrap_or(1.0);
@@ -418,7 +449,7 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
                 (Some(rho), None, None, None) => {
                     let s = flatten(law.as_ref(), hyp, a.initial_stretch, rho)?;
                     ensure_finite(&flattening_values(&s))?;
-                    print_state(&s, a.json)
+                    print_state(&s, a.json, &a.units.units(law.as_ref())?)
                 }
                 (None, Some(to), Some(points), Some(csv)) => {
                     let c = flattening_curve(law.as_ref(), hyp, a.initial_stretch, to, points)?;
@@ -439,12 +470,20 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
         GpsCommand::Limits(a) => {
             let law = a.material.build()?;
             let l = limit_points(law.as_ref(), a.hypothesis.into())?;
-            print_limits(&l, a.json)
+            print_limits(&l, a.json, &a.units.units(law.as_ref())?)
         }
     }
 }
 
-fn print_limits(l: &Limits, json: bool) -> Result<()> {
+fn print_limits(l: &Limits, json: bool, units: &tubemem_app::units::Units) -> Result<()> {
+    use tubemem_app::units::Dimension;
+    let pa = |w: f64| {
+        if units.is_si() {
+            format!(" ({:.6e} Pa)", units.from_core(Dimension::Pressure, w))
+        } else {
+            String::new()
+        }
+    };
     let mut nums = vec![];
     for p in [l.max, l.min].into_iter().flatten() {
         nums.extend([p.lambda_s, p.lambda_z, p.w]);
@@ -454,14 +493,20 @@ fn print_limits(l: &Limits, json: bool) -> Result<()> {
     }
     ensure_finite(&nums)?;
     if json {
-        let v = serde_json::json!({ "max": l.max, "min": l.min, "maxwell": l.maxwell });
+        let mut v = serde_json::json!({ "max": l.max, "min": l.min, "maxwell": l.maxwell });
+        for k in ["max", "min", "maxwell"] {
+            if let Some(p) = v.get_mut(k) {
+                add_si(p, units);
+            }
+        }
         crate::say!("{v}")?;
         return Ok(());
     }
     let point = |name: &str, p: Option<tubemem_gps::limits::LimitPoint>| match p {
         Some(p) => crate::say!(
-            "{name:>8}: ϖ = {:.10}  at λs = {:.10}, λz = {:.10}",
+            "{name:>8}: ϖ = {:.10}{}  at λs = {:.10}, λz = {:.10}",
             p.w,
+            pa(p.w),
             p.lambda_s,
             p.lambda_z
         ),
@@ -471,8 +516,9 @@ fn print_limits(l: &Limits, json: bool) -> Result<()> {
     point("minimum", l.min)?;
     match l.maxwell {
         Some(m) => crate::say!(
-            " Maxwell: ϖ = {:.10}  coexisting λs = {:.10} and {:.10}",
+            " Maxwell: ϖ = {:.10}{}  coexisting λs = {:.10} and {:.10}",
             m.w,
+            pa(m.w),
             m.lambda_s_lower,
             m.lambda_s_upper
         )?,

@@ -29,9 +29,65 @@ pub struct MaterialArgs {
     /// Hardening parameter α (≥ 0) of the mooney-rivlin law.
     #[arg(long)]
     pub alpha: Option<f64>,
-    /// Shear modulus μ (only scales dimensional output; results here are per μH).
+    /// Shear modulus μ: in Pa with --radius and --thickness (the SI values are then printed
+    /// beside the dimensionless ones), else a scale no dimensionless result depends on.
     #[arg(long, default_value_t = 1.0)]
     pub shear_modulus: f64,
+}
+
+/// The tube's size for SI outputs: with both, the law's moduli are read in Pa, the results are
+/// printed in SI beside the dimensionless ones, and a pressure given is read in Pa.
+#[derive(Args, Debug, Clone, Default)]
+pub struct UnitArgs {
+    /// The tube's radius R in m (with --thickness: SI outputs, pressures in Pa).
+    #[arg(long, requires = "thickness")]
+    pub radius: Option<f64>,
+    /// The membrane's undeformed thickness H in m (with --radius).
+    #[arg(long, requires = "radius")]
+    pub thickness: Option<f64>,
+}
+
+impl UnitArgs {
+    /// The unit system: SI with R, H and the law's μ (Pa), or dimensionless.
+    pub fn units(&self, law: &dyn MembraneLaw) -> Result<tubemem_app::units::Units> {
+        use tubemem_app::units::Units;
+        match (self.radius, self.thickness) {
+            (Some(r), Some(h)) => Ok(Units::si(
+                tubemem_gps::Scales::new(r, h, law.shear_modulus()).map_err(|e| {
+                    anyhow::anyhow!(
+                        "--radius {r} --thickness {h}: {}",
+                        tubemem_app::error_chain(&e)
+                    )
+                })?,
+            )),
+            _ => Ok(Units::dimensionless()),
+        }
+    }
+}
+
+/// The SI twins of a closed-form state's dimensional keys (`w` → `pressure_pa`, `n_s` →
+/// `n_s_n_per_m`, `force` → `force_n_per_m`, `rho` → `half_gap_m`), added to its JSON object
+/// under SI; nothing when dimensionless.
+pub fn add_si(v: &mut serde_json::Value, units: &tubemem_app::units::Units) {
+    use tubemem_app::units::Dimension;
+    let Some(map) = v.as_object_mut() else {
+        return;
+    };
+    if !units.is_si() {
+        return;
+    }
+    for (key, name, d) in [
+        ("w", "pressure_pa", Dimension::Pressure),
+        ("n_s", "n_s_n_per_m", Dimension::Resultant),
+        ("n_z", "n_z_n_per_m", Dimension::Resultant),
+        ("force", "force_n_per_m", Dimension::ForcePerLength),
+        ("rho", "half_gap_m", Dimension::Length),
+        ("r", "half_height_m", Dimension::Length),
+    ] {
+        if let Some(x) = map.get(key).and_then(|x| x.as_f64()) {
+            map.insert(name.into(), units.from_core(d, x).into());
+        }
+    }
 }
 
 /// The spec of `--material` with its parameters, or why the flags do not make one.
