@@ -189,7 +189,67 @@ pub fn schema() -> serde_json::Value {
     );
     let mut value = schema.to_value();
     bound_counts(&mut value);
+    state_units(&mut value);
     value
+}
+
+/// Each dimensional key's unit ([`crate::units::CASE_KEYS`]) appended to its description in
+/// the schema (and so in the book's case reference): `Unit: m under [units] system = "SI", R
+/// otherwise`.
+fn state_units(schema: &mut serde_json::Value) {
+    // the table each definition of the schema describes
+    const TABLES: [(&str, &str); 6] = [
+        ("Geometry", "geometry"),
+        ("MaterialSpec", "material"),
+        ("MeshSpec", "mesh"),
+        ("SolverSpec", "solver"),
+        ("StageSpec", "stage"),
+        ("PlaneSpec", "stage.plane"),
+    ];
+    fn visit(v: &mut serde_json::Value, table: &str) {
+        match v {
+            serde_json::Value::Object(m) => {
+                if let Some(serde_json::Value::Object(props)) = m.get_mut("properties") {
+                    for (key, prop) in props.iter_mut() {
+                        let Some(d) = crate::units::case_key(&format!("{table}.{key}")) else {
+                            continue;
+                        };
+                        if let Some(o) = prop.as_object_mut() {
+                            let text = o
+                                .get("description")
+                                .and_then(|d| d.as_str())
+                                .unwrap_or("")
+                                .to_string();
+                            let unit = if table == "geometry" {
+                                "Unit: m under [units] system = \"SI\"; in a dimensionless case any one length unit (only L/R enters; R is the unit of the other lengths).".to_string()
+                            } else {
+                                format!("Unit: {}.", d.describe())
+                            };
+                            let joined = if text.is_empty() {
+                                unit
+                            } else {
+                                format!("{text}. {unit}")
+                            };
+                            o.insert("description".into(), joined.into());
+                        }
+                    }
+                }
+                for x in m.values_mut() {
+                    visit(x, table);
+                }
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(|x| visit(x, table)),
+            _ => {}
+        }
+    }
+    let Some(defs) = schema.get_mut("$defs").and_then(|d| d.as_object_mut()) else {
+        return;
+    };
+    for (def, table) in TABLES {
+        if let Some(d) = defs.get_mut(def) {
+            visit(d, table);
+        }
+    }
 }
 
 /// A member run's output defaults (a verify member, an atlas member), written into its case
@@ -1136,7 +1196,7 @@ impl Case {
         let stages: Vec<String> = self.plan.iter().map(|p| p.describe_in(&units)).collect();
         format!(
             "L/R = {}, {} caps; {law}; {mesh}; {}",
-            tubemem_material::Num(g.length / g.radius),
+            tubemem_material::Num(crate::units::round_sig(g.length / g.radius)),
             format!("{:?}", g.caps).to_lowercase(),
             stages.join(" → ")
         )

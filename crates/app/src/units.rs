@@ -64,6 +64,9 @@ impl Dimension {
         match self {
             Dimension::Ratio => "a ratio: the same number in every unit system".into(),
             Dimension::Angle => "radians".into(),
+            Dimension::Modulus => format!(
+                "{si} under [units] system = \"SI\"; in a dimensionless case any one unit (only the moduli's ratios enter the results)"
+            ),
             _ => format!("{si} under [units] system = \"SI\", {core} otherwise"),
         }
     }

@@ -89,10 +89,11 @@ pub fn run(a: AtlasArgs) -> u8 {
     let n = atlas.members.len();
     let _ = writeln!(
         std::io::stderr(),
-        "tubemem atlas: {} — {n} runs ({} λs* × {} L/R) on {workers} workers, {} ρ levels, {} quantities",
+        "tubemem atlas: {} — {n} runs ({} λs* × {} L/R) on {workers} worker{}, {} ρ levels, {} quantities",
         file.display(),
         atlas.spec.stretches.len(),
         atlas.spec.lengths.len(),
+        if workers == 1 { "" } else { "s" },
         atlas.spec.rho.len(),
         atlas.spec.quantities.len()
     );

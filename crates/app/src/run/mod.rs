@@ -117,6 +117,9 @@ fn run_inner(
     if let Some(w) = runner.coarse.as_ref().and_then(|c| c.warning.clone()) {
         report.warnings.push(w);
     }
+    if let Some(w) = thickness_warning(case) {
+        report.warnings.push(w);
+    }
     if let Some(ck) = &options.resume {
         runner.restore(ck, label, report)?;
     }
@@ -149,6 +152,9 @@ fn run_inner(
             report,
             observers,
         )?;
+        if let Some(w) = length_warning(case, report) {
+            report.warnings.push(w);
+        }
         for o in observers.iter_mut() {
             o.stage_finished(report)
                 .map_err(|source| AppError::Output {
@@ -164,4 +170,37 @@ fn run_inner(
         })?;
     }
     Ok(())
+}
+
+/// The largest H/R of a thin shell: 1/20 (Ventsel & Krauthammer, *Thin Plates and Shells*,
+/// 2001, §10.1: a shell is thin where max(h/R) ≤ 1/20; beyond it the bending and transverse
+/// shear a membrane model leaves out are no longer small against the membrane forces).
+pub const THIN_MEMBRANE_RATIO: f64 = 1.0 / 20.0;
+
+/// A warning when the case's H/R is beyond thin-membrane theory's range.
+fn thickness_warning(case: &Case) -> Option<String> {
+    let h = case.geometry.thickness? / case.geometry.radius;
+    (h > THIN_MEMBRANE_RATIO).then(|| {
+        format!(
+            "[geometry] thickness / radius = H/R = {:.3} is beyond thin-membrane theory's range (H/R ≤ 1/20, Ventsel & Krauthammer 2001): the membrane model leaves out bending and transverse shear, whose share grows with H/R; the results are the membrane's, and a shell model would differ by O(H/R)",
+            h
+        )
+    })
+}
+
+/// A warning when a finished stage's tube has no translation-invariant middle: the caps'
+/// boundary layers (λs within 0.1 % of mid-span from `cap_boundary_layer` inside each
+/// junction) meet at mid-span, so no part of it is the uniform tube GPS describes.
+fn length_warning(case: &Case, report: &RunReport) -> Option<String> {
+    let StageOutcome::Finished(s) = &report.stages.last()?.outcome else {
+        return None;
+    };
+    let half = 0.5 * case.geometry.length / case.geometry.radius;
+    let layer = s.cap_boundary_layer?;
+    (layer >= 0.9 * half).then(|| {
+        format!(
+            "stage {}: the caps' boundary layers (λs within 0.1 % of mid-span only {layer:.3} R inside each junction) fill the tube (L/2 = {half:.3} R): no middle part is translation invariant, and the mid-span differs from GPS by the end effect; `tubemem verify --case` gives the length an accuracy needs",
+            s.index
+        )
+    })
 }
