@@ -35,12 +35,21 @@ def case(si):
     return d
 
 
+# columns that are deviations from 1 or lengths that are round-off around 0 (penetrations,
+# gaps): compared on their natural scale, 1 (a ratio; R), not on their own tiny values
+UNIT_SCALE = {"flat_pressure_deviation", "nonuniformity", "penetration", "contact_gap", "multiplier_change"}
+
+
 def test_an_si_case_dict_and_its_twin_agree(tmp_path):
     a = tubemem.run(case(True), str(tmp_path / "si"))
     b = tubemem.run(case(False), str(tmp_path / "dl"))
     for name in b.steps.columns:
         x, y = np.asarray(a.steps[name], float), np.asarray(b.steps[name], float)
         scale = max(np.nanmax(np.abs(y)), 1e-12) if np.isfinite(y).any() else 1.0
+        if name in UNIT_SCALE:
+            scale = max(scale, 1.0)
+        if name == "n_sz":
+            scale = max(scale, float(np.nanmax(np.abs(np.asarray(b.steps["n_s"])))))
         assert np.array_equal(np.isnan(x), np.isnan(y)), name
         ok = np.isnan(y) | (np.abs(x - y) <= 1e-9 * np.maximum(np.abs(y), scale))
         assert ok.all(), (name, x, y)
@@ -60,7 +69,7 @@ def test_the_plate_force_is_the_integral_of_the_contact_pressure(tmp_path):
     m = meshio.read(frames[-1])
     pts = m.points
     quads = m.cells_dict["quad"]
-    pc = m.cell_data_dict["contact_pressure"]["quad"]
+    pc = np.ravel(m.cell_data_dict["contact_pressure"]["quad"])
     # the deformed area of each bilinear quad: its two triangles, over both diagonals
     a, b, c, d = (pts[quads[:, k]] for k in range(4))
 
@@ -74,5 +83,7 @@ def test_the_plate_force_is_the_integral_of_the_contact_pressure(tmp_path):
     # the VTU's cell pressure is the element's force over its deformed area computed with
     # the element's Gauss rule; an element lying flat on the plate is planar and both areas
     # agree exactly; the elements at the contact edge are not planar, and the triangle
-    # split differs from the Gauss area there by O(h²) of their share: measured 2.4e-5 here
+    # split differs from the Gauss area there by O(h²) of their share: measured 2.8e-5 here
+    # (16 around); 1e-4 holds it with a factor 3.6, and a unit slip (μHR against μH/R) would be
+    # off by 1/R² = 8264
     assert math.isclose(integral, total, rel_tol=1e-4), (integral, total)
