@@ -241,12 +241,13 @@ fn quadratic_constant(l: &[f64], e: &[f64]) -> Option<f64> {
         }
         m.swap(col, piv);
         b.swap(col, piv);
+        let (pivot, pb) = (m[col], b[col]);
         for row in col + 1..3 {
-            let f = m[row][col] / m[col][col];
-            for k in col..3 {
-                m[row][k] -= f * m[col][k];
+            let f = m[row][col] / pivot[col];
+            for (x, p) in m[row][col..].iter_mut().zip(&pivot[col..]) {
+                *x -= f * p;
             }
-            b[row] -= f * b[col];
+            b[row] -= f * pb;
         }
     }
     let mut x = [0.0f64; 3];

@@ -46,6 +46,9 @@ pub struct FitArgs {
     /// Write the fit's figure to PLOT.svg and PLOT.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Replace an existing PLOT.svg or PLOT.png that this command did not write.
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 /// `NAME=VALUE` of --fix.
@@ -99,6 +102,26 @@ pub fn run(a: FitArgs) -> Result<()> {
                 })?,
         ),
     };
+    // the figure's files checked against the inputs and existing files before anything is read
+    if let Some(stem) = &a.plot {
+        let law_file = Some(PathBuf::from(&a.law)).filter(|p| p.is_file());
+        let inputs: Vec<&std::path::Path> = [&a.uniaxial, &a.equibiaxial, &a.pure_shear, &law_file]
+            .into_iter()
+            .flatten()
+            .map(|p| p.as_path())
+            .collect();
+        let ours = |t: &str| t.starts_with("<svg") && t.contains("Fit of the");
+        // a PNG's writer cannot be told from its bytes: it is this command's where the SVG
+        // written beside it is
+        let svg_ours = std::fs::read_to_string(stem.with_extension("svg")).is_ok_and(|t| ours(&t));
+        for ext in ["svg", "png"] {
+            let path = stem.with_extension(ext);
+            tubemem_app::output_file::check("--plot", &path, &inputs, |t| {
+                a.overwrite || ours(t) || (ext == "png" && svg_ours)
+            })
+            .map_err(|e| anyhow::anyhow!(tubemem_app::error_chain(&e)))?;
+        }
+    }
     let mut files = vec![];
     for (path, mode) in [
         (&a.uniaxial, Mode::Uniaxial),

@@ -18,6 +18,39 @@ fn write_csv(
     tubemem_app::curves::write_csv(path, header, rows).map_err(|e| anyhow::anyhow!(e.chain()))
 }
 
+/// The output policy for a file a `gps` command writes (`key` its option): not an input (the
+/// `--law` file, `--ring`), and an existing file only where it is one of this command's own
+/// (its first line `header`), or with `--overwrite`.
+fn may_write(
+    key: &'static str,
+    path: &std::path::Path,
+    inputs: &[&std::path::Path],
+    header: &str,
+    overwrite: bool,
+) -> Result<()> {
+    tubemem_app::output_file::check(key, path, inputs, |text| {
+        overwrite || text.starts_with(header)
+    })
+    .map_err(|e| anyhow::anyhow!(e.chain()))
+}
+
+/// Whether `text` begins as a figure tubemem wrote (an SVG of plotters' with its title) or a
+/// PNG (whose writer cannot be told: replaced only with `--overwrite`).
+fn figure_title(title: &'static str) -> impl Fn(&str) -> bool {
+    move |text: &str| text.starts_with("<svg") && text.contains(title)
+}
+
+/// The `--law` argument's file, when it names one (an input no output may replace).
+fn law_file(law: &Option<String>) -> Option<PathBuf> {
+    law.as_ref().map(PathBuf::from).filter(|p| p.is_file())
+}
+
+/// The first columns of `gps confine --csv` (each wall's contact and force follow).
+const CONFINE_HEADER: &str = "scale,w,lambda_s,lambda_z,n_s,n_z,r,area,regime";
+
+/// The title of `gps confine --figure`.
+const SECTION_TITLE: &str = "Confined cross-section (GPS closed form, eqs. 55–60)";
+
 #[derive(Copy, Clone, Debug, ValueEnum)]
 pub enum Hyp {
     /// generalized plane strain (λz from the end-cap balance)
@@ -85,6 +118,9 @@ pub struct ConfineArgs {
     /// Draw the final section and the walls to this figure (.png or .svg).
     #[arg(long)]
     figure: Option<PathBuf>,
+    /// Replace an existing --csv or --figure file that this command did not write.
+    #[arg(long)]
+    overwrite: bool,
     /// With --figure: also draw these FE mid-span ring points (x,y CSV, e.g. a run's
     /// profiles/stage2_midspan_ring.csv).
     #[arg(long, requires = "figure")]
@@ -134,6 +170,30 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
             )?)
         })
         .collect::<Result<Vec<_>>>()?;
+    // every output checked against every input and existing file before anything is read
+    // or written: the --ring file may not be the --csv or the --figure
+    let law_path = law_file(&a.material.law);
+    let inputs: Vec<&std::path::Path> = law_path
+        .iter()
+        .map(|p| p.as_path())
+        .chain(a.ring.as_deref())
+        .collect();
+    if let Some(csv) = &a.csv {
+        may_write("--csv", csv, &inputs, CONFINE_HEADER, a.overwrite)?;
+    }
+    if let Some(fig) = &a.figure {
+        let title = figure_title(SECTION_TITLE);
+        tubemem_app::output_file::check("--figure", fig, &inputs, |t| a.overwrite || title(t))
+            .map_err(|e| anyhow::anyhow!(e.chain()))?;
+    }
+    if let (Some(c), Some(f)) = (&a.csv, &a.figure) {
+        if c == f {
+            bail!(
+                "--csv and --figure name the same file {}: give two",
+                c.display()
+            );
+        }
+    }
     let path = match (a.initial_stretch, a.pressure) {
         (Some(ls0), None) => confine_path(law.as_ref(), hyp, &walls, ls0, a.points.unwrap_or(2))?,
         (None, Some(p)) => vec![confine_at_pressure(
@@ -148,7 +208,7 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
         bail!("internal error: an empty confinement path; please report this input");
     };
     if let Some(csv) = &a.csv {
-        let mut header = "scale,w,lambda_s,lambda_z,n_s,n_z,r,area,regime".to_string();
+        let mut header = CONFINE_HEADER.to_string();
         for k in 0..walls.len() {
             header.push_str(&format!(",contact_{k},force_{k}"));
         }
@@ -276,12 +336,7 @@ fn draw_section(
         },
         equal_aspect: true,
         y_from_zero: false,
-        ..Figure::new(
-            "Confined cross-section (GPS closed form, eqs. 55–60)",
-            "x/R",
-            "y/R",
-            series,
-        )
+        ..Figure::new(SECTION_TITLE, "x/R", "y/R", series)
     };
     let stem = path.with_extension("");
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("png");
@@ -318,6 +373,9 @@ pub struct InflateArgs {
     /// Write the curve to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Replace an existing --csv file that this command did not write.
+    #[arg(long)]
+    overwrite: bool,
     /// Print one JSON object (a single state) instead of text.
     #[arg(long)]
     json: bool,
@@ -349,6 +407,9 @@ pub struct FlattenArgs {
     /// Write the curve to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Replace an existing --csv file that this command did not write.
+    #[arg(long)]
+    overwrite: bool,
     #[arg(long)]
     json: bool,
 }
@@ -433,6 +494,9 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
                     print_state(&s, a.json, &a.units.units(law.as_ref())?)
                 }
                 (None, Some(to), Some(points), Some(csv)) => {
+                    let law_file = law_file(&a.material.law);
+                    let inputs: Vec<&std::path::Path> = law_file.iter().map(|p| p.as_path()).collect();
+                    may_write("--csv", csv, &inputs, INFLATION_HEADER, a.overwrite)?;
                     let from = a.from.unwrap_or(1.0);
                     let c = inflation_curve(law.as_ref(), hyp, from, to, points)?;
                     write_csv(csv, INFLATION_HEADER, c.iter().map(inflation_values))?;
@@ -452,6 +516,10 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
                     print_state(&s, a.json, &a.units.units(law.as_ref())?)
                 }
                 (None, Some(to), Some(points), Some(csv)) => {
+                    let law_file = law_file(&a.material.law);
+                    let inputs: Vec<&std::path::Path> =
+                        law_file.iter().map(|p| p.as_path()).collect();
+                    may_write("--csv", csv, &inputs, FLATTENING_HEADER, a.overwrite)?;
                     let c = flattening_curve(law.as_ref(), hyp, a.initial_stretch, to, points)?;
                     write_csv(csv, FLATTENING_HEADER, c.iter().map(flattening_values))?;
                     crate::say!(

@@ -688,7 +688,7 @@ pub fn fit_with(
     };
     let mut parameters = vec![];
     let mut fi = 0;
-    for (k, (name, _)) in named.iter().enumerate() {
+    for (name, _) in named.iter() {
         if let Some(&v) = opts.fixed.get(name) {
             parameters.push(FittedParameter {
                 name: name.clone(),
@@ -700,7 +700,6 @@ pub fn fit_with(
             });
             continue;
         }
-        let _ = k;
         let value = x[fi];
         let se = std[fi];
         parameters.push(FittedParameter {

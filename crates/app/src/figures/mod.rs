@@ -280,16 +280,23 @@ pub(crate) fn audit(fig: &Figure) -> FigureAudit {
     }
 }
 
-/// The corner of the plot where the legend covers the fewest points (curve and marker points,
-/// a curve's segments sampled between its points), the upper left on a tie.
+/// The weight of a marker against a curve's sample in [`legend_corner`]: a marker hidden is a
+/// datum (an FE point, an atlas grid point) lost, a curve's sample a short stretch of a line
+/// whose course the rest shows, so one marker outweighs any curve's samples in a corner.
+const MARKER_WEIGHT: usize = 100_000;
+
+/// The corner of the plot where the legend covers the least: markers first (each outweighs any
+/// number of curve samples, [`MARKER_WEIGHT`]), then curve points (a curve's segments sampled
+/// between its points); the upper left on a tie.
 pub(crate) fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
     let size = legend_size(fig);
     let unit = |p: (f64, f64)| ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
-    let mut pts: Vec<(f64, f64)> = fig
+    let marks: Vec<(f64, f64)> = fig
         .markers
         .iter()
         .flat_map(|m| m.points.iter().map(|&p| unit(p)))
         .collect();
+    let mut pts: Vec<(f64, f64)> = vec![];
     for s in &fig.series {
         for seg in s.points.windows(2) {
             let (a, b) = (unit(seg[0]), unit(seg[1]));
@@ -303,9 +310,12 @@ pub(crate) fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> Serie
         }
     }
     let covered = |left: bool, upper: bool| {
-        pts.iter()
-            .filter(|(u, v)| under_legend(*u, *v, left, upper, size))
-            .count()
+        let hidden = |v: &[(f64, f64)]| {
+            v.iter()
+                .filter(|(u, w)| under_legend(*u, *w, left, upper, size))
+                .count()
+        };
+        MARKER_WEIGHT * hidden(&marks) + hidden(&pts)
     };
     [
         (SeriesLabelPosition::UpperLeft, true, true),

@@ -268,14 +268,17 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
         path: path.to_path_buf(),
         message: format!("check `{}`: {message}", c.name),
     };
+    // the name is a folder under --out: `.` and `..` (and any name of dots) would be the
+    // output folder itself or its parent, where the check's run would replace a user's files
     if c.name.trim().is_empty()
+        || c.name.chars().all(|ch| ch == '.')
         || !c
             .name
             .chars()
             .all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch))
     {
         return Err(err(
-            "`name` must be non-empty ASCII letters, digits, '-', '_' or '.' (it names a folder)"
+            "`name` must be ASCII letters, digits, '-', '_' or '.', not only dots (it names the check's folder under --out)"
                 .into(),
         ));
     }

@@ -19,7 +19,7 @@ impl Yeoh {
     /// C10 > 0 and finite C20, C30. Negative coefficients are accepted (fitted silicone laws
     /// have them: Ecoflex's C30 < 0): such a law is stable only up to the I1 where its membrane
     /// tangent stops being positive definite ([`Yeoh::stable_limit`], found by
-    /// [`stability_limit`]), and refuses states beyond it (every Yeoh law with C10 > 0 is
+    /// `stability_limit` below), and refuses states beyond it (every Yeoh law with C10 > 0 is
     /// stable at the reference state, where ∇I1 = 0).
     pub fn new(c10: f64, c20: f64, c30: f64) -> Result<Self, MaterialError> {
         super::check_positive("c10", c10)?;
