@@ -1475,10 +1475,17 @@ impl Case {
                 Target::Rho(r) => {
                     if let Some((h, what)) = &height {
                         if r >= *h {
+                            let given = match self.stages[k].target_gap {
+                                Some(g) => format!(
+                                    "`target_gap` = {} (ρ = {})",
+                                    units.written(Dimension::Length, g),
+                                    tubemem_material::Num(crate::units::round_sig(r))
+                                ),
+                                None => format!("`target_rho` = {}", tubemem_material::Num(r)),
+                            };
                             invalid!(
-                                "[[stage]] {}: the plates' half-gap ρ = {}: the plates must close on the tube, below {what} (ρ < {})",
+                                "[[stage]] {}: {given}: the plates must close on the tube, below {what} (ρ < {})",
                                 k + 1,
-                                units.show(Dimension::Ratio, r),
                                 tubemem_material::Num(*h)
                             );
                         }

@@ -179,14 +179,8 @@ pub fn round_sig(v: f64) -> f64 {
     if v == 0.0 || !v.is_finite() {
         return v;
     }
-    let digits = 7 - 1 - v.abs().log10().floor() as i32;
-    let f = 10f64.powi(digits.clamp(-300, 300));
-    let r = (v * f).round() / f;
-    if r.is_finite() {
-        r
-    } else {
-        v
-    }
+    // through the decimal text: exact at every magnitude (1e308 stays 1e308)
+    format!("{v:.6e}").parse().unwrap_or(v)
 }
 
 /// Every key of a case file that carries a dimension, by its path (`stage.` stands for each

@@ -1384,7 +1384,11 @@ fn a_killed_tracked_run_resumes_bit_identical() {
     );
     run_ok(&case, &killed, &["--resume"]);
     let steps = std::fs::read_to_string(killed.join("steps.csv")).unwrap();
-    assert!(steps.lines().next().unwrap().ends_with(",mesh_refits"));
+    assert!(steps
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with(",mesh_refits,plate_force"));
     assert_same_run(
         &reference,
         &killed,
@@ -2362,9 +2366,10 @@ fn figures_of_runs_with_units_have_dimensional_axes() {
 }
 
 /// `tubemem fit`: the shipped synthetic Yeoh data (examples/fit; the stated law, C10 = 0.012,
-/// C20 = −3e-4, C30 = 2e-5 MPa, with 1 % noise) give back that law within three standard
-/// errors, with a figure; bad data files name the file and the line; `--law` takes any law for
-/// the closed form.
+/// C20 = −3e-4, C30 = 2e-5 MPa, with 1 % noise; the headers say MPa, so the fit works in Pa)
+/// give back that law within three standard errors, converged, with a figure and the table
+/// labelled in Pa; bad data files name the file and the line; `--law` takes any law for the
+/// closed form.
 #[test]
 fn fit_recovers_the_synthetic_law_and_names_bad_data() {
     let ex = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/fit");
@@ -2382,7 +2387,8 @@ fn fit_recovers_the_synthetic_law_and_names_bad_data() {
         plot.to_str().unwrap(),
         "--json",
     ]);
-    for (name, truth) in [("c10", 0.012), ("c20", -3e-4), ("c30", 2e-5)] {
+    assert_eq!(v["converged"], true, "{}", v["stop_reason"]);
+    for (name, truth) in [("c10", 0.012e6), ("c20", -3e-4 * 1e6), ("c30", 2e-5 * 1e6)] {
         let p = v["parameters"]
             .as_array()
             .unwrap()
@@ -2400,7 +2406,64 @@ fn fit_recovers_the_synthetic_law_and_names_bad_data() {
     std::fs::write(&bad, "stretch,stress\n1.1,0.01\n1.2,abc\n").unwrap();
     assert_clean_failure(
         &["fit", "--law", "yeoh", "--uniaxial", bad.to_str().unwrap()],
-        "bad.csv, line 3: the stress `abc` is not a number",
+        "bad.csv, line 3: the stress `abc` is not a finite number",
+    );
+    // the columns by their names: a `stress,stretch` header is read as stress, stretch
+    let swapped = d.join("swapped.csv");
+    let text = std::fs::read_to_string(ex.join("yeoh_synthetic_uniaxial.csv")).unwrap();
+    let rows: Vec<String> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            let (a, b) = l.split_once(',').unwrap();
+            format!("{b},{a}")
+        })
+        .collect();
+    std::fs::write(
+        &swapped,
+        format!("nominal_stress_mpa,stretch\n{}\n", rows.join("\n")),
+    )
+    .unwrap();
+    let w = json(&[
+        "fit",
+        "--law",
+        "yeoh",
+        "--uniaxial",
+        swapped.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(w["converged"], true);
+    // decimal commas, a header-less file and a mix of units are named
+    let comma = d.join("comma.csv");
+    std::fs::write(&comma, "stretch,stress_pa\n1,1,0,01\n").unwrap();
+    assert_clean_failure(
+        &[
+            "fit",
+            "--law",
+            "yeoh",
+            "--uniaxial",
+            comma.to_str().unwrap(),
+        ],
+        "a decimal comma?",
+    );
+    let bare = d.join("bare.csv");
+    std::fs::write(
+        &bare,
+        "stretch,stress\n1.1,0.01\n1.2,0.02\n1.3,0.03\n1.4,0.04\n",
+    )
+    .unwrap();
+    assert_clean_failure(
+        &[
+            "fit",
+            "--law",
+            "yeoh",
+            "--uniaxial",
+            ex.join("yeoh_synthetic_uniaxial.csv").to_str().unwrap(),
+            "--equibiaxial",
+            bare.to_str().unwrap(),
+        ],
+        "one unit per fit",
     );
     assert_clean_failure(
         &[

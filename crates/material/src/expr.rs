@@ -73,18 +73,44 @@ enum Token {
     End,
 }
 
+/// The deepest nesting an energy may have (parentheses, signs, exponents and function calls
+/// inside one another): 200. The parser descends once per level; a hand-written energy nests a
+/// few levels, and 200 keeps the descent far inside the smallest stack a thread runs it on.
+pub const MAX_DEPTH: usize = 200;
+
+/// The most operations an energy may have after its constants are folded: 100,000 (a 1 MiB
+/// case holds about 250,000 characters of `+ x`; each operation costs every evaluation at
+/// every Gauss point).
+pub const MAX_NODES: usize = 100_000;
+
+/// The longest excerpt of an energy an error message quotes around its column.
+const EXCERPT: usize = 40;
+
 struct Parser<'a> {
     tokens: Vec<(Token, usize)>,
     pos: usize,
+    /// the current nesting (see [`MAX_DEPTH`])
+    depth: usize,
     nodes: Vec<Node>,
     variables: &'a [&'a str],
     parameters: &'a BTreeMap<String, f64>,
     text: &'a str,
 }
 
+/// An error at `column` of `text`, quoting at most [`EXCERPT`] characters on each side of it
+/// (a 1 MiB energy is not echoed whole).
 fn error(text: &str, column: usize, message: String) -> MaterialError {
+    let chars: Vec<char> = text.chars().collect();
+    let at = column.saturating_sub(1).min(chars.len());
+    let (from, to) = (at.saturating_sub(EXCERPT), (at + EXCERPT).min(chars.len()));
+    let excerpt = format!(
+        "{}{}{}",
+        if from > 0 { "…" } else { "" },
+        chars[from..to].iter().collect::<String>(),
+        if to < chars.len() { "…" } else { "" }
+    );
     MaterialError::Expression {
-        energy: text.into(),
+        energy: excerpt.into(),
         column,
         message: message.into(),
     }
@@ -192,6 +218,18 @@ impl Parser<'_> {
         self.nodes.push(folded.map_or(n, Node::Const));
         self.nodes.len() - 1
     }
+    /// Whether the energy has grown past [`MAX_NODES`] operations.
+    fn too_many(&self) -> Result<(), MaterialError> {
+        if self.nodes.len() > MAX_NODES {
+            let col = self.column();
+            return Err(error(
+                self.text,
+                col,
+                format!("the energy has more than {MAX_NODES} operations (an energy is a formula, not data)"),
+            ));
+        }
+        Ok(())
+    }
     fn expect_close(&mut self, open_col: usize) -> Result<(), MaterialError> {
         match self.next() {
             (Token::Close, _) => Ok(()),
@@ -210,6 +248,7 @@ impl Parser<'_> {
                     self.next();
                     let r = self.term()?;
                     left = self.push(Node::Add(left, r));
+                    self.too_many()?;
                 }
                 Token::Op('-') => {
                     self.next();
@@ -228,6 +267,7 @@ impl Parser<'_> {
                     self.next();
                     let r = self.unary()?;
                     left = self.push(Node::Mul(left, r));
+                    self.too_many()?;
                 }
                 Token::Op('/') => {
                     self.next();
@@ -238,7 +278,23 @@ impl Parser<'_> {
             }
         }
     }
+    /// One level of nesting: every recursion of the parser passes here (a sign, a
+    /// parenthesis's expression, an exponent, a call's arguments), so the depth is bounded.
     fn unary(&mut self) -> Result<usize, MaterialError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            let col = self.column();
+            return Err(error(
+                self.text,
+                col,
+                format!("the energy nests deeper than {MAX_DEPTH} levels (parentheses, signs, exponents, calls) here"),
+            ));
+        }
+        let r = self.unary_inner();
+        self.depth -= 1;
+        r
+    }
+    fn unary_inner(&mut self) -> Result<usize, MaterialError> {
         match self.peek() {
             Token::Op('-') => {
                 self.next();
@@ -414,6 +470,7 @@ impl Expr {
         let mut p = Parser {
             tokens: tokenize(text)?,
             pos: 0,
+            depth: 0,
             nodes: vec![],
             variables,
             parameters,
@@ -428,14 +485,9 @@ impl Expr {
                 "unexpected text after a complete expression (an operator missing?)".into(),
             ));
         }
-        let mut nodes = p.nodes;
-        // the root last: evaluation starts there
-        if root + 1 != nodes.len() {
-            let n = nodes[root];
-            nodes.push(n);
-        }
+        p.too_many()?;
         Ok(Expr {
-            nodes,
+            nodes: tape(&p.nodes, root),
             text: text.to_string(),
             variables: variables.iter().map(|v| v.to_string()).collect(),
         })
@@ -451,26 +503,84 @@ impl Expr {
         self.nodes.contains(&Node::Var(k))
     }
 
-    /// The value at `vars` (one per variable, in the order given to [`Expr::parse`]).
+    /// The value at `vars` (one per variable, in the order given to [`Expr::parse`]): the
+    /// tape evaluated in order, each operation once, without recursion (an operation's
+    /// operands come before it), so a sum of 20,000 terms costs 20,000 operations and no
+    /// stack.
     pub fn eval<T: Real>(&self, vars: &[T]) -> T {
-        self.node(self.nodes.len() - 1, vars)
-    }
-
-    fn node<T: Real>(&self, k: usize, v: &[T]) -> T {
-        match self.nodes[k] {
-            Node::Const(c) => v[0].lift(c),
-            Node::Var(i) => v[i],
-            Node::Neg(a) => -self.node(a, v),
-            Node::Add(a, b) => self.node(a, v) + self.node(b, v),
-            Node::Sub(a, b) => self.node(a, v) - self.node(b, v),
-            Node::Mul(a, b) => self.node(a, v) * self.node(b, v),
-            Node::Div(a, b) => self.node(a, v) / self.node(b, v),
-            Node::PowI(a, n) => self.node(a, v).powi(n),
-            Node::PowF(a, p) => self.node(a, v).powf(p),
-            Node::Pow(a, b) => self.node(a, v).pow(self.node(b, v)),
-            Node::Call(f, a) => f.apply(self.node(a, v)),
+        let mut val: Vec<T> = Vec::with_capacity(self.nodes.len());
+        for n in &self.nodes {
+            let x = match *n {
+                Node::Const(c) => vars[0].lift(c),
+                Node::Var(i) => vars[i],
+                Node::Neg(a) => -val[a],
+                Node::Add(a, b) => val[a] + val[b],
+                Node::Sub(a, b) => val[a] - val[b],
+                Node::Mul(a, b) => val[a] * val[b],
+                Node::Div(a, b) => val[a] / val[b],
+                Node::PowI(a, k) => val[a].powi(k),
+                Node::PowF(a, p) => val[a].powf(p),
+                Node::Pow(a, b) => val[a].pow(val[b]),
+                Node::Call(f, a) => f.apply(val[a]),
+            };
+            val.push(x);
         }
+        val[val.len() - 1]
     }
+}
+
+/// The operations `root` depends on, in an order where each comes after its operands, the
+/// root last (the tape [`Expr::eval`] runs): the parser's arena without what constant folding
+/// left unused. Walked with an explicit stack, so its depth is unbounded.
+fn tape(nodes: &[Node], root: usize) -> Vec<Node> {
+    let operands = |n: &Node| -> [Option<usize>; 2] {
+        match *n {
+            Node::Const(_) | Node::Var(_) => [None, None],
+            Node::Neg(a) | Node::PowI(a, _) | Node::PowF(a, _) | Node::Call(_, a) => {
+                [Some(a), None]
+            }
+            Node::Add(a, b)
+            | Node::Sub(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Pow(a, b) => [Some(a), Some(b)],
+        }
+    };
+    let mut live = vec![false; nodes.len()];
+    let mut stack = vec![root];
+    while let Some(k) = stack.pop() {
+        if std::mem::replace(&mut live[k], true) {
+            continue;
+        }
+        stack.extend(operands(&nodes[k]).into_iter().flatten());
+    }
+    // the arena is already in operand-before-operation order (a node is pushed after its
+    // operands): keep the live nodes in it, renumbered
+    let mut new_index = vec![usize::MAX; nodes.len()];
+    let mut out = Vec::with_capacity(nodes.len());
+    for (k, n) in nodes.iter().enumerate() {
+        if !live[k] {
+            continue;
+        }
+        let map = |i: usize| new_index[i];
+        let m = match *n {
+            Node::Neg(a) => Node::Neg(map(a)),
+            Node::Add(a, b) => Node::Add(map(a), map(b)),
+            Node::Sub(a, b) => Node::Sub(map(a), map(b)),
+            Node::Mul(a, b) => Node::Mul(map(a), map(b)),
+            Node::Div(a, b) => Node::Div(map(a), map(b)),
+            Node::PowI(a, p) => Node::PowI(map(a), p),
+            Node::PowF(a, p) => Node::PowF(map(a), p),
+            Node::Pow(a, b) => Node::Pow(map(a), map(b)),
+            Node::Call(f, a) => Node::Call(f, map(a)),
+            c @ (Node::Const(_) | Node::Var(_)) => c,
+        };
+        new_index[k] = out.len();
+        out.push(m);
+    }
+    // the root is the arena's largest live index (everything live is its operand, or it)
+    debug_assert_eq!(new_index[root], out.len() - 1);
+    out
 }
 
 #[cfg(test)]
@@ -537,5 +647,51 @@ mod tests {
         // a parameter named as a variable, or not finite
         assert!(Expr::parse("I1", &["I1", "I2"], &params(&[("I1", 1.0)])).is_err());
         assert!(Expr::parse("I1", &["I1", "I2"], &params(&[("a", f64::NAN)])).is_err());
+    }
+
+    /// Issue #61: energies that had overflowed the stack (exit 134) are parsed and evaluated
+    /// without recursion, or refused with a short message: 100k nested parentheses and 100k
+    /// unary minus signs pass [`MAX_DEPTH`]; a plain sum of 20,000 terms (200 KB) is a tape of
+    /// 40,000 operations, evaluated to the exact sum; a 1000-term energy too; a message quotes
+    /// at most 2 × 40 characters of the energy.
+    #[test]
+    fn deep_and_long_energies_are_refused_or_evaluated_without_recursion() {
+        let p = BTreeMap::new();
+        for text in [
+            format!("{}I1{}", "(".repeat(100_000), ")".repeat(100_000)),
+            format!("{}I1", "-".repeat(100_000)),
+            format!("I1{}", "^2".repeat(100_000)),
+        ] {
+            let e = Expr::parse(&text, &["I1", "I2"], &p)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(&format!("deeper than {MAX_DEPTH}")),
+                "{}",
+                &e[..e.len().min(300)]
+            );
+            assert!(
+                e.len() < 400,
+                "the message echoes the energy: {} bytes",
+                e.len()
+            );
+        }
+        let n = 20_000;
+        let sum = vec!["I1"; n].join(" + ");
+        let e = Expr::parse(&sum, &["I1", "I2"], &p).unwrap();
+        assert_eq!(e.eval(&[1.5, 0.0]), 1.5 * n as f64);
+        // folded constants leave no dead operations on the tape
+        let e = Expr::parse("2 * 3 + I1 * (4 - 4)", &["I1", "I2"], &p).unwrap();
+        assert_eq!(e.nodes.len(), 5, "{:?}", e.nodes);
+        assert_eq!(e.eval(&[7.0, 0.0]), 6.0);
+        let too_long = vec!["I1"; MAX_NODES + 10].join(" + ");
+        let e = Expr::parse(&too_long, &["I1", "I2"], &p)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("more than 100000 operations") && e.len() < 400,
+            "{}",
+            &e[..e.len().min(300)]
+        );
     }
 }
