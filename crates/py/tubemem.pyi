@@ -162,8 +162,10 @@ def verify(
     update_gold: bool = False,
     python: Optional[Union[str, PathLike]] = None,
     python_ref: Optional[Union[str, PathLike]] = None,
+    epsilon: Optional[float] = None,
 ) -> dict[str, Any]:
-    """Verification suites (or the study of one case): results.json's content as a dict."""
+    """Verification suites (or the study of one case, with `epsilon` the accuracy asked for,
+    default 1e-3): results.json's content as a dict."""
 
 
 class Material:
@@ -196,7 +198,12 @@ def fit(
     uniaxial: Optional[TestData] = None,
     equibiaxial: Optional[TestData] = None,
     pure_shear: Optional[TestData] = None,
+    fix: Optional[Mapping[str, float]] = None,
+    bounds: Optional[Mapping[str, tuple[float, float]]] = None,
+    starts: int = 8,
 ) -> dict[str, Any]:
-    """Fit a law's parameters to test data (nominal stress against stretch; CSV paths, (N, 2)
-    arrays or (stretch, stress) pairs): material (the fitted Material), parameters (name,
-    value, std_error, determined), correlation, residual_std, warnings, …"""
+    """Fit a law's parameters to test data (nominal stress against stretch; CSV paths whose
+    headers name the stress unit, read in Pa, (N, 2) arrays or (stretch, stress) pairs):
+    material (the fitted Material), converged and stop_reason, parameters (name, value,
+    std_error — None where fixed or not determined —, determined, fixed, at_bound),
+    correlation, rank, residual_std, stress_unit, warnings, …"""

@@ -137,12 +137,19 @@ impl PyMaterial {
 
 /// One test's data: a path to a CSV file (stretch, nominal stress), or an (N, 2) array, or a
 /// (stretch, stress) pair of arrays.
-fn test_data(py: Python<'_>, mode: Mode, arg: &Bound<'_, PyAny>, what: &str) -> PyResult<TestData> {
+fn test_data(
+    py: Python<'_>,
+    mode: Mode,
+    arg: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<(TestData, bool)> {
     if let Ok(p) = arg.extract::<PathBuf>() {
         if arg.is_instance_of::<pyo3::types::PyString>() || p.is_file() {
-            return tubemem_app::fit::read_test(&p, mode).map_err(|e| {
-                PyValueError::new_err(format!("{what}: {}", tubemem_app::error_chain(&e)))
-            });
+            return tubemem_app::fit::read_test_file(&p, mode, None)
+                .map(|f| (f.data, f.unit.is_some()))
+                .map_err(|e| {
+                    PyValueError::new_err(format!("{what}: {}", tubemem_app::error_chain(&e)))
+                });
         }
     }
     let np = py.import("numpy")?;
@@ -162,11 +169,14 @@ fn test_data(py: Python<'_>, mode: Mode, arg: &Bound<'_, PyAny>, what: &str) -> 
         [2, _] => (arr.get_item(0)?.extract()?, arr.get_item(1)?.extract()?),
         _ => return Err(bad()),
     };
-    Ok(TestData {
-        mode,
-        stretch,
-        stress,
-    })
+    Ok((
+        TestData {
+            mode,
+            stretch,
+            stress,
+        },
+        false,
+    ))
 }
 
 /// Fit a law's parameters to test data: `law` a model name (starting values estimated from
@@ -178,7 +188,8 @@ fn test_data(py: Python<'_>, mode: Mode, arg: &Bound<'_, PyAny>, what: &str) -> 
 /// `stop_reason` says why), `parameters` (name, value, std_error — None where fixed or not
 /// determined —, determined, fixed, at_bound), `correlation`, `rank`, `residual_std`,
 /// `max_relative_residual`, `points`, `starts`, `starts_agreeing`, `termination`,
-/// `evaluations` and `warnings`.
+/// `evaluations`, `warnings` and `stress_unit` ("Pa" where the files' headers named a unit and
+/// the moduli are in Pa; None where the data's numbers were taken as they are).
 #[pyfunction]
 #[pyo3(signature = (law, uniaxial=None, equibiaxial=None, pure_shear=None, fix=None, bounds=None, starts=tubemem_material::fit::DEFAULT_STARTS))]
 #[allow(clippy::too_many_arguments)]
@@ -193,15 +204,36 @@ pub(crate) fn fit<'py>(
     starts: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let mut data = vec![];
+    let mut named = vec![];
     for (arg, mode, what) in [
         (uniaxial, Mode::Uniaxial, "uniaxial"),
         (equibiaxial, Mode::Equibiaxial, "equibiaxial"),
         (pure_shear, Mode::PureShear, "pure_shear"),
     ] {
         if let Some(a) = arg.filter(|a| !a.is_none()) {
-            data.push(test_data(py, mode, a, what)?);
+            let (d, unit) = test_data(py, mode, a, what)?;
+            data.push(d);
+            named.push((what, unit));
         }
     }
+    // one unit per fit: files whose headers name a unit are read in Pa; arrays and files that
+    // name none keep their numbers
+    if named.iter().any(|n| n.1) && !named.iter().all(|n| n.1) {
+        let list = |u: bool| {
+            named
+                .iter()
+                .filter(|n| n.1 == u)
+                .map(|n| n.0)
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Err(PyValueError::new_err(format!(
+            "fit: one unit per fit: {} name their stress unit (read in Pa) and {} do not; give all as files whose headers name it, or all as numbers in one unit",
+            list(true),
+            list(false)
+        )));
+    }
+    let in_pa = named.iter().all(|n| n.1);
     if data.is_empty() {
         return Err(PyValueError::new_err(
             "fit: give test data as uniaxial=, equibiaxial= and/or pure_shear=",
@@ -230,6 +262,7 @@ pub(crate) fn fit<'py>(
             }
         })?;
     let d = to_py(py, &result)?;
+    d.set_item("stress_unit", if in_pa { Some("Pa") } else { None })?;
     d.set_item(
         "material",
         Bound::new(py, PyMaterial::of(result.spec.clone())?)?,

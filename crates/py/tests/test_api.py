@@ -704,7 +704,7 @@ def test_material_objects_and_energies_written_as_text():
     assert np.allclose(gent.nominal_stress("uniaxial", l), want, rtol=1e-12)
     for kwargs, needle in [
         (dict(model="gent", shear_modulus=1.0), "jm"),
-        (dict(model="yeoh", c10=0.5, c20=-1.0), "c20"),
+        (dict(model="yeoh", c10=0.0, c20=0.1), "c10"),
         (dict(model="invariants", energy="(I1 - 3)/2 * jn", parameters={"jm": 1}, shear_modulus=1), "column 14: unknown name `jn`"),
         (dict(model="principal", energy="-(l^2 - 1)", shear_modulus=1), "not positive definite"),
         (dict(model="ogden", mu=[1.0, -1.0], alpha=[2.0, 2.0]), "mu[1]"),
@@ -712,6 +712,11 @@ def test_material_objects_and_energies_written_as_text():
         with pytest.raises(ValueError, match=None) as e:
             tubemem.Material(**kwargs)
         assert needle in str(e.value), (kwargs, str(e.value))
+    # a Yeoh law with a negative coefficient is a law, stable over a range (issue #60 item 5):
+    # a state beyond it is refused, naming the limit
+    narrow = tubemem.Material("yeoh", c10=0.5, c20=-1.0)
+    with pytest.raises(Exception, match="stable only for I1"):
+        tubemem.gps_inflate(3.0, material=narrow)
 
 
 def test_a_material_object_runs_in_a_case(tmp_path):
@@ -734,9 +739,14 @@ def test_fit_takes_files_or_arrays_and_says_what_the_data_do_not_determine():
     r = tubemem.fit("yeoh", uniaxial=ex / "yeoh_synthetic_uniaxial.csv",
                     equibiaxial=str(ex / "yeoh_synthetic_equibiaxial.csv"),
                     pure_shear=ex / "yeoh_synthetic_pure_shear.csv")
+    # the headers say MPa: the fit works in Pa
+    assert r["stress_unit"] == "Pa" and r["converged"], r["stop_reason"]
     for p in r["parameters"]:
-        assert abs(p["value"] - synthetic.YEOH[p["name"]]) <= 3 * p["std_error"], p
+        assert abs(p["value"] - 1e6 * synthetic.YEOH[p["name"]]) <= 3 * p["std_error"], p
     assert isinstance(r["material"], tubemem.Material)
+    with pytest.raises(ValueError, match="one unit per fit"):
+        tubemem.fit("yeoh", uniaxial=ex / "yeoh_synthetic_uniaxial.csv",
+                    equibiaxial=np.c_[[1.1, 1.2, 1.3], [0.01, 0.02, 0.03]])
     og = tubemem.Material("ogden", mu=[0.2, 0.002], alpha=[1.8, 5.0])
     l = np.linspace(1.05, 3.5, 20)
     r = tubemem.fit({"model": "ogden", "mu": [0.1, 0.01], "alpha": [2.0, 4.0]},
