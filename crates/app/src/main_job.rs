@@ -69,22 +69,32 @@ pub fn limits_text(l: &Limits) -> String {
     }
 }
 
-/// Run the main job into `out`; `observers` see the FE run (e.g. a progress display).
+/// Run the embedded case `text` into the main job's own folder `dir` (each run of the main job
+/// replaces the last), `observers` beside its writer.
+fn run_embedded(
+    text: &str,
+    dir: &Path,
+    label: &str,
+    observers: &mut [&mut dyn Observer],
+) -> Result<RunReport> {
+    let case = Case::parse(text)?;
+    let mut writer = RunWriter::create(dir, FolderMode::Overwrite, case.hash(), &[])?;
+    let mut all: Vec<&mut dyn Observer> = vec![&mut writer];
+    all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
+    run(&case, label, &mut all).into_result()
+}
+
+/// Run the main job into `out`; `observers` see the FE runs (e.g. a progress display).
 pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<MainJob> {
     let law = AnssariBenamBucchi::new(1.0, 30.0)?;
     let limits = paper_limits()?;
-    let case = Case::parse(DEFAULT_CASE)?;
     let run_dir = out.join("squeeze");
-    // the main job's own folder: each run of it replaces the last
-    let mut writer = RunWriter::create(&run_dir, FolderMode::Overwrite, case.hash(), &[])?;
-    let mut all: Vec<&mut dyn Observer> = vec![&mut writer];
-    all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
-    let report = run(
-        &case,
+    let report = run_embedded(
+        DEFAULT_CASE,
+        &run_dir,
         "embedded default: cases/squeeze_abb30_ls1.3_quad9.toml",
-        &mut all,
-    )
-    .into_result()?;
+        observers,
+    )?;
     let mut rows = vec![];
     for s in report.steps() {
         let (Some(c), Some(g)) = (&s.contact, &s.closed_form.gps_flattening) else {
@@ -110,17 +120,13 @@ pub fn run_main_job(out: &Path, observers: &mut [&mut dyn Observer]) -> Result<M
         });
     }
     // Fig. 7's FE points: the companion run from λs* = 6
-    let fig7 = Case::parse(FIG7_CASE)?;
     let fig7_dir = out.join("squeeze_ls6");
-    let mut writer = RunWriter::create(&fig7_dir, FolderMode::Overwrite, fig7.hash(), &[])?;
-    let mut all: Vec<&mut dyn Observer> = vec![&mut writer];
-    all.extend(observers.iter_mut().map(|o| &mut **o as &mut dyn Observer));
-    let fig7_report = run(
-        &fig7,
+    let fig7_report = run_embedded(
+        FIG7_CASE,
+        &fig7_dir,
         "embedded Fig. 7 companion: cases/squeeze_abb30_ls6.0_fig7.toml",
-        &mut all,
-    )
-    .into_result()?;
+        observers,
+    )?;
     // the FE points from the reports themselves, not read back from the files just written
     let overlays = [
         figures::Overlay::from_report(&report, "embedded default case", &run_dir),

@@ -56,6 +56,15 @@ impl Twin {
     }
 }
 
+/// The squeeze twins' numbers: L/R = 10, ϖ = 0.55, half-gap 1.05 R, penalty 2e4 μH/R².
+const SQUEEZE_TWIN: Twin = Twin {
+    l: 10.0,
+    p: 0.55,
+    gap: 1.05,
+    d: [0.0, 0.0],
+    k: 2e4,
+};
+
 /// Inflated by a pressure target, squeezed to a half-gap given as a length, with the
 /// penalty given as a stiffness: every converted key at once.
 const SQUEEZE: &str = r#"
@@ -280,17 +289,7 @@ fn same_json(a: &Value, b: &Value, path: &str, skip: &[&str]) {
 fn an_si_run_and_its_dimensionless_twin_give_the_same_results() {
     let d = tmp("units-run");
     let twins = [
-        (
-            "squeeze",
-            SQUEEZE,
-            Twin {
-                l: 10.0,
-                p: 0.55,
-                gap: 1.05,
-                d: [0.0, 0.0],
-                k: 2e4,
-            },
-        ),
+        ("squeeze", SQUEEZE, SQUEEZE_TWIN),
         (
             "confine",
             CONFINE,
@@ -353,13 +352,7 @@ fn an_si_run_and_its_dimensionless_twin_give_the_same_results() {
 #[test]
 fn an_si_study_and_its_dimensionless_twin_give_the_same_verdict() {
     let d = tmp("units-study");
-    let twin = Twin {
-        l: 10.0,
-        p: 0.55,
-        gap: 1.05,
-        d: [0.0, 0.0],
-        k: 2e4,
-    };
+    let twin = SQUEEZE_TWIN;
     let mut results = vec![];
     for si in [true, false] {
         let case = write(&d, &format!("tube_{si}.toml"), &twin.text(SQUEEZE, si));
@@ -500,13 +493,7 @@ fn si_figures_gps_and_atlas_agree_with_their_dimensionless_twins() {
 
     // figures over the twins' runs: the same FE points (the CSV is dimensionless), the SI
     // figure's axes in units
-    let twin = Twin {
-        l: 10.0,
-        p: 0.55,
-        gap: 1.05,
-        d: [0.0, 0.0],
-        k: 2e4,
-    };
+    let twin = SQUEEZE_TWIN;
     let mut points = vec![];
     for si in [true, false] {
         let case = write(&d, &format!("fig_{si}.toml"), &twin.text(SQUEEZE, si));
