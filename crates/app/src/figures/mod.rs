@@ -212,10 +212,27 @@ pub fn axes(fig: &Figure) -> ((f64, f64), (f64, f64)) {
             .chain(fig.markers.iter().flat_map(|m| m.points.iter()))
             .filter(|p| p.0.is_finite() && p.1.is_finite())
     };
-    (
-        range(all().map(|p| p.0), false),
-        range(all().map(|p| p.1), fig.y_from_zero),
-    )
+    let x = range(all().map(|p| p.0), false);
+    let mut y = range(all().map(|p| p.1), fig.y_from_zero);
+    // where every corner holds a marker (an atlas's grid spans the whole plot), room above the
+    // data for the legend: the y range grows by the legend's height, so the upper corners are
+    // free of markers and the legend hides none
+    let size = legend_size(fig);
+    let unit = |p: &(f64, f64)| ((p.0 - x.0) / (x.1 - x.0), (p.1 - y.0) / (y.1 - y.0));
+    let marks: Vec<(f64, f64)> = fig
+        .markers
+        .iter()
+        .flat_map(|m| m.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite())
+        .map(unit)
+        .collect();
+    let blocked = [(true, true), (false, true), (true, false), (false, false)]
+        .iter()
+        .all(|&(l, u)| marks.iter().any(|m| under_legend(m.0, m.1, l, u, size)));
+    if blocked && y.1 > y.0 {
+        y.1 = y.0 + (y.1 - y.0) / (1.0 - (size.1 + 0.02)).max(0.1);
+    }
+    (x, y)
 }
 
 /// What a figure shows, for tests of the plots: its points (curve and marker points), those not
@@ -326,4 +343,48 @@ pub(crate) fn legend_corner(fig: &Figure, x: (f64, f64), y: (f64, f64)) -> Serie
     .into_iter()
     .min_by_key(|(_, left, upper)| covered(*left, *upper))
     .map_or(SeriesLabelPosition::UpperLeft, |c| c.0)
+}
+
+#[cfg(test)]
+mod legend_tests {
+    use super::*;
+
+    /// Issue #60 item 9: an atlas map's grid fills the plot to its corners, so the legend hid
+    /// the grid point in whichever corner it took ((1.3, 0.8) on the CI atlas). The y range
+    /// now grows by the legend's height there, and no marker lies under it.
+    #[test]
+    fn a_legend_hides_no_marker_when_markers_fill_every_corner() {
+        let grid: Vec<(f64, f64)> = [1.2, 1.3]
+            .iter()
+            .flat_map(|&x| [0.8, 0.9, 1.0, 1.1].map(|y| (x, y)))
+            .collect();
+        let mut fig = Figure::new(
+            "minimum L/R",
+            "λs*",
+            "ρ",
+            vec![Series {
+                label: "L/R = 200".into(),
+                points: vec![(1.2, 0.93), (1.22, 1.1)],
+                color: series_color(0),
+                stroke: Stroke::Solid,
+                width: 2,
+            }],
+        );
+        // an atlas map's axes start at the grid's range, not at zero
+        fig.y_from_zero = false;
+        fig.markers = vec![Markers {
+            label: "grid point".into(),
+            points: grid,
+            color: plotters::style::RGBColor(0, 0, 0),
+            hollow: false,
+        }];
+        let a = audit(&fig);
+        assert_eq!((a.under_legend, a.outside), (0, 0), "{a:?}");
+        let (_, grown) = axes(&fig);
+        // a plot with a free corner keeps its range (the legend goes there)
+        fig.markers[0].points.retain(|p| *p != (1.3, 1.1));
+        let (_, kept) = axes(&fig);
+        assert!(grown.1 > kept.1, "{grown:?} against {kept:?}");
+        assert_eq!(audit(&fig).under_legend, 0);
+    }
 }
