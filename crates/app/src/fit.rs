@@ -214,12 +214,6 @@ pub fn read_test_file(
     })
 }
 
-/// Read a test's CSV file (see [`read_test_file`]), the stresses as the file gives them
-/// converted to Pa where its header names the unit.
-pub fn read_test(path: &Path, mode: Mode) -> Result<TestData, FitError> {
-    read_test_file(path, mode, None).map(|t| t.data)
-}
-
 /// The one stress unit of a fit's files: all name the same one (the data are then in Pa), or
 /// none does (the data's own numbers); a mix is refused.
 pub fn common_unit(files: &[(PathBuf, TestFile)]) -> Result<Option<StressUnit>, FitError> {

@@ -162,7 +162,7 @@ impl Default for FitOptions {
 
 /// The parameters in stress units, by their table name (`mu[1]` as `mu`): scaling all of them
 /// by s scales every nominal stress by s.
-const MODULI: [&str; 8] = [
+const MODULI: [&str; 7] = [
     "shear_modulus",
     "c10",
     "c20",
@@ -170,7 +170,6 @@ const MODULI: [&str; 8] = [
     "c2",
     "mu",
     "young_modulus",
-    "c1",
 ];
 
 /// Whether a fitted parameter (`mu[1]`, `c10`) is in stress units (the others are ratios).
