@@ -115,10 +115,11 @@ pub fn read_test_file(
     mode: Mode,
     unit: Option<StressUnit>,
 ) -> Result<TestFile, FitError> {
-    let text = std::fs::read_to_string(path).map_err(|source| FitError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = tubemem_mesh::io::read_text_limited(path, tubemem_mesh::io::MAX_TEXT_INPUT_BYTES)
+        .map_err(|source| FitError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
     let err = |line: usize, message: String| FitError::Data {
         path: path.to_path_buf(),
         line,
@@ -413,8 +414,30 @@ pub fn save_figure(
 /// moduli are in: Pa where the data named their unit (ready for `[units] system = "SI"`),
 /// else the data's own.
 pub fn material_table(spec: &MaterialSpec, unit: Option<StressUnit>) -> String {
-    let v = toml::Value::try_from(spec).ok();
-    let body = v.and_then(|v| toml::to_string(&v).ok()).unwrap_or_default();
+    // numbers in their shortest round-trip form (1e300, not 301 digits)
+    fn value(v: &toml::Value) -> String {
+        match v {
+            toml::Value::Float(f) => format!("{f:?}"),
+            toml::Value::Array(a) => {
+                format!("[{}]", a.iter().map(value).collect::<Vec<_>>().join(", "))
+            }
+            toml::Value::Table(t) => format!(
+                "{{ {} }}",
+                t.iter()
+                    .map(|(k, v)| format!("{k} = {}", value(v)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            other => other.to_string(),
+        }
+    }
+    let body: String = match toml::Value::try_from(spec) {
+        Ok(toml::Value::Table(t)) => t
+            .iter()
+            .map(|(k, v)| format!("{k} = {}\n", value(v)))
+            .collect(),
+        _ => String::new(),
+    };
     let note = match unit {
         Some(u) => format!(
             "# moduli in {} (SI): for a case with [units] system = \"SI\" (a dimensionless case takes them as they are: only their ratios matter)",

@@ -45,6 +45,19 @@ pub fn membrane_kernel<const N: usize, const D: usize>(
                 }
             }
         }
+        // a finite stress on a huge deformation can still overflow the forces
+        if !(energy.is_finite() && r.iter().all(|v| v.is_finite())) {
+            let c = cauchy_green(&f);
+            return Err((
+                g,
+                MaterialError::non_finite(
+                    law.name(),
+                    "energy or internal force",
+                    c[0] + c[1],
+                    c[0] * c[1] - c[2] * c[2],
+                ),
+            ));
+        }
         if let Some(k) = k.as_deref_mut() {
             let b: [Matrix3<f64>; N] = std::array::from_fn(|a| {
                 Matrix3::from_rows(&[
@@ -112,12 +125,23 @@ pub fn point_state_of(law: &dyn MembraneLaw, f: &[Vec3; 2]) -> Result<PointState
     }
     // Principal values of N in the tangent plane: N = (1/J) F S Fᵀ has the eigenvalues of
     // (1/J) S C (mixed form).
+    // scaled by its largest entry, so that squares of large resultants cannot overflow
     let sc = s * Matrix2::new(c[0], c[2], c[2], c[1]);
+    // (only where they are large: an ordinary state is computed as it always was)
+    let scale = if sc.amax() > 1e150 { sc.amax() } else { 1.0 };
+    let sc = sc / scale;
     let (t2, d2) = (sc.trace(), sc.determinant());
     let disc2 = (0.25 * t2 * t2 - d2).max(0.0).sqrt();
+    let principal = [
+        (0.5 * t2 + disc2) * scale / j,
+        (0.5 * t2 - disc2) * scale / j,
+    ];
+    if !(n.iter().all(|v| v.is_finite()) && principal.iter().all(|v| v.is_finite())) {
+        return Err(MaterialError::non_finite(law.name(), "resultant", tr, det));
+    }
     Ok(PointState {
         stretches: [l1, l2],
         cauchy: n,
-        principal: [(0.5 * t2 + disc2) / j, (0.5 * t2 - disc2) / j],
+        principal,
     })
 }

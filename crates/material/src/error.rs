@@ -64,7 +64,41 @@ pub fn tidy_numbers(message: &str) -> String {
         out.push(c);
         i += c.len_utf8();
     }
-    out
+    shorten_lines(&out)
+}
+
+/// The longest line of a message a user reads, in characters: a parser that quotes the input
+/// line (TOML's reader, serde's) would otherwise echo a 945 KB energy or a 10 MB CSV line.
+pub const MAX_MESSAGE_LINE: usize = 1200;
+
+/// Every line of `message` longer than [`MAX_MESSAGE_LINE`] characters cut to its first 800
+/// and last 200, with the count of those left out between them. tubemem's own longest
+/// messages (a limit point with its advice and residual history) are about 500 characters, so
+/// only an echoed input is ever cut.
+pub fn shorten_lines(message: &str) -> String {
+    const HEAD: usize = 800;
+    const TAIL: usize = 200;
+    if message
+        .lines()
+        .all(|l| l.chars().count() <= MAX_MESSAGE_LINE)
+    {
+        return message.to_string();
+    }
+    let mut out: Vec<String> = vec![];
+    for line in message.split('\n') {
+        let n = line.chars().count();
+        if n <= MAX_MESSAGE_LINE {
+            out.push(line.to_string());
+        } else {
+            let head: String = line.chars().take(HEAD).collect();
+            let tail: String = line.chars().skip(n - TAIL).collect();
+            out.push(format!(
+                "{head} … ({} characters left out) … {tail}",
+                n - HEAD - TAIL
+            ));
+        }
+    }
+    out.join("\n")
 }
 
 /// Why a material law or a stretch state was rejected.
@@ -121,6 +155,48 @@ pub enum MaterialError {
     #[error("the {law} law is not admissible: {reason}")]
     Inadmissible { law: Box<str>, reason: Box<str> },
     /// The energy or one of its derivatives is not finite at this state.
-    #[error("the {law} energy is not finite at I1 = {i1}, I2 = {i2}")]
-    NonFinite { law: String, i1: f64, i2: f64 },
+    #[error(
+        "the {law} law's {what} is not finite at the stretches λ1 = {}, λ2 = {} (I1 = {}, I2 = {})",
+        Num(stretches[0]), Num(stretches[1]), Num(*i1), Num(*i2)
+    )]
+    NonFinite {
+        law: String,
+        /// what overflowed: the energy or its derivatives, the stress, the tangent
+        what: &'static str,
+        stretches: [f64; 2],
+        i1: f64,
+        i2: f64,
+    },
+}
+
+impl MaterialError {
+    /// [`MaterialError::NonFinite`]: `what` of `law` overflowed at the state of invariants
+    /// `a` = tr C, `b` = det C (its stretches and I1, I2 are named).
+    pub fn non_finite(law: String, what: &'static str, a: f64, b: f64) -> Self {
+        let disc = (0.25 * a * a - b).max(0.0).sqrt();
+        MaterialError::NonFinite {
+            law,
+            what,
+            stretches: [(0.5 * a + disc).sqrt(), (0.5 * a - disc).max(0.0).sqrt()],
+            i1: a + 1.0 / b,
+            i2: a / b + b,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_lines_of_a_message_are_cut_to_an_excerpt() {
+        let line = format!("energy = \"{}\"", "I1 + ".repeat(200_000));
+        let msg = format!("TOML parse error at line 1, column 5\n{line}\n   ^\nexpected a value");
+        let s = tidy_numbers(&msg);
+        assert!(s.len() < 1200, "{}", s.len());
+        assert!(s.contains("characters left out") && s.ends_with("expected a value"));
+        assert_eq!(tidy_numbers("short\nlines"), "short\nlines");
+        let ours = "no equilibrium beyond the limit point; use volume control ".repeat(10);
+        assert_eq!(shorten_lines(&ours), ours);
+    }
 }

@@ -319,6 +319,9 @@ impl Parser<'_> {
     }
     fn pow(&mut self, base: usize, e: usize) -> usize {
         match self.nodes[e] {
+            // x^0 = 1 everywhere, with zero derivatives (through powi its derivative would be
+            // 0 · x⁻¹, NaN at x = 0)
+            Node::Const(p) if p == 0.0 => self.push(Node::Const(1.0)),
             Node::Const(p) if p == p.trunc() && p.abs() <= 64.0 => {
                 self.push(Node::PowI(base, p as i32))
             }
@@ -428,6 +431,11 @@ impl Func {
             Func::Sqrt => x.sqrt(),
             Func::Sinh => (x.exp() - (-x).exp()) * 0.5,
             Func::Cosh => (x.exp() + (-x).exp()) * 0.5,
+            // through exp(−2|x|) ≤ 1, which cannot overflow (exp(2x) is inf above x ≈ 355)
+            Func::Tanh if x.value() >= 0.0 => {
+                let e = (x * -2.0).exp();
+                (e * -1.0 + 1.0) / (e + 1.0)
+            }
             Func::Tanh => {
                 let e = (x * 2.0).exp();
                 (e - 1.0) / (e + 1.0)
@@ -608,6 +616,10 @@ mod tests {
             ("pow(I1, c) + sqrt(4) + exp(0) + log(1)", 2.25 + 3.0),
             ("cosh(0.3)^2 - sinh(0.3)^2", 1.0),
             ("tanh(0.2)", 0.2f64.tanh()),
+            ("tanh(400)", 1.0),
+            ("tanh(-400)", -1.0),
+            ("tanh(-0.2)", -(0.2f64.tanh())),
+            ("(I1 - 1.5)^0 + I2^0", 2.0),
             ("1.5e1 + .5", 15.5),
             ("I1^0.5", 1.5f64.sqrt()),
         ];

@@ -342,6 +342,45 @@ impl Problem<'_> {
         }
         Some(r)
     }
+    /// Why [`Self::residuals_at`] has no value at `x`: the parameters, and the first data
+    /// point the law cannot take, with the law's own reason.
+    fn evaluation_failure(&self, x: &[f64], names: &[&str]) -> String {
+        let params: Vec<String> = names
+            .iter()
+            .zip(x)
+            .map(|(n, v)| format!("{n} = {}", crate::Num(*v)))
+            .collect();
+        let at = params.join(", ");
+        let Some(spec) = self.spec_at(x) else {
+            return format!("the parameters ({at}) are not numbers a law takes");
+        };
+        let law = match spec.build() {
+            Ok(l) => l,
+            Err(e) => return format!("the parameters ({at}) make no law: {e}"),
+        };
+        for t in self.data {
+            for &l in &t.stretch {
+                match nominal_stress(law.as_ref(), t.mode, l) {
+                    Err(e) => {
+                        return format!(
+                            "with {at}, the {} point at stretch {}: {e}",
+                            t.mode.label(),
+                            crate::Num(l)
+                        )
+                    }
+                    Ok(m) if !m.is_finite() => {
+                        return format!(
+                            "with {at}, the {} point at stretch {}: the law's stress is {m}",
+                            t.mode.label(),
+                            crate::Num(l)
+                        )
+                    }
+                    Ok(_) => {}
+                }
+            }
+        }
+        format!("with {at}: no point fails (please report this input)")
+    }
     fn count(&self) -> usize {
         self.data.iter().map(|t| t.stretch.len()).sum()
     }
@@ -613,8 +652,10 @@ pub fn fit_with(
         .min_by(|a, b| a.ssr.total_cmp(&b.ssr))
         .ok_or_else(|| {
             FitError::Data(format!(
-                "no start reached a law that can be evaluated at every data point ({} starts tried)",
-                runs.len()
+                "no start reached a law that can be evaluated at every data point ({} starts tried); where the first ended, {}",
+                runs.len(),
+                runs.first()
+                    .map_or_else(|| "no start".to_string(), |r| problem.evaluation_failure(&r.x, &free_names))
             ))
         })?;
     let agreeing = runs
@@ -626,7 +667,10 @@ pub fn fit_with(
         .spec_at(&x)
         .ok_or_else(|| FitError::Data("the fitted parameters do not make a law".into()))?;
     let r = problem.residuals_at(&x).ok_or_else(|| {
-        FitError::Data("the fitted law cannot be evaluated at every data point".into())
+        FitError::Data(format!(
+            "the fitted law cannot be evaluated at every data point: {}",
+            problem.evaluation_failure(&x, &free_names)
+        ))
     })?;
     let m = r.len();
     let ssr: f64 = r.iter().map(|v| v * v).sum();

@@ -48,7 +48,7 @@ pub mod separable;
 mod spec;
 pub mod taylor;
 
-pub use error::{tidy_numbers, MaterialError, Num};
+pub use error::{shorten_lines, tidy_numbers, MaterialError, Num};
 pub use spec::{MaterialSpec, Wrinkling};
 
 /// W(a, b) and its partial derivatives, a = tr C, b = det C (dimensionless, per μ).
@@ -209,9 +209,16 @@ pub trait MembraneLaw: Send + Sync + std::fmt::Debug {
                 tangent[p][q] = cc(i, j, k, l);
             }
         }
+        let stress = [s(0, 0), s(1, 1), s(0, 1)];
+        if !stress.iter().all(|v| v.is_finite()) {
+            return Err(non_finite(self.name(), "stress", a, b));
+        }
+        if !tangent.iter().flatten().all(|v| v.is_finite()) {
+            return Err(non_finite(self.name(), "tangent", a, b));
+        }
         Ok(StressTangent {
             w: d.w,
-            s: [s(0, 0), s(1, 1), s(0, 1)],
+            s: stress,
             tangent,
         })
     }
@@ -244,12 +251,12 @@ fn derivatives_checked<L: MembraneLaw + ?Sized>(
     {
         Ok(d)
     } else {
-        Err(MaterialError::NonFinite {
-            law: law.name(),
-            i1: a + 1.0 / b,
-            i2: a / b + b,
-        })
+        Err(non_finite(law.name(), "energy or its derivatives", a, b))
     }
+}
+
+fn non_finite(law: String, what: &'static str, a: f64, b: f64) -> MaterialError {
+    MaterialError::non_finite(law, what, a, b)
 }
 
 /// A law given only by its energy W̄(I1, I2), written once for any [`dual::Real`] scalar.
