@@ -484,6 +484,14 @@ fn solve_at(
         source,
     })?;
     let w = res.ns / sec.r;
+    if res.ns < 0.0 {
+        return Err(GpsError::Compressive {
+            stage: "confinement",
+            at,
+            n_s: res.ns,
+            w,
+        });
+    }
     Ok(ConfineState {
         w,
         lambda_s: ls,

@@ -23,6 +23,19 @@ pub enum GpsError {
     /// A set of walls that cannot hold the section (open, empty, too short a perimeter).
     #[error("{message}")]
     Walls { message: String },
+    /// The equations' solution is a compressed membrane (N_s < 0, so ϖ < 0 and a negative
+    /// plate force): a branch a softening energy or one with a pole allows, which a membrane
+    /// cannot carry. Reported, never returned as an answer.
+    #[error(
+        "{stage} at {at}: the solution found is a compressed membrane (N_s = {} μH < 0, ϖ = {}), which a membrane cannot carry; the law's energy softens or has a pole on this path, so no tensile state continues it",
+        tubemem_material::Num(*n_s), tubemem_material::Num(*w)
+    )]
+    Compressive {
+        stage: &'static str,
+        at: String,
+        n_s: f64,
+        w: f64,
+    },
     /// Newton did not converge, even after step cut-back.
     #[error(
         "{stage} did not converge at {at}: residual {residual:.3e} after {iterations} iterations"

@@ -153,6 +153,14 @@ fn inflation_solve(
         }
     };
     let r = resultants::resultants(law, ls, lz).map_err(material)?;
+    if r.ns < 0.0 {
+        return Err(GpsError::Compressive {
+            stage: "free inflation",
+            at: at_ls(ls),
+            n_s: r.ns,
+            w: r.ns / ls,
+        });
+    }
     Ok(InflationState {
         w: r.ns / ls,
         lambda_s: ls,
@@ -346,6 +354,14 @@ impl<'a> Flattening<'a> {
         })?;
         let chi = contact_length(ls, rho, "flattening (negative contact length)", &at)?;
         let w = r.ns / rho;
+        if r.ns < 0.0 {
+            return Err(GpsError::Compressive {
+                stage: "flattening",
+                at,
+                n_s: r.ns,
+                w,
+            });
+        }
         Ok(FlatteningState {
             w,
             lambda_s: ls,

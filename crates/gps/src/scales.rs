@@ -2,6 +2,9 @@
 use crate::error::{invalid, GpsError};
 use serde::{Deserialize, Serialize};
 
+/// The range each SI scale and product of scales must lie in ([`Scales::new`]).
+pub const SCALE_RANGE: (f64, f64) = (1e-100, 1e100);
+
 /// Reference radius R, undeformed thickness H and shear modulus μ, in any consistent units
 /// (e.g. m, m, Pa → pressures in Pa and forces per length in N/m).
 #[derive(schemars::JsonSchema, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -20,6 +23,27 @@ impl Scales {
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid(name, v, "must be finite and > 0"));
+            }
+        }
+        // Every dimensional output is a reduced value times one of these products; the reduced
+        // values span many decades (a force of 1e-12 μHR at first contact, pressures of 1e3 ϖ
+        // near a limit), so each product must leave that room inside f64's ±1e308: a scale
+        // within 1e±100 does, for any physical tube (nm to km, mPa to TPa).
+        let (r, h, mu) = (radius, thickness, shear_modulus);
+        for (name, v) in [
+            ("pressure scale mu*thickness/radius", mu * h / r),
+            ("resultant scale mu*thickness", mu * h),
+            ("force scale mu*thickness*radius", mu * h * r),
+            ("stiffness scale mu*thickness/radius^2", mu * h / (r * r)),
+            ("radius", r),
+            ("shear_modulus", mu),
+        ] {
+            if !(SCALE_RANGE.0..=SCALE_RANGE.1).contains(&v) {
+                return Err(invalid(
+                    name,
+                    v,
+                    "must be within 1e-100 and 1e100 (SI units: every output is a reduced value times this scale, and must stay finite)",
+                ));
             }
         }
         Ok(Self {

@@ -66,6 +66,33 @@ impl StageKind for Confine {
                 ));
             }
         }
+        // the planes must press the tube: some plane moves in, and ends inside the tube's
+        // present reach along its normal (walls that never touch it would leave a stage with
+        // no contact, compared with a confinement the FE never had)
+        if !input.continues_confine && !planes.iter().any(|p| p.target < p.offset) {
+            return Err(
+                "no plane moves in (every `target` ≥ its `offset`): a confine stage presses the tube; a plane moving out releases it, which a later stage after a confine stage may do"
+                    .to_string(),
+            );
+        }
+        let reaches: Vec<f64> = planes
+            .iter()
+            .map(|p| {
+                let len = p.normal[0].hypot(p.normal[1]);
+                let reach = state
+                    .x
+                    .iter()
+                    .map(|x| (p.normal[0] * x[0] + p.normal[1] * x[1]) / len)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                reach - p.target / len
+            })
+            .collect();
+        if !input.continues_confine && reaches.iter().all(|&d| d <= 0.0) {
+            return Err(format!(
+                "no plane's `target` reaches the tube: the nearest stays {:.6} R outside it along its normal, so the planes would never touch it; move a target inside the tube's present surface",
+                -reaches.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            ));
+        }
         // the planes must have the model's symmetry
         let sym = model.mesh().symmetry.planes();
         for (axis, name) in [(0usize, "x = 0"), (1usize, "y = 0")] {
