@@ -549,7 +549,7 @@ pub struct PlaneSpec {
 }
 
 /// A plane's `normal`: exactly two numbers.
-fn two_components<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+pub(crate) fn two_components<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
     let v: Vec<f64> = Deserialize::deserialize(d)?;
     match v.as_slice() {
         [a, b] => Ok([*a, *b]),
@@ -1337,6 +1337,12 @@ impl Case {
                 );
             }
         }
+        if let (Some(_), Some(h)) = (self.units, g.thickness) {
+            let mu = self.material.shear_modulus();
+            if let Err(e) = tubemem_gps::Scales::new(g.radius, h, mu) {
+                invalid!("[units] `system` = \"SI\" with [geometry] `radius`, `thickness` and [material] `shear_modulus`: {e}");
+            }
+        }
         let ratio = g.length / g.radius;
         if !(ratio.is_finite() && (MIN_LENGTH_RATIO..=MAX_LENGTH_RATIO).contains(&ratio)) {
             invalid!(
@@ -1364,6 +1370,11 @@ impl Case {
             (None, Some(around), Some(along)) => {
                 // the generator's own admissibility, before anything runs or is written
                 let cap_rows = m.cap_rows.unwrap_or(around / 8);
+                if m.cap_rows.is_none() && cap_rows == 0 {
+                    invalid!(
+                        "[mesh] `around` = {around}: the caps take `cap_rows` = around/8 rows by default, 0 here; give `around` ≥ 8 or `cap_rows` ≥ 1"
+                    );
+                }
                 if let Err(tubemem_mesh::MeshError::InvalidParameter {
                     name,
                     value,

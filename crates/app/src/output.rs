@@ -26,8 +26,6 @@ pub use crate::columns::{
 use crate::observer::{BoxError, Observer, StepView};
 use crate::report::{RunReport, StepRecord};
 use crate::{AppError, Result};
-use std::fs::File;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::post::{cell_contact_pressure, cell_values, regime_code, RingValues};
@@ -427,7 +425,7 @@ pub struct RunWriter {
     frames: usize,
     rows: usize,
     /// held for the writer's life: the folder's exclusive lock
-    _lock: File,
+    _lock: crate::output_file::FolderLock,
     case_hash: String,
     started: f64,
     /// continuing a run: the files are there already
@@ -515,12 +513,43 @@ impl RunWriter {
             .filter_map(|k| read_checkpoint(&dir.join("checkpoints").join(format!("ckpt-{k}.bin"))))
             .max_by_key(|c| c.rows)
             .ok_or_else(|| {
-                // killed while its first checkpoint was being written: checkpoints/ exists,
-                // but holds no whole checkpoint
-                folder("it holds no whole checkpoint to resume from (the run was killed before its first checkpoint was complete): start it afresh with --overwrite".into())
+                // checkpoints/ exists but holds no readable checkpoint: killed while the first
+                // was being written, or the files were cut or changed since
+                let present: Vec<String> = ["a", "b"]
+                    .iter()
+                    .map(|k| dir.join("checkpoints").join(format!("ckpt-{k}.bin")))
+                    .filter_map(|p| {
+                        let len = std::fs::metadata(&p).ok()?.len();
+                        Some(format!("{} ({len} bytes)", p.display()))
+                    })
+                    .collect();
+                folder(if present.is_empty() {
+                    "it holds no whole checkpoint to resume from (the run was killed before its first checkpoint was complete): start it afresh with --overwrite".into()
+                } else {
+                    format!(
+                        "its checkpoint files cannot be read (truncated or changed after the run: {}): start it afresh with --overwrite",
+                        present.join(", ")
+                    )
+                })
             })?;
         if let Some(message) = ck.mismatch(case_hash, None) {
             return Err(folder(message));
+        }
+        // every frame the checkpoint lists must still be there (checked before anything is
+        // cut back, so a refused resume leaves the folder as it was)
+        let missing: Vec<&str> = ck
+            .pvd
+            .iter()
+            .map(|(_, f)| f.as_str())
+            .filter(|f| !dir.join(f).is_file())
+            .collect();
+        if !missing.is_empty() {
+            return Err(folder(format!(
+                "{} of the {} VTU frames its checkpoint lists are missing (first: {}): the folder was changed after the run, so its series cannot be continued; start it afresh with --overwrite",
+                missing.len(),
+                ck.pvd.len(),
+                missing[0]
+            )));
         }
         // steps.csv: the header and the checkpoint's rows
         let path = dir.join("steps.csv");
@@ -573,35 +602,7 @@ impl RunWriter {
     }
 
     fn create_locked(dir: &Path, case_hash: &str) -> Result<Self> {
-        let lock_path = dir.join(LOCK);
-        let mut lock = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&lock_path)
-            .map_err(|e| AppError::io(&lock_path, e))?;
-        match lock.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                let holder = std::fs::read_to_string(&lock_path).unwrap_or_default();
-                return Err(AppError::Folder {
-                    path: dir.to_path_buf(),
-                    message: format!(
-                        "another tubemem run is writing into it ({}); wait for it or choose another --out",
-                        if holder.trim().is_empty() { "process unknown" } else { holder.trim() }
-                    ),
-                });
-            }
-            Err(std::fs::TryLockError::Error(e)) => return Err(AppError::io(&lock_path, e)),
-        }
-        {
-            use std::io::Seek;
-            lock.set_len(0).map_err(|e| AppError::io(&lock_path, e))?;
-            lock.seek(std::io::SeekFrom::Start(0))
-                .map_err(|e| AppError::io(&lock_path, e))?;
-            write!(lock, "pid {}", std::process::id()).map_err(|e| AppError::io(&lock_path, e))?;
-        }
+        let lock = crate::output_file::lock_folder(dir, LOCK)?;
         Ok(Self {
             dir: dir.to_path_buf(),
             journal: crate::journal::Journal::default(),

@@ -51,6 +51,12 @@ pub fn check(
             input.display()
         ));
     }
+    if path.exists() && !path.is_file() {
+        // a FIFO would block the write until a reader comes, a device would take the bytes
+        return refuse(
+            "is not a regular file (a FIFO, a device or a socket): give a file path".into(),
+        );
+    }
     if path.exists() {
         let text = head(path).map_err(|source| AppError::io(path, source))?;
         if !ours(&text) {
@@ -104,6 +110,19 @@ pub fn write_whole(path: &Path, bytes: &[u8]) -> Result<()> {
 pub(crate) fn create_folder(dir: &Path) -> Result<()> {
     let mut p = Some(dir);
     while let Some(q) = p.filter(|q| !q.as_os_str().is_empty()) {
+        let link = q
+            .symlink_metadata()
+            .is_ok_and(|m| m.file_type().is_symlink());
+        if link && !q.exists() {
+            return Err(AppError::Folder {
+                path: dir.to_path_buf(),
+                message: format!(
+                    "{} is a symbolic link to {}, which does not exist: create its target or give another path",
+                    q.display(),
+                    std::fs::read_link(q).map_or_else(|_| "?".into(), |t| t.display().to_string())
+                ),
+            });
+        }
         if q.exists() {
             if !q.is_dir() {
                 return Err(AppError::Folder {
@@ -178,4 +197,48 @@ pub(crate) fn write_owned(
         written.push(path.clone());
     }
     Ok(written)
+}
+
+/// An exclusive lock on a folder a command writes into, held while this value lives (the
+/// operating system releases it when the process ends, however it ends).
+#[derive(Debug)]
+pub struct FolderLock {
+    _file: std::fs::File,
+}
+
+/// Take the exclusive lock `name` in `dir` (a file holding the holder's pid): a second
+/// command writing into the same folder is refused with the holder named.
+pub fn lock_folder(dir: &Path, name: &str) -> Result<FolderLock> {
+    use std::io::{Seek, Write};
+    let lock_path = dir.join(name);
+    let mut lock = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&lock_path)
+        .map_err(|e| AppError::io(&lock_path, e))?;
+    match lock.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            let holder = std::fs::read_to_string(&lock_path).unwrap_or_default();
+            return Err(AppError::Folder {
+                path: dir.to_path_buf(),
+                message: format!(
+                    "another tubemem command is writing into it ({}); wait for it or choose another --out",
+                    if holder.trim().is_empty() {
+                        "process unknown"
+                    } else {
+                        holder.trim()
+                    }
+                ),
+            });
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(AppError::io(&lock_path, e)),
+    }
+    lock.set_len(0).map_err(|e| AppError::io(&lock_path, e))?;
+    lock.seek(std::io::SeekFrom::Start(0))
+        .map_err(|e| AppError::io(&lock_path, e))?;
+    write!(lock, "pid {}", std::process::id()).map_err(|e| AppError::io(&lock_path, e))?;
+    Ok(FolderLock { _file: lock })
 }

@@ -237,8 +237,9 @@ fn run_confine(a: ConfineArgs) -> Result<()> {
         let ring = match &a.ring {
             None => vec![],
             Some(p) => {
-                let text = std::fs::read_to_string(p)
-                    .map_err(|e| anyhow::anyhow!("--ring {}: {e}", p.display()))?;
+                let text =
+                    tubemem_mesh::io::read_text_limited(p, tubemem_mesh::io::MAX_TEXT_INPUT_BYTES)
+                        .map_err(|e| anyhow::anyhow!("--ring {}: {e}", p.display()))?;
                 text.lines()
                     .skip(1)
                     .enumerate()

@@ -131,8 +131,9 @@ pub fn spec_of(
 pub fn law_of(text: &str) -> Result<MaterialSpec> {
     let path = std::path::Path::new(text);
     let table: toml::Table = if !text.contains('=') && path.is_file() {
-        let file = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("--law {}: {e}", path.display()))?;
+        let file =
+            tubemem_mesh::io::read_text_limited(path, tubemem_app::case::MAX_CASE_FILE_BYTES)
+                .map_err(|e| anyhow::anyhow!("--law {}: {e}", path.display()))?;
         let mut t: toml::Table =
             toml::from_str(&file).map_err(|e| anyhow::anyhow!("--law {}: {e}", path.display()))?;
         match t.remove("material") {

@@ -35,10 +35,23 @@ pub struct MeshFile {
 /// form (some 80 bytes a node): already beyond what the memory guard admits for a full model.
 pub const MAX_MESH_FILE_BYTES: u64 = 256 << 20;
 
-/// Read at most `limit` bytes of a text file; a longer file (or a device such as /dev/zero)
-/// is refused with its limit named.
+/// The largest text input other than a case or a mesh (test data, rings, atlas and suite
+/// files): 64 MiB.
+pub const MAX_TEXT_INPUT_BYTES: u64 = 64 << 20;
+
+/// Read at most `limit` bytes of a regular text file; a longer file is refused with its limit
+/// named, and anything but a regular file (a FIFO, /dev/zero) before it is opened.
 pub fn read_text_limited(path: &Path, limit: u64) -> std::io::Result<String> {
     use std::io::Read;
+    // a FIFO would block the open until a writer comes (forever, if none does); a device or
+    // socket is not a file to read
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a folder, a FIFO, a device or a socket): give a file",
+        ));
+    }
     let f = std::fs::File::open(path)?;
     let mut buf = Vec::new();
     f.take(limit + 1).read_to_end(&mut buf)?;
