@@ -43,6 +43,7 @@ pub enum AtlasCommand {
 }
 
 fn setup(message: impl std::fmt::Display) -> u8 {
+    let message = tubemem_material::tidy_numbers(&message.to_string());
     let _ = writeln!(std::io::stderr(), "error: {message}");
     2
 }
@@ -61,10 +62,11 @@ pub fn run(a: AtlasArgs) -> u8 {
     let (Some(file), Some(out)) = (a.file, a.out) else {
         return setup("usage: tubemem atlas ATLAS.toml --out DIR (or tubemem atlas predict DIR …)");
     };
-    let text = match std::fs::read_to_string(&file) {
-        Ok(t) => t,
-        Err(e) => return setup(format!("cannot read {}: {e}", file.display())),
-    };
+    let text =
+        match tubemem_mesh::io::read_text_limited(&file, tubemem_app::case::MAX_CASE_FILE_BYTES) {
+            Ok(t) => t,
+            Err(e) => return setup(format!("cannot read {}: {e}", file.display())),
+        };
     let base = file.parent().map(PathBuf::from).unwrap_or_default();
     let atlas = match Atlas::parse(&text, &base) {
         Ok(a) => a,
@@ -108,8 +110,30 @@ pub fn run(a: AtlasArgs) -> u8 {
         );
         b
     });
+    // the estimate, from the first run this process finishes (the longest tubes run first,
+    // so it is an upper bound per run)
+    let estimated = std::sync::atomic::AtomicBool::new(false);
     let progress = |p: Progress| {
         let r = p.result;
+        if !p.resumed
+            && r.error.is_none()
+            && !estimated.swap(true, std::sync::atomic::Ordering::SeqCst)
+        {
+            let left = p.total - p.done;
+            let secs = r.seconds * left as f64 / workers.min(left.max(1)) as f64;
+            let line = format!(
+                "estimate: the first run took {:.1} s; the {left} left on {workers} worker{} take at most about {}",
+                r.seconds,
+                if workers == 1 { "" } else { "s" },
+                tubemem_app::atlas::duration_words(secs)
+            );
+            match &bar {
+                Some(b) => b.println(line),
+                None => {
+                    let _ = writeln!(std::io::stderr(), "{line}");
+                }
+            }
+        }
         let what = match (&r.error, p.resumed) {
             (_, true) => "kept from the earlier run".to_string(),
             (Some(e), _) => format!("FAILED: {e}"),
@@ -144,7 +168,7 @@ pub fn run(a: AtlasArgs) -> u8 {
             "interrupted: {} of {n} runs are done and kept; run the same command again to do the {} missing ({})",
             n - outcome.missing.len(),
             outcome.missing.len(),
-            outcome.missing.join(", ")
+            atlas::missing_summary(&outcome.missing)
         );
         return 130;
     }
@@ -180,8 +204,9 @@ pub fn run(a: AtlasArgs) -> u8 {
 }
 
 fn predict(dir: &std::path::Path, s: f64, rho: f64, l: f64, json: bool) -> u8 {
-    let result = atlas::predict::read(dir).and_then(|a| atlas::predict::predict(&a, s, rho, l));
-    let preds = match result {
+    let result = atlas::predict::read(dir)
+        .and_then(|a| Ok((atlas::predict::predict(&a, s, rho, l)?, a.spec.lengths)));
+    let (preds, lengths) = match result {
         Ok(p) => p,
         Err(e) => return setup(tubemem_app::error_chain(&e)),
     };
@@ -201,6 +226,14 @@ fn predict(dir: &std::path::Path, s: f64, rho: f64, l: f64, json: bool) -> u8 {
         o,
         "λs* = {s}, ρ = {rho}, L/R = {l}: FE/GPS − 1 = c + end effect"
     );
+    let longest = lengths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let shortest = lengths.iter().copied().fold(f64::INFINITY, f64::min);
+    if l > longest {
+        let _ = writeln!(
+            o,
+            "note: L/R = {l} is beyond the longest run (L/R = {longest}): the end effect is the fitted law's extrapolation"
+        );
+    }
     let _ = writeln!(
         o,
         "{:<10} {:>12} {:>12} {:>12}  minimum L/R per ε",
@@ -210,7 +243,11 @@ fn predict(dir: &std::path::Path, s: f64, rho: f64, l: f64, json: bool) -> u8 {
         let mins: Vec<String> = p
             .min_length_ratio
             .iter()
-            .map(|(e, m)| format!("{e:e}: {m:.1}"))
+            .map(|(e, m)| match atlas::fit::extent(*m, &lengths) {
+                atlas::fit::Extent::BelowRuns => format!("{e:e}: ≤ {shortest} (below the runs)"),
+                atlas::fit::Extent::BeyondRuns => format!("{e:e}: {m:.1} (extrapolated)"),
+                atlas::fit::Extent::Within => format!("{e:e}: {m:.1}"),
+            })
             .collect();
         let _ = writeln!(
             o,

@@ -188,3 +188,41 @@ pub fn law_name(law: stats::EndLaw) -> &'static str {
         stats::EndLaw::Exponential => "c + A exp(−k L/R)",
     }
 }
+
+/// Where a length lies against the lengths an atlas ran: a minimum L/R or a prediction's
+/// length outside them is the law's extrapolation, and says so.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Extent {
+    /// within the shortest and the longest run
+    Within,
+    /// shorter than every run: the end effect was already below ε at every length run, so
+    /// the minimum is at most the shortest run's length, not the law's value
+    BelowRuns,
+    /// longer than every run: the law's extrapolation
+    BeyondRuns,
+}
+
+impl Extent {
+    /// atlas.csv's `min_length_extent` value ("" within the runs).
+    pub fn name(self) -> &'static str {
+        match self {
+            Extent::Within => "",
+            Extent::BelowRuns => "below-runs",
+            Extent::BeyondRuns => "beyond-runs",
+        }
+    }
+}
+
+/// Where `length` lies against `lengths` (the atlas's runs).
+pub fn extent(length: f64, lengths: &[f64]) -> Extent {
+    let lo = lengths.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = lengths.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if length < lo {
+        Extent::BelowRuns
+    } else if length > hi {
+        Extent::BeyondRuns
+    } else {
+        Extent::Within
+    }
+}

@@ -115,7 +115,9 @@ pub fn earlier_result(out: &Path, member: &Member) -> Option<MemberResult> {
 
 /// Claim `out` for this atlas: a new folder, or one holding the same atlas (resumed: its
 /// finished members are kept). A folder holding anything else is refused, untouched.
-pub fn prepare(atlas_text: &str, out: &Path) -> Result<(), AtlasError> {
+/// The lock is held while the returned value lives: a second atlas (or a run) into the same
+/// folder is refused, not let to fail this one's members.
+pub fn prepare(atlas_text: &str, out: &Path) -> Result<crate::output_file::FolderLock, AtlasError> {
     let folder = |message: String| AtlasError::Folder {
         path: out.to_path_buf(),
         message,
@@ -141,9 +143,13 @@ pub fn prepare(atlas_text: &str, out: &Path) -> Result<(), AtlasError> {
         }
     }
     crate::output_file::create_folder(out)?;
+    let lock = crate::output_file::lock_folder(out, ATLAS_LOCK)?;
     crate::output_file::write_whole(&out.join("atlas.toml"), atlas_text.as_bytes())?;
-    Ok(())
+    Ok(lock)
 }
+
+/// The atlas folder's lock file ([`prepare`]).
+pub const ATLAS_LOCK: &str = ".tubemem-atlas.lock";
 
 /// Run the atlas into `out` on `workers` threads (its members not yet done), then fit and
 /// write. `atlas_text` is the atlas file (kept as `out/atlas.toml`, which is how a rerun knows
@@ -155,7 +161,7 @@ pub fn run(
     workers: usize,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<AtlasOutcome, AtlasError> {
-    prepare(atlas_text, out)?;
+    let _lock = prepare(atlas_text, out)?;
     let n = atlas.members.len();
     let slots: Mutex<Vec<Option<MemberResult>>> = Mutex::new(vec![None; n]);
     let done = AtomicUsize::new(0);
@@ -267,4 +273,48 @@ pub fn assemble(
     let points = fit::points(atlas, results);
     let written = output::write_all(atlas, results, &points, out)?;
     Ok((points, written))
+}
+
+/// The members not run, as a message shows them: every name up to 5, else the first 3 and a
+/// count (an interrupted 100 × 100 atlas had printed all 9,867 names).
+pub fn missing_summary(missing: &[String]) -> String {
+    const SHOWN: usize = 3;
+    if missing.len() <= 5 {
+        missing.join(", ")
+    } else {
+        format!(
+            "{}, … and {} more; runs/ holds the finished ones",
+            missing[..SHOWN].join(", "),
+            missing.len() - SHOWN
+        )
+    }
+}
+
+/// `secs` in words: "40 s", "12 min", "3.5 h", "2.1 days".
+pub fn duration_words(secs: f64) -> String {
+    if secs < 90.0 {
+        format!("{secs:.0} s")
+    } else if secs < 5400.0 {
+        format!("{:.0} min", secs / 60.0)
+    } else if secs < 172_800.0 {
+        format!("{:.1} h", secs / 3600.0)
+    } else {
+        format!("{:.1} days", secs / 86_400.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_members_are_summarized_not_listed() {
+        let names: Vec<String> = (0..9867).map(|i| format!("m{i}")).collect();
+        let s = missing_summary(&names);
+        assert!(s.len() < 100 && s.contains("9864 more"), "{s}");
+        assert_eq!(missing_summary(&names[..2]), "m0, m1");
+        assert_eq!(duration_words(40.0), "40 s");
+        assert_eq!(duration_words(3600.0), "60 min");
+        assert_eq!(duration_words(36_000.0), "10.0 h");
+    }
 }

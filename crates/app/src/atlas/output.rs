@@ -37,18 +37,19 @@ fn num(v: Option<f64>) -> String {
 /// atlas.csv's text.
 pub fn atlas_csv(atlas: &Atlas, points: &[Point]) -> String {
     let mut s = String::from(
-        "lambda_s_star,rho,quantity,epsilon,min_length_ratio,law,c,a,k,fit_residual,flag,reason\n",
+        "lambda_s_star,rho,quantity,epsilon,min_length_ratio,min_length_extent,law,c,a,k,fit_residual,flag,reason\n",
     );
     for p in points {
         for (e, m) in atlas.spec.epsilon.iter().zip(&p.min_length) {
             let f = p.fit.as_ref();
             s.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
                 p.stretch,
                 p.rho,
                 p.quantity,
                 e,
                 num(*m),
+                m.map_or("", |m| super::fit::extent(m, &atlas.spec.lengths).name()),
                 field(law_name(atlas.spec.law)),
                 num(f.map(|f| f.c)),
                 num(f.map(|f| f.a)),

@@ -21,6 +21,9 @@ pub struct Prediction {
     pub a: f64,
     /// per ε of the atlas: (ε, minimum L/R)
     pub min_length_ratio: Vec<(f64, f64)>,
+    /// where the length predicted at lies against the lengths run (`beyond-runs`: the law's
+    /// extrapolation)
+    pub length_extent: super::fit::Extent,
 }
 
 /// Read an atlas's atlas.json.
@@ -67,6 +70,15 @@ pub fn predict(
         )));
     }
     let s = &atlas.spec;
+    // below the shortest run the law's asymptotic form has no support (A/(L/R) grows without
+    // bound as L → 0): refused; beyond the longest it is the law's tail, flagged
+    let runs = super::fit::extent(length, &s.lengths);
+    if runs == super::fit::Extent::BelowRuns {
+        return Err(AtlasError::Predict(format!(
+            "--length-ratio {length} is below every length the atlas ran ({:?}): the end-effect law is fitted on those lengths and does not hold for shorter tubes",
+            s.lengths
+        )));
+    }
     let (s0, s1, ws) = bracket(&s.stretches, stretch, "--lambda-s-star")?;
     let (r0, r1, wr) = bracket(&s.rho, rho, "--rho")?;
     let mut out = vec![];
@@ -115,6 +127,7 @@ pub fn predict(
             c,
             a,
             min_length_ratio: s.epsilon.iter().map(|&e| (e, fit.length_for(e))).collect(),
+            length_extent: runs,
         });
     }
     Ok(out)

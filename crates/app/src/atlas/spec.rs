@@ -21,7 +21,8 @@ pub const PLANE_QUANTITIES: [&str; 4] = ["w", "wall_force", "lambda_s", "lambda_
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AtlasPlane {
-    /// [nx, ny] (normalized by the case reader)
+    /// [nx, ny] (normalized by the case reader; three components are refused, not truncated)
+    #[serde(deserialize_with = "crate::case::two_components")]
     pub normal: [f64; 2],
     /// a wall that stays at d = `offset` (in R); without it the plane moves with ρ: d = ρ at
     /// each level
@@ -73,6 +74,18 @@ pub struct AtlasSpec {
     /// keys added to every generated squeeze (or confine) stage (contact_method, …)
     #[serde(default)]
     pub squeeze: toml::Table,
+    /// the most member runs (λs* × L/R) the atlas may have (default 1000, the guard against
+    /// a grid mistyped by orders of magnitude); raise it to run a larger atlas on purpose
+    #[serde(default = "default_max_runs")]
+    pub max_runs: usize,
+}
+
+/// The default guard on an atlas's runs ([`AtlasSpec::max_runs`]): at a few seconds per run
+/// on 2 cores, an hour's work.
+pub const DEFAULT_MAX_RUNS: usize = 1000;
+
+fn default_max_runs() -> usize {
+    DEFAULT_MAX_RUNS
 }
 
 /// `[atlas.ps_map]`: the grid of the closed-form map of |PS/GPS − 1|.
@@ -145,10 +158,11 @@ fn tag(v: f64) -> String {
 impl Atlas {
     /// Read and validate an atlas file.
     pub fn read(path: &Path) -> Result<Self, AtlasError> {
-        let text = std::fs::read_to_string(path).map_err(|source| AtlasError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = tubemem_mesh::io::read_text_limited(path, crate::case::MAX_CASE_FILE_BYTES)
+            .map_err(|source| AtlasError::Read {
+                path: path.to_path_buf(),
+                source,
+            })?;
         let base = path
             .parent()
             .map(Path::to_path_buf)
@@ -171,6 +185,18 @@ impl Atlas {
             )
         })?;
         let mut template: toml::Table = toml::from_str(text).map_err(AtlasError::Syntax)?;
+        // `quantities = []` written out is a mistake, not the default (the key left out)
+        let written_empty = template
+            .get("atlas")
+            .and_then(|a| a.get("quantities"))
+            .and_then(|q| q.as_array())
+            .is_some_and(|q| q.is_empty());
+        if written_empty {
+            return Err(bad(
+                "atlas.quantities",
+                "is empty: name at least one quantity, or leave the key out for the stage's default set",
+            ));
+        }
         template.remove("atlas");
         if template.contains_key("stage") {
             return Err(bad(
@@ -185,6 +211,18 @@ impl Atlas {
                 &PLANE_QUANTITIES
             };
             spec.quantities = q.iter().map(|s| s.to_string()).collect();
+        }
+        let runs = spec.stretches.len().saturating_mul(spec.lengths.len());
+        if runs > spec.max_runs {
+            return Err(bad(
+                "atlas.max_runs",
+                &format!(
+                    "the grid has {} stretches × {} lengths = {runs} member runs, more than max_runs = {}: check the grid, or raise `max_runs` to run it on purpose",
+                    spec.stretches.len(),
+                    spec.lengths.len(),
+                    spec.max_runs
+                ),
+            ));
         }
         check(&spec, &template)?;
         let mut members = vec![];
