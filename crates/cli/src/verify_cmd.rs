@@ -53,6 +53,7 @@ pub struct VerifyArgs {
 
 /// Exit code 2: the verification could not be set up.
 fn setup(message: impl std::fmt::Display) -> u8 {
+    let message = tubemem_material::tidy_numbers(&message.to_string());
     let _ = writeln!(std::io::stderr(), "error: {message}");
     2
 }

@@ -37,6 +37,14 @@ pub fn set_interrupt(flag: Arc<AtomicBool>) {
     let _ = INTERRUPT.set(flag);
 }
 
+/// The verification's interrupt flag, installed now if none is (a library caller such as the
+/// Python module sets it from its own signal checks, and clears it before each call).
+pub fn interrupt_flag() -> Arc<AtomicBool> {
+    INTERRUPT
+        .get_or_init(|| Arc::new(AtomicBool::new(false)))
+        .clone()
+}
+
 /// Whether the verification was interrupted.
 pub fn interrupted() -> bool {
     INTERRUPT.get().is_some_and(|f| f.load(Ordering::Relaxed))
@@ -197,6 +205,20 @@ pub fn run_checks(
     opts: &VerifyOptions,
     progress: &(dyn Fn(Event) + Sync),
 ) -> crate::Result<Vec<CheckResult>> {
+    // each check is a folder under `out`: one name in two suites would be one folder, the
+    // second run refused by the first's lock (and blamed on this very process)
+    let mut seen: std::collections::HashMap<&str, &str> = Default::default();
+    for c in checks {
+        if let Some(other) = seen.insert(&c.spec.name, &c.suite) {
+            return Err(crate::AppError::Folder {
+                path: out.join(&c.spec.name),
+                message: format!(
+                    "check `{}` is in suite `{other}` and in suite `{}`: check names must be unique across the suites of one run (each is a folder under --out); rename one",
+                    c.spec.name, c.suite
+                ),
+            });
+        }
+    }
     std::fs::create_dir_all(out).map_err(|e| crate::AppError::io(out, e))?;
     let selected: Vec<&Check> = checks
         .iter()

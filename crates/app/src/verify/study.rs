@@ -372,10 +372,11 @@ pub fn run_study(
     opts: &VerifyOptions,
     progress: &(dyn Fn(Event) + Sync),
 ) -> Result<Study, VerifyError> {
-    let text = std::fs::read_to_string(case_path).map_err(|source| VerifyError::Read {
-        path: case_path.to_path_buf(),
-        source,
-    })?;
+    let text = tubemem_mesh::io::read_text_limited(case_path, crate::case::MAX_CASE_FILE_BYTES)
+        .map_err(|source| VerifyError::Read {
+            path: case_path.to_path_buf(),
+            source,
+        })?;
     let case = crate::case::Case::parse(&text).map_err(|source| VerifyError::Case {
         what: case_path.display().to_string(),
         source,

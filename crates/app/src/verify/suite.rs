@@ -367,7 +367,20 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
                 return Err(err("an invariance check needs `min_core_fraction`".into()));
             }
         }
-        CheckKind::Gold => {}
+        CheckKind::Gold => {
+            if let Some(r) = c.rel_err {
+                if !(r.is_finite() && r > 0.0 && r < 1.0) {
+                    return Err(err(format!(
+                        "`rel_err` = {r}: must be a finite relative tolerance in (0, 1)"
+                    )));
+                }
+            }
+            if let Some(a) = c.abs_zero {
+                if !(a.is_finite() && a >= 0.0) {
+                    return Err(err(format!("`abs_zero` = {a}: must be finite and ≥ 0")));
+                }
+            }
+        }
         CheckKind::TensionField => {
             known(TENSION_FIELD_QUANTITIES, &mut c.tolerance.keys())?;
             if c.tolerance.is_empty() {
@@ -459,7 +472,8 @@ pub fn read_suite(path: &Path) -> Result<(String, Vec<Check>), SuiteError> {
         path: path.to_path_buf(),
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| err(format!("cannot read it: {e}")))?;
+    let text = tubemem_mesh::io::read_text_limited(path, tubemem_mesh::io::MAX_TEXT_INPUT_BYTES)
+        .map_err(|e| err(format!("cannot read it: {e}")))?;
     let file: SuiteFile = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let suite = file.suite.name.clone().unwrap_or_else(|| {
@@ -480,9 +494,10 @@ pub fn read_suite(path: &Path) -> Result<(String, Vec<Check>), SuiteError> {
         let (case_text, base_dir) = match &spec.case {
             CaseRef::Path(p) => {
                 let cp = dir.join(p);
-                let t = std::fs::read_to_string(&cp).map_err(|e| {
-                    err(format!("check `{}`: case {}: {e}", spec.name, cp.display()))
-                })?;
+                let t = tubemem_mesh::io::read_text_limited(&cp, crate::case::MAX_CASE_FILE_BYTES)
+                    .map_err(|e| {
+                        err(format!("check `{}`: case {}: {e}", spec.name, cp.display()))
+                    })?;
                 (t, cp.parent().map(Path::to_path_buf).unwrap_or_default())
             }
             CaseRef::Inline(t) => (

@@ -40,12 +40,23 @@ fn convergence(c: &Check, dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult
                 .into(),
         );
     }
-    let mut reports = vec![];
-    let mut arounds = vec![];
+    // every member's case first, so that a family `start` or `meshes` takes off the end of
+    // the admissible meshes is refused naming those keys, before anything runs
+    let mut texts = vec![];
     for k in 0..n {
         let e = start + k as i32;
-        let f = ratio.powi(e);
-        let text = vary(&c.case_text, |t| scale_mesh(t, f))?;
+        let text = vary(&c.case_text, |t| scale_mesh(t, ratio.powi(e)))?;
+        if let Err(err) = crate::case::Case::parse(&text) {
+            return Err(format!(
+                "`start` = {start}, `refinement` = {ratio}, `meshes` = {n}: the family's mesh {k} (the case's mesh × {ratio}^{e}) is refused: {}",
+                crate::error_chain(&err)
+            ));
+        }
+        texts.push(text);
+    }
+    let mut reports = vec![];
+    let mut arounds = vec![];
+    for (k, text) in texts.into_iter().enumerate() {
         let t: toml::Table = toml::from_str(&text).map_err(|e| e.to_string())?;
         arounds.push(
             t.get("mesh")

@@ -156,6 +156,13 @@ fn gold(c: &Check, dir: &Path, opts: &VerifyOptions, r: &mut CheckResult) -> Kin
                 b.get(gi).map(String::as_str).unwrap_or(""),
             );
             match (x.parse::<f64>(), y.parse::<f64>()) {
+                (Ok(xv), Ok(yv)) if !(xv.is_finite() && yv.is_finite()) => {
+                    first.get_or_insert(format!(
+                        "steps.csv row {} `{col}`: `{x}` against gold `{y}`: not a finite number ({} is corrupt or the run overflowed)",
+                        ri + 1,
+                        if yv.is_finite() { "the run's steps.csv" } else { "the gold file" }
+                    ));
+                }
                 (Ok(x), Ok(y)) => {
                     let d = if x.abs() <= abs_zero && y.abs() <= abs_zero {
                         0.0
