@@ -59,7 +59,7 @@ pub(crate) fn atlas<'py>(
     workers: Option<usize>,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let text = std::fs::read_to_string(&atlas)
+    let text = tubemem_mesh::io::read_text_limited(&atlas, tubemem_app::case::MAX_CASE_FILE_BYTES)
         .map_err(|e| PyValueError::new_err(format!("cannot read {}: {e}", atlas.display())))?;
     let base = atlas
         .parent()
@@ -74,6 +74,26 @@ pub(crate) fn atlas<'py>(
     })?;
     if workers == Some(0) {
         return Err(PyValueError::new_err("atlas: workers = 0: at least 1"));
+    }
+    // what the end needs, checked before any member runs: the Dataset (xarray) and atlas.nc
+    // (written with the scipy engine)
+    for (module, why) in [
+        ("xarray", "the atlas's Dataset"),
+        ("scipy", "atlas.nc (xarray's scipy engine)"),
+    ] {
+        if py.import(module).is_err() {
+            return Err(pyo3::exceptions::PyImportError::new_err(format!(
+                "atlas: the Python package `{module}` is needed for {why} and cannot be imported; install it (pip install {module}) before running the atlas"
+            )));
+        }
+    }
+    if let Some(c) = client {
+        if !(c.hasattr("map")? && c.hasattr("gather")?) {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "atlas: client must be a dask.distributed.Client (with map and gather), not {}; connect one with dask.distributed.Client(\"tcp://host:8786\")",
+                c.repr().map_or_else(|_| "?".to_string(), |r| r.to_string())
+            )));
+        }
     }
     let n = a.members.len();
     let call = |py: Python<'_>, r: &MemberResult, done: usize| -> PyResult<()> {
@@ -106,13 +126,14 @@ pub(crate) fn atlas<'py>(
                 return Err(TubememError::new_err(format!(
                     "interrupted: {} members not run ({}); call again to run them",
                     o.missing.len(),
-                    o.missing.join(", ")
+                    app_atlas::missing_summary(&o.missing)
                 )));
             }
             o.results
         }
         Some(client) => {
-            app_atlas::prepare(&text, &out)
+            // held until the atlas is assembled: a second atlas into `out` is refused
+            let _lock = app_atlas::prepare(&text, &out)
                 .map_err(|e| TubememError::new_err(tubemem_app::error_chain(&e)))?;
             let mut slots: Vec<Option<MemberResult>> = a
                 .members

@@ -84,8 +84,11 @@ impl PyCase {
     /// Read a case file (user meshes are looked up relative to its folder).
     #[staticmethod]
     fn read(path: PathBuf) -> PyResult<Self> {
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| PyValueError::new_err(format!("cannot read {}: {e}", path.display())))?;
+        let text =
+            tubemem_mesh::io::read_text_limited(&path, tubemem_app::case::MAX_CASE_FILE_BYTES)
+                .map_err(|e| {
+                    PyValueError::new_err(format!("cannot read {}: {e}", path.display()))
+                })?;
         Self::parse(text, path.parent().map(PathBuf::from).unwrap_or_default())
     }
     fn to_toml(&self) -> String {
@@ -268,7 +271,7 @@ pub(crate) fn case_text(py: Python<'_>, case: &Bound<'_, PyAny>) -> PyResult<Str
     let text: String = case.str()?.extract()?;
     let path = PathBuf::from(&text);
     if !text.contains('\n') && path.is_file() {
-        return std::fs::read_to_string(&path)
+        return tubemem_mesh::io::read_text_limited(&path, tubemem_app::case::MAX_CASE_FILE_BYTES)
             .map_err(|e| PyValueError::new_err(format!("cannot read {}: {e}", path.display())));
     }
     let _ = py;

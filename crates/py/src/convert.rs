@@ -10,17 +10,30 @@ pub(crate) fn from_py<T: serde::de::DeserializeOwned>(
     obj: &Bound<'_, PyAny>,
     what: &str,
 ) -> PyResult<T> {
-    let json = obj.py().import("json")?;
-    let kwargs = pyo3::types::PyDict::new(obj.py());
+    let py = obj.py();
+    let json = py.import("json")?;
+    let kwargs = pyo3::types::PyDict::new(py);
     kwargs.set_item("allow_nan", false)?;
+    // numpy scalars (np.int64(3), np.float64(0.5): what indexing an array gives) as the
+    // Python numbers they hold; anything else stays refused by the JSON writer
+    let default = py.eval(
+        c"lambda o: o.item() if (type(o).__module__ == 'numpy' and getattr(o, 'ndim', None) == 0 and getattr(o, 'dtype', None) is not None and o.dtype.kind in 'iuf') else (_ for _ in ()).throw(TypeError(f'{type(o).__name__} {o!r} is not a real number, string, list or dict'))",
+        None,
+        None,
+    )?;
+    kwargs.set_item("default", default)?;
     // NaN and infinity are not values a material may have; say so rather than let the JSON
     // reader point at a column the user never wrote
     let text: String = json
         .call_method("dumps", (obj,), Some(&kwargs))
-        .map_err(|_| {
-            PyValueError::new_err(format!(
-                "{what}: a value is not a finite number (NaN or infinity) or not a plain number, string or dict: {obj}"
-            ))
+        .map_err(|e| {
+            let cause = e.value(py).to_string();
+            let cause = if cause.contains("Out of range float") {
+                "a value is not a finite number (NaN or infinity)".to_string()
+            } else {
+                cause
+            };
+            PyValueError::new_err(tubemem_material::shorten_lines(&format!("{what}: {cause}")))
         })?
         .extract()?;
     serde_json::from_str(&text)

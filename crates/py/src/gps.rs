@@ -4,7 +4,7 @@
 use crate::convert::to_py;
 use crate::errors::{gps_err, material_err, TubememError};
 use crate::table::Table;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use tubemem_gps::GpsError;
 use tubemem_gps::Hypothesis;
@@ -58,7 +58,7 @@ pub(crate) fn gps_inflate<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let law = law(material)?;
     let hyp = self::hypothesis(hypothesis)?;
-    if let Ok(v) = stretch.extract::<f64>() {
+    if let Ok(v) = real_scalar(stretch, "stretch")? {
         let s = tubemem_gps::inflate(law.as_ref(), hyp, v).map_err(gps_err)?;
         return to_py(py, &s);
     }
@@ -71,6 +71,20 @@ pub(crate) fn gps_inflate<'py>(
         |v| tubemem_gps::inflate(law.as_ref(), hyp, v).map(|s| inflation_values(&s)),
         &keys,
     )
+}
+
+/// `obj` as one real number (Ok(Err) where it is not a scalar: an array goes the vectorized
+/// way); a bool or a string is refused, not read as 1.0 or parsed.
+fn real_scalar(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Result<f64, ()>> {
+    use pyo3::types::{PyBool, PyString};
+    if obj.is_instance_of::<PyBool>() || obj.is_instance_of::<PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{what}: a number or an array of numbers, not {}",
+            obj.repr()
+                .map_or_else(|_| "?".to_string(), |r| r.to_string())
+        )));
+    }
+    Ok(obj.extract::<f64>().map_err(|_| ()))
 }
 
 /// Evaluate `f` at every entry of the array-like `input` (any shape) and return a dict of numpy
@@ -96,6 +110,16 @@ pub(crate) fn vectorized<'py>(
     if kind == "c" {
         return Err(PyValueError::new_err(format!(
             "{what}: complex numbers are not stretches or pressures (give real numbers)"
+        )));
+    }
+    // text ("1.3") and booleans would be converted to numbers by the float conversion below
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(PyTypeError::new_err(format!(
+            "{what}: a number or an array of numbers, not {} (numpy dtype kind {kind:?})",
+            input
+                .get_type()
+                .name()
+                .map_or_else(|_| "?".to_string(), |n| n.to_string())
         )));
     }
     // contiguous float64 (a strided view, e.g. `a[::2]`, is copied once)
@@ -237,7 +261,7 @@ pub(crate) fn gps_flatten<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let law = law(material)?;
     let hyp = self::hypothesis(hypothesis)?;
-    if let Ok(r) = rho.extract::<f64>() {
+    if let Ok(r) = real_scalar(rho, "rho")? {
         let s = tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r).map_err(gps_err)?;
         return to_py(py, &s);
     }

@@ -156,12 +156,33 @@ fn test_data(
     let bad = || {
         PyValueError::new_err(format!("{what}: a CSV path, an (N, 2) array of (stretch, stress), or a (stretch, stress) pair of arrays"))
     };
-    let arr = np
-        .call_method1("asarray", (arg, "float64"))
-        .map_err(|_| bad())?;
+    // real numbers only: a float conversion would drop imaginary parts and parse text
+    let raw = np.call_method1("asarray", (arg,)).map_err(|_| bad())?;
+    let kind: String = raw.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u" | "f") {
+        return Err(PyValueError::new_err(format!(
+            "{what}: the data must be real numbers (numpy dtype kind {kind:?}: {}); complex values, text and booleans are refused",
+            match kind.as_str() {
+                "c" => "complex",
+                "U" | "S" => "text",
+                "b" => "boolean",
+                _ => "not numbers",
+            }
+        )));
+    }
+    let arr = raw.call_method1("astype", ("float64",))?;
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    // a tuple of two sequences is the (stretch, stress) pair; an array (or a list) is (N, 2)
+    // rows, or (2, N) where N ≠ 2; a 2 × 2 one is either, so it is refused
+    let pair = arg.is_instance_of::<pyo3::types::PyTuple>();
     let (stretch, stress): (Vec<f64>, Vec<f64>) = match shape.as_slice() {
-        // (N, 2): one (stretch, stress) row per point (a 2 × 2 array is read so too)
+        [2, _] if pair => (arr.get_item(0)?.extract()?, arr.get_item(1)?.extract()?),
+        [2, 2] => {
+            return Err(PyValueError::new_err(format!(
+                "{what}: a 2 × 2 array is ambiguous (two (stretch, stress) rows, or the stretch and stress rows?): give a (stretch, stress) tuple of arrays"
+            )))
+        }
+        // (N, 2): one (stretch, stress) row per point
         [_, 2] => {
             let t = arr.getattr("T")?;
             (t.get_item(0)?.extract()?, t.get_item(1)?.extract()?)

@@ -51,17 +51,25 @@ pub(crate) fn verify<'py>(
     };
     let t0 = std::time::Instant::now();
     let quiet = |_: v::Event| {};
+    // Ctrl-C: the checks not started are skipped and the runs in progress stop at their next
+    // Newton iteration (as in the CLI); the report of what ran is written, then
+    // KeyboardInterrupt is raised
+    let flag = v::interrupt_flag();
+    flag.store(false, std::sync::atomic::Ordering::Relaxed);
+    let mut raised: Option<PyErr> = None;
     let (names, results, verdict) = match (case, suites) {
         (Some(c), None) => {
-            let s = py
-                .detach(|| {
-                    let study = v::study::StudyOptions {
-                        quick,
-                        epsilon: epsilon.unwrap_or(v::study::DEFAULT_EPSILON),
-                    };
-                    v::study::run_study(&c, &out, &study, &opts, &quiet)
-                })
-                .map_err(|e| PyValueError::new_err(tubemem_app::error_chain(&e)))?;
+            let s = watch(py, &flag, &mut raised, || {
+                let study = v::study::StudyOptions {
+                    quick,
+                    epsilon: epsilon.unwrap_or(v::study::DEFAULT_EPSILON),
+                };
+                v::study::run_study(&c, &out, &study, &opts, &quiet)
+            })?
+            .map_err(|e| match raised.take() {
+                Some(k) => k,
+                None => PyValueError::new_err(tubemem_app::error_chain(&e)),
+            })?;
             (
                 vec![format!("study of {}", c.display())],
                 s.results,
@@ -77,9 +85,13 @@ pub(crate) fn verify<'py>(
                 names.push(n);
                 checks.extend(c);
             }
-            let r = py
-                .detach(|| v::run_checks(&checks, &out, &opts, &quiet))
-                .map_err(|e| TubememError::new_err(e.chain()))?;
+            let r = watch(py, &flag, &mut raised, || {
+                v::run_checks(&checks, &out, &opts, &quiet)
+            })?
+            .map_err(|e| match raised.take() {
+                Some(k) => k,
+                None => TubememError::new_err(e.chain()),
+            })?;
             (names, r, None)
         }
         _ => {
@@ -90,5 +102,40 @@ pub(crate) fn verify<'py>(
     };
     let results = Results::new(names, t0.elapsed().as_secs_f64(), &results, verdict);
     v::report::write_all(&out, &results).map_err(|e| TubememError::new_err(e.chain()))?;
+    if let Some(e) = raised {
+        // the report of what ran is on disk; say where, then raise the interrupt
+        let msg = format!(
+            "verification interrupted: the report of the checks that ran is in {}",
+            out.display()
+        );
+        let _ = py
+            .import("sys")
+            .and_then(|s| s.getattr("stderr"))
+            .and_then(|s| s.call_method1("write", (msg + "\n",)));
+        return Err(e);
+    }
     to_py(py, &results)
+}
+
+/// Run `work` on a thread while this one checks Python's signals every 50 ms: on Ctrl-C (or
+/// any signal handler raising) `flag` is set, so the work stops within a Newton iteration,
+/// and the exception is kept in `raised`.
+fn watch<T: Send>(
+    py: Python<'_>,
+    flag: &std::sync::atomic::AtomicBool,
+    raised: &mut Option<PyErr>,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    std::thread::scope(|s| {
+        let h = s.spawn(work);
+        while !h.is_finished() {
+            py.detach(|| std::thread::sleep(std::time::Duration::from_millis(50)));
+            if let Err(e) = py.check_signals() {
+                flag.store(true, std::sync::atomic::Ordering::Relaxed);
+                raised.get_or_insert(e);
+            }
+        }
+        h.join()
+            .map_err(|_| TubememError::new_err("the verification's thread stopped abnormally"))
+    })
 }
