@@ -1043,7 +1043,7 @@ fn output_folders_cannot_be_mixed() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "a locked folder must be refused");
         assert!(
-            err.contains("another tubemem run")
+            err.contains("another tubemem command")
                 && err.contains(&format!("pid {}", std::process::id())),
             "{err}"
         );
@@ -1347,28 +1347,60 @@ fn a_killed_sequenced_run_resumes_bit_identical() {
     );
 }
 
-/// Issue #25, class 5: a confine stage whose walls never touch the tube prints no `NaN%` (the
-/// relative errors of a wall that carries nothing in GPS read "none in GPS").
+/// Issue #25, class 5: a confine stage where some walls never touch the tube prints no `NaN%`
+/// (the relative errors of a wall that carries nothing in GPS read "none in GPS"); issue #61:
+/// a stage where no wall reaches the tube is refused, naming the gap, with every converged
+/// step of the inflation kept (it had compared a far GPS branch with an FE that had no contact).
 #[test]
 fn walls_that_never_touch_print_no_nan() {
     let d = tmp("far-walls");
-    let case = d.join("far.toml");
-    let text = include_str!("../../../cases/channel_abb30_ls1.3.toml")
+    let base = include_str!("../../../cases/channel_abb30_ls1.3.toml")
         .replace("element = \"quad9\"", "")
         .replace("track_contact_edge = true", "")
         .replace("around = 32", "around = 16")
-        .replace("along = 80", "along = 40")
-        .replace("target = 1.1", "target = 1.34")
-        + "\n[output]\nvtu = \"none\"\n";
-    std::fs::write(&case, text).unwrap();
-    let o = run_in(&case, &d.join("out"), &[]);
+        .replace("along = 80", "along = 40");
+    // the side walls squeeze to 1.1; the top and bottom ones stand at 2 R, beyond the bulge
+    let mut parts: Vec<String> = base.split("[[stage.plane]]").map(str::to_string).collect();
+    for p in parts.iter_mut().skip(3) {
+        *p = p.replace("offset = 1.35\ntarget = 1.1", "offset = 2.0\ntarget = 2.0");
+    }
+    let some = parts.join("[[stage.plane]]") + "\n[output]\nvtu = \"none\"\n";
+    let case = d.join("some.toml");
+    std::fs::write(&case, &some).unwrap();
+    let o = run_in(&case, &d.join("some"), &[]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
-        out.contains("wall 1") && out.contains("none in GPS"),
+        out.contains("wall 3") && out.contains("none in GPS"),
         "{out}"
     );
     assert!(!out.contains("NaN"), "{out}");
+
+    let none = base.replace("target = 1.1", "target = 1.34") + "\n[output]\nvtu = \"none\"\n";
+    let case = d.join("none.toml");
+    std::fs::write(&case, none).unwrap();
+    let o = run_in(&case, &d.join("none"), &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "walls that never touch must be refused");
+    assert!(
+        err.contains("[[stage]] 2")
+            && err.contains("reaches the tube")
+            && err.contains("0.040000 R outside"),
+        "{err}"
+    );
+    // every converged inflation step is kept: the same rows as the first stage of the run above
+    let inflation = |run: &str| -> Vec<String> {
+        std::fs::read_to_string(d.join(run).join("steps.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .filter(|l| l.starts_with("1,"))
+            .map(str::to_string)
+            .collect()
+    };
+    let kept = inflation("none");
+    assert!(!kept.is_empty());
+    assert_eq!(kept, inflation("some"));
 }
 
 /// Restart of a run whose node lines follow the contact edges (`track_contact_edge`, the main
@@ -1656,8 +1688,8 @@ fn a_whole_tube_holds_its_neutral_bulge_translation_and_reaches_the_target() {
 }
 
 /// Resource guards: the 6.6 M-equation full tube is refused before anything is built (well
-/// within a second), with its estimate; a case file that is /dev/zero is read through the size
-/// limit; an overlay whose steps.csv holds NaN or NUL bytes is refused.
+/// within a second), with its estimate; a case file that is /dev/zero is refused as not a
+/// regular file (before it is opened; a FIFO would block the open); an overlay whose steps.csv holds NaN or NUL bytes is refused.
 #[test]
 fn resource_guards_refuse_with_their_estimate() {
     let d = tmp("guards");
@@ -1687,7 +1719,7 @@ fn resource_guards_refuse_with_their_estimate() {
             "--out",
             d.join("zero").to_str().unwrap(),
         ],
-        "MiB",
+        "not a regular file",
     );
     // an overlay run folder whose steps.csv is corrupt
     let run = d.join("corrupt");
