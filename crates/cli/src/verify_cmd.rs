@@ -143,7 +143,12 @@ pub fn run(a: VerifyArgs) -> u8 {
                 opts.filter.as_deref().unwrap_or("")
             ));
         }
-        let _ = writeln!(std::io::stderr(), "{n} checks from {}", names.join(", "));
+        let _ = writeln!(
+            std::io::stderr(),
+            "{n} check{} from {}",
+            if n == 1 { "" } else { "s" },
+            names.join(", ")
+        );
         match verify::run_checks(&checks, &a.out, &opts, &progress) {
             Ok(r) => (names, r, None),
             Err(e) => return setup(e.chain()),

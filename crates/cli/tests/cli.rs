@@ -1381,7 +1381,10 @@ fn walls_that_never_touch_print_no_nan() {
     std::fs::write(&case, none).unwrap();
     let o = run_in(&case, &d.join("none"), &[]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "walls that never touch must be refused");
+    assert!(
+        !o.status.success(),
+        "walls that never touch must be refused"
+    );
     assert!(
         err.contains("[[stage]] 2")
             && err.contains("reaches the tube")

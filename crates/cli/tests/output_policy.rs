@@ -130,3 +130,283 @@ fn a_check_named_with_dots_cannot_leave_its_folder() {
         assert!(!d.join("run").exists(), "{name}: a run beside --out");
     }
 }
+
+/// Every file under `dir`, with its bytes (symlinks as their target, not followed).
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let meta = std::fs::symlink_metadata(&p).unwrap();
+            if meta.file_type().is_symlink() {
+                let t = std::fs::read_link(&p).unwrap();
+                out.insert(p, t.to_string_lossy().as_bytes().to_vec());
+            } else if meta.is_dir() {
+                todo.push(p);
+            } else {
+                out.insert(p.clone(), std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+/// The inputs every command of the property below reads, written into `dir`.
+fn inputs(dir: &Path) {
+    let case = include_str!("../../../cases/small_abb30_ls1.2.toml")
+        .replace("around = 16", "around = 8")
+        .replace("along = 24", "along = 4")
+        + "\n[output]\nvtu = \"none\"\n";
+    std::fs::write(dir.join("case.toml"), case).unwrap();
+    std::fs::write(
+        dir.join("law.toml"),
+        "[material]\nmodel = \"neo-hookean\"\nshear_modulus = 1.0\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("ring.csv"), "x,y\n1.0,0.0\n0.0,1.0\n").unwrap();
+    std::fs::write(
+        dir.join("data.csv"),
+        "stretch,nominal_stress_mpa\n1.0,0.0\n1.2,0.1\n1.4,0.18\n1.6,0.25\n1.8,0.31\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("suite.toml"),
+        "[[check]]\nname = \"c\"\ncase = \"case.toml\"\nkind = \"closed-form\"\ntolerance.w = { value = 1.0, source = \"test\" }\n",
+    )
+    .unwrap();
+    let atlas = include_str!("../../../atlas/ci.toml")
+        .replace("around = 32", "around = 8")
+        .replace("stretches = [1.2, 1.3]", "stretches = [1.2]")
+        .replace("rho = [1.1, 1.0, 0.9, 0.8]", "rho = [1.0]")
+        .replace("lengths = [10, 20, 40]", "lengths = [4, 6]");
+    std::fs::write(dir.join("atlas.toml"), atlas).unwrap();
+}
+
+/// Issue #61's output policy, by property: every subcommand and every output option, pointed
+/// at one of its own inputs (the path itself, through `..`, a symbolic link and a hard link to
+/// it) or at an existing file of the user's (or a folder holding one under an output's name),
+/// is refused with a message, and no file that existed before the command changed. Nothing is
+/// passed `--overwrite`: a user's file is replaced only when asked.
+#[test]
+fn every_output_option_refuses_inputs_links_and_users_files() {
+    // (command line with IN_x for inputs and OUT for the output, the input OUT may alias, the
+    // file name the command writes when OUT is a folder)
+    let commands: &[(&[&str], &str, Option<&str>)] = &[
+        (
+            &["run", "IN_case.toml", "--out", "OUT"],
+            "case.toml",
+            Some("steps.csv"),
+        ),
+        (
+            &["run", "IN_case.toml", "--out", "OUTDIR", "--log", "OUT"],
+            "case.toml",
+            None,
+        ),
+        (
+            &[
+                "gps",
+                "inflate",
+                "--law",
+                "IN_law.toml",
+                "--to",
+                "2",
+                "--points",
+                "3",
+                "--csv",
+                "OUT",
+            ],
+            "law.toml",
+            None,
+        ),
+        (
+            &[
+                "gps",
+                "flatten",
+                "--law",
+                "IN_law.toml",
+                "--stretch",
+                "1.5",
+                "--points",
+                "3",
+                "--csv",
+                "OUT",
+            ],
+            "law.toml",
+            None,
+        ),
+        (
+            &[
+                "gps",
+                "confine",
+                "--material",
+                "neo-hookean",
+                "--initial-stretch",
+                "1.3",
+                "--plane=0,1,1.2",
+                "--plane=0,-1,1.2",
+                "--points",
+                "3",
+                "--ring",
+                "IN_ring.csv",
+                "--csv",
+                "OUT",
+            ],
+            "ring.csv",
+            None,
+        ),
+        (
+            &[
+                "gps",
+                "confine",
+                "--law",
+                "IN_law.toml",
+                "--initial-stretch",
+                "1.3",
+                "--plane=0,1,1.2",
+                "--plane=0,-1,1.2",
+                "--points",
+                "3",
+                "--figure",
+                "OUT",
+            ],
+            "law.toml",
+            None,
+        ),
+        (
+            &[
+                "fit",
+                "--law",
+                "neo-hookean",
+                "--uniaxial",
+                "IN_data.csv",
+                "--plot",
+                "OUT",
+            ],
+            "data.csv",
+            None,
+        ),
+        (
+            &["verify", "IN_suite.toml", "--out", "OUT"],
+            "suite.toml",
+            Some("results.json"),
+        ),
+        (
+            &["atlas", "IN_atlas.toml", "--out", "OUT"],
+            "atlas.toml",
+            Some("atlas.csv"),
+        ),
+        (
+            &["export", "IN_case.toml", "--out", "OUT"],
+            "case.toml",
+            None,
+        ),
+        (
+            &["figures", "--out", "OUT"],
+            "case.toml",
+            Some("fig5_pressure_stretch.svg"),
+        ),
+        (&["man", "--out", "OUT"], "case.toml", Some("tubemem.1")),
+    ];
+    let hazards = [
+        "itself",
+        "dotdot",
+        "symlink",
+        "hardlink",
+        "users-file",
+        "users-folder",
+    ];
+    let root = tmp("policy-property");
+    let mut tried = 0;
+    for (i, (args, aliased, writes)) in commands.iter().enumerate() {
+        for hazard in hazards {
+            let folder_output = writes.is_some();
+            if hazard == "users-folder" && !folder_output {
+                continue;
+            }
+            let d = root.join(format!("{i}-{hazard}"));
+            std::fs::create_dir_all(d.join("sub")).unwrap();
+            inputs(&d);
+            let input = d.join(aliased);
+            // `fit --plot P` writes P.svg and P.png: alias through the stem
+            let fit = args[0] == "fit";
+            let stem = |p: &Path| p.with_extension("");
+            let out = match hazard {
+                "itself" => input.clone(),
+                "dotdot" => d.join("sub").join("..").join(aliased),
+                "symlink" => {
+                    let l = d.join("link");
+                    std::os::unix::fs::symlink(&input, &l).unwrap();
+                    l
+                }
+                "hardlink" => {
+                    let l = d.join("hard");
+                    std::fs::hard_link(&input, &l).unwrap();
+                    l
+                }
+                "users-file" => {
+                    // `fit --plot mine` writes mine.svg and mine.png
+                    let u = d.join(if fit { "mine.svg" } else { "mine.txt" });
+                    std::fs::write(&u, "the user's notes\n").unwrap();
+                    u
+                }
+                _ => {
+                    let f = d.join("mine");
+                    std::fs::create_dir_all(&f).unwrap();
+                    std::fs::write(f.join(writes.unwrap()), "the user's own\n").unwrap();
+                    f
+                }
+            };
+            let out = if fit && hazard == "users-file" {
+                stem(&out)
+            } else if fit {
+                // the data file as the plot's SVG (data.svg), through each alias
+                let svg = out.with_extension("svg");
+                if !svg.exists() {
+                    if hazard == "itself" || hazard == "dotdot" {
+                        std::fs::rename(&input, input.with_extension("svg")).unwrap();
+                    } else {
+                        std::fs::rename(&out, &svg).unwrap();
+                    }
+                }
+                stem(&out)
+            } else {
+                out
+            };
+            let args: Vec<String> = args
+                .iter()
+                .map(|a| match *a {
+                    "OUT" => out.to_str().unwrap().to_string(),
+                    "OUTDIR" => d.join("run").to_str().unwrap().to_string(),
+                    a => match a.strip_prefix("IN_") {
+                        Some(name) if fit && name == "data.csv" && hazard != "users-file" => {
+                            // the data moved to data.svg above (or its link points there)
+                            d.join("data.svg").to_str().unwrap().to_string()
+                        }
+                        Some(name) => d.join(name).to_str().unwrap().to_string(),
+                        None => a.to_string(),
+                    },
+                })
+                .collect();
+            let before = snapshot(&d);
+            let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+            let o = tubemem(&refs);
+            let err = String::from_utf8_lossy(&o.stderr);
+            tried += 1;
+            assert!(
+                !o.status.success() && !err.trim().is_empty(),
+                "{hazard}: {args:?} was accepted (exit {:?}); stderr: {err}",
+                o.status.code()
+            );
+            let after = snapshot(&d);
+            for (path, bytes) in &before {
+                assert!(
+                    after.get(path) == Some(bytes),
+                    "{hazard}: {args:?} changed or removed {}; stderr: {err}",
+                    path.display()
+                );
+            }
+        }
+    }
+    assert!(tried >= 60, "{tried} combinations");
+}

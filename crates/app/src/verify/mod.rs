@@ -219,6 +219,8 @@ pub fn run_checks(
             });
         }
     }
+    // a user's own results.json (or report.md, …) in `out` is refused before any check runs
+    report::check_folder(out)?;
     std::fs::create_dir_all(out).map_err(|e| crate::AppError::io(out, e))?;
     let selected: Vec<&Check> = checks
         .iter()

@@ -288,8 +288,33 @@ pub fn html(r: &Results) -> String {
     h
 }
 
+/// The report files a verification run writes into its `--out` folder.
+pub const REPORT_FILES: [&str; 4] = ["results.json", "report.md", "report.html", "junit.xml"];
+
+/// Whether the first 4 KiB `head` of the report file `name` is one a verification run wrote.
+fn is_report(name: &str, head: &str) -> bool {
+    match name {
+        "results.json" => head.starts_with('{') && head.contains("\"tubemem_version\""),
+        "report.md" => head.starts_with("# tubemem verify"),
+        "report.html" => head.contains("<title>tubemem verify"),
+        _ => head.contains("<testsuites name=\"tubemem verify\""),
+    }
+}
+
+/// Refuse an `out` folder where a report file exists that no verification run wrote (a
+/// user's own `results.json`), or that is a folder or not a regular file: checked before any
+/// check runs, and again before the reports are written.
+pub fn check_folder(out: &Path) -> crate::Result<()> {
+    for name in REPORT_FILES {
+        crate::output_file::check("--out", &out.join(name), &[], |head| is_report(name, head))?;
+    }
+    Ok(())
+}
+
 /// Write results.json, report.md, report.html and junit.xml into `out`; the files written.
+/// A report file that a verification run did not write is refused ([`check_folder`]).
 pub fn write_all(out: &Path, r: &Results) -> crate::Result<Vec<PathBuf>> {
+    check_folder(out)?;
     let mut written = vec![];
     let json = serde_json::to_string_pretty(r).map_err(|e| crate::AppError::Output {
         what: "results.json".into(),
