@@ -157,6 +157,8 @@ fn inputs(dir: &Path) {
     let case = include_str!("../../../cases/small_abb30_ls1.2.toml")
         .replace("around = 16", "around = 8")
         .replace("along = 24", "along = 4")
+        .replace("model = \"abb\"", "model = \"neo-hookean\"")
+        .replace("kuhn = 30", "")
         + "\n[output]\nvtu = \"none\"\n";
     std::fs::write(dir.join("case.toml"), case).unwrap();
     std::fs::write(
@@ -165,6 +167,8 @@ fn inputs(dir: &Path) {
     )
     .unwrap();
     std::fs::write(dir.join("ring.csv"), "x,y\n1.0,0.0\n0.0,1.0\n").unwrap();
+    // the same ring under a figure's name, so that a figure output can alias it
+    std::fs::write(dir.join("ring.svg"), "x,y\n1.0,0.0\n0.0,1.0\n").unwrap();
     std::fs::write(
         dir.join("data.csv"),
         "stretch,nominal_stress_mpa\n1.0,0.0\n1.2,0.1\n1.4,0.18\n1.6,0.25\n1.8,0.31\n",
@@ -179,7 +183,7 @@ fn inputs(dir: &Path) {
         .replace("around = 32", "around = 8")
         .replace("stretches = [1.2, 1.3]", "stretches = [1.2]")
         .replace("rho = [1.1, 1.0, 0.9, 0.8]", "rho = [1.0]")
-        .replace("lengths = [10, 20, 40]", "lengths = [4, 6]");
+        .replace("lengths = [10, 20, 40]", "lengths = [4, 6, 8]");
     std::fs::write(dir.join("atlas.toml"), atlas).unwrap();
 }
 
@@ -225,8 +229,10 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
                 "flatten",
                 "--law",
                 "IN_law.toml",
-                "--stretch",
-                "1.5",
+                "--initial-stretch",
+                "1.3",
+                "--to",
+                "0.9",
                 "--points",
                 "3",
                 "--csv",
@@ -249,6 +255,8 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
                 "3",
                 "--ring",
                 "IN_ring.csv",
+                "--figure",
+                "SIDE.svg",
                 "--csv",
                 "OUT",
             ],
@@ -267,10 +275,14 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
                 "--plane=0,-1,1.2",
                 "--points",
                 "3",
+                "--csv",
+                "SIDE.csv",
+                "--ring",
+                "IN_ring.svg",
                 "--figure",
                 "OUT",
             ],
-            "law.toml",
+            "ring.svg",
             None,
         ),
         (
@@ -308,6 +320,37 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
         ),
         (&["man", "--out", "OUT"], "case.toml", Some("tubemem.1")),
     ];
+    let root = tmp("policy-property");
+    // each command line is valid: it succeeds with a fresh output path (so the refusals below
+    // are the output policy's, not a usage error's)
+    for (i, (args, _, _)) in commands.iter().enumerate() {
+        let d = root.join(format!("{i}-fresh"));
+        std::fs::create_dir_all(&d).unwrap();
+        inputs(&d);
+        let args: Vec<String> = args
+            .iter()
+            .map(|a| match *a {
+                "OUT" if args.contains(&"--figure") && !args.contains(&"SIDE.svg") => {
+                    d.join("fresh.svg").to_str().unwrap().to_string()
+                }
+                "OUT" => d.join("fresh").to_str().unwrap().to_string(),
+                "OUTDIR" => d.join("run").to_str().unwrap().to_string(),
+                "SIDE.svg" => d.join("side.svg").to_str().unwrap().to_string(),
+                "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
+                a => match a.strip_prefix("IN_") {
+                    Some(name) => d.join(name).to_str().unwrap().to_string(),
+                    None => a.to_string(),
+                },
+            })
+            .collect();
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = tubemem(&refs);
+        assert!(
+            o.status.success(),
+            "{args:?} fails with a fresh output: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
     let hazards = [
         "itself",
         "dotdot",
@@ -316,7 +359,6 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
         "users-file",
         "users-folder",
     ];
-    let root = tmp("policy-property");
     let mut tried = 0;
     for (i, (args, aliased, writes)) in commands.iter().enumerate() {
         for hazard in hazards {
@@ -346,7 +388,12 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
                 }
                 "users-file" => {
                     // `fit --plot mine` writes mine.svg and mine.png
-                    let u = d.join(if fit { "mine.svg" } else { "mine.txt" });
+                    let figure = args.contains(&"--figure") && !args.contains(&"SIDE.svg");
+                    let u = d.join(if fit || figure {
+                        "mine.svg"
+                    } else {
+                        "mine.txt"
+                    });
                     std::fs::write(&u, "the user's notes\n").unwrap();
                     u
                 }
@@ -378,6 +425,11 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
                 .map(|a| match *a {
                     "OUT" => out.to_str().unwrap().to_string(),
                     "OUTDIR" => d.join("run").to_str().unwrap().to_string(),
+                    "SIDE.svg" => d.join("side.svg").to_str().unwrap().to_string(),
+                    "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
+                    "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
+                    "SIDE.svg" => d.join("side.svg").to_str().unwrap().to_string(),
+                    "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
                     a => match a.strip_prefix("IN_") {
                         Some(name) if fit && name == "data.csv" && hazard != "users-file" => {
                             // the data moved to data.svg above (or its link points there)
