@@ -157,7 +157,7 @@ def verify(
     out: Union[str, PathLike] = "tubemem-verify",
     case: Optional[Union[str, PathLike]] = None,
     quick: bool = False,
-    jobs: int = 0,
+    jobs: Optional[int] = None,
     filter: Optional[str] = None,
     update_gold: bool = False,
     python: Optional[Union[str, PathLike]] = None,
@@ -200,7 +200,7 @@ def fit(
     pure_shear: Optional[TestData] = None,
     fix: Optional[Mapping[str, float]] = None,
     bounds: Optional[Mapping[str, tuple[float, float]]] = None,
-    starts: int = 8,
+    starts: Optional[int] = None,
 ) -> dict[str, Any]:
     """Fit a law's parameters to test data (nominal stress against stretch; CSV paths whose
     headers name the stress unit, read in Pa, (N, 2) arrays or (stretch, stress) pairs):

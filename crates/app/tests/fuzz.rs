@@ -23,6 +23,7 @@
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -45,14 +46,81 @@ fn number() -> impl Strategy<Value = String> {
     ]
 }
 
+/// An energy written as text (issue #61): sums, products, quotients and powers of the
+/// invariants and of constants from 0 to 1e300, through exp, ln, sqrt and tanh; some deep or
+/// long. Most are not laws a membrane could have: they must be refused, or give finite answers.
+fn energy() -> impl Strategy<Value = String> {
+    let leaf = prop_oneof![
+        3 => Just("(I1 - 3)".to_string()),
+        2 => Just("(I2 - 3)".to_string()),
+        1 => Just("I1".to_string()),
+        1 => Just("I2".to_string()),
+        1 => Just("l".to_string()),
+        1 => Just("0".to_string()),
+        1 => Just("1e150".to_string()),
+        1 => Just("1e-300".to_string()),
+        1 => Just("1e300".to_string()),
+        2 => (0.01f64..5.0).prop_map(|v| format!("{v}")),
+        1 => Just("jm".to_string()),
+    ];
+    let tree = leaf.prop_recursive(4, 24, 3, |inner| {
+        prop_oneof![
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a} + {b})")),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a} - {b})")),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} * {b}")),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("{a} / {b}")),
+            (inner.clone(), 0u32..5).prop_map(|(a, k)| format!("{a}^{k}")),
+            inner.clone().prop_map(|a| format!("exp({a})")),
+            inner.clone().prop_map(|a| format!("ln({a})")),
+            inner.clone().prop_map(|a| format!("sqrt({a})")),
+            inner.clone().prop_map(|a| format!("tanh({a})")),
+            inner.prop_map(|a| format!("-{a}")),
+        ]
+    });
+    prop_oneof![
+        8 => tree,
+        // admissible laws, so that some text laws reach the closed form and the run
+        4 => prop_oneof![
+            Just("(I1 - 3) / 2".to_string()),
+            Just("(I1 - 3) / 2 + 0.1 * (I2 - 3)".to_string()),
+            Just("(I1 - 3) / 2 + 0.01 * (I1 - 3)^2 + 1e-4 * (I1 - 3)^3".to_string()),
+            (0.05f64..1.0).prop_map(|c| format!("(I1 - 3) / 2 + {c} * (I1 - 3)^2")),
+        ],
+        // the probe's shapes: deep, long, a near-miss of a known law
+        1 => (1usize..400).prop_map(|n| format!("{}(I1 - 3){}", "(".repeat(n), ")".repeat(n))),
+        1 => (1usize..30000).prop_map(|n| vec!["(I1 - 3)"; n].join(" + ")),
+        1 => Just("-(jm / 2) * ln(1 - (I1 - 3) / jm)".to_string()),
+        1 => Just("(I1 - 3) / 2 + ".to_string()),
+        1 => Just("1e150*(I1-3)^2".to_string()),
+    ]
+}
+
+/// A `[material]` table's body with an energy written as text, by invariants or by principal
+/// stretches.
+fn text_law() -> impl Strategy<Value = String> {
+    (energy(), any::<bool>()).prop_map(|(e, principal)| {
+        if principal {
+            format!(
+                "model = \"principal\"\nshear_modulus = 1.0\nenergy = \"{}\"",
+                e.replace("I1", "l").replace("I2", "l")
+            )
+        } else {
+            format!(
+                "model = \"invariants\"\nshear_modulus = 1.0\nparameters = {{ jm = 40 }}\nenergy = \"{e}\""
+            )
+        }
+    })
+}
+
 fn material() -> impl Strategy<Value = String> {
     prop_oneof![
-        (number()).prop_map(|k| format!("model = \"abb\"\nshear_modulus = 1.0\nkuhn = {k}")),
-        (number())
+        3 => text_law(),
+        3 => (number()).prop_map(|k| format!("model = \"abb\"\nshear_modulus = 1.0\nkuhn = {k}")),
+        2 => (number())
             .prop_map(|a| format!("model = \"mooney-rivlin\"\nshear_modulus = 1.0\nalpha = {a}")),
-        Just("model = \"neo-hookean\"\nshear_modulus = 1.0".to_string()),
-        Just("model = \"abb\"".to_string()),
-        Just("model = \"rubber\"\nshear_modulus = 1.0".to_string()),
+        2 => Just("model = \"neo-hookean\"\nshear_modulus = 1.0".to_string()),
+        1 => Just("model = \"abb\"".to_string()),
+        1 => Just("model = \"rubber\"\nshear_modulus = 1.0".to_string()),
     ]
 }
 
@@ -130,15 +198,82 @@ fn stage() -> impl Strategy<Value = String> {
     ]
 }
 
-/// A whole case file, sometimes with a damaged line.
+/// A whole case file: half of them ordinary (a valid law, mesh and stages, so that the mesh,
+/// the model, the contact and the outputs are reached), half hostile.
 fn case_text() -> impl Strategy<Value = String> {
+    prop_oneof![1 => ordinary_case(), 1 => hostile_case()]
+}
+
+/// An ordinary case: an admissible law (a built-in one or an energy written as text), a small
+/// generated mesh, an inflation, then perhaps a squeeze or a confinement by two planes.
+fn ordinary_case() -> impl Strategy<Value = String> {
+    let law = prop_oneof![
+        Just("model = \"abb\"\nshear_modulus = 1.0\nkuhn = 30".to_string()),
+        Just("model = \"mooney-rivlin\"\nshear_modulus = 1.0\nalpha = 0.1".to_string()),
+        Just("model = \"neo-hookean\"\nshear_modulus = 1.0".to_string()),
+        (0.0f64..0.5).prop_map(|c| format!(
+            "model = \"invariants\"\nshear_modulus = 1.0\nenergy = \"(I1 - 3) / 2 + {c} * (I1 - 3)^2\""
+        )),
+        Just("model = \"principal\"\nshear_modulus = 1.0\nenergy = \"(l^2 - 1) / 2\"".to_string()),
+    ];
+    let mesh = (
+        prop_oneof![Just(8usize), Just(16)],
+        (2usize..9).prop_map(|k| 2 * k),
+        prop_oneof![Just("eighth"), Just("quarter"), Just("half")],
+        prop_oneof![
+            3 => Just(""),
+            1 => Just("\ntrack_contact_edge = true\nelement = \"quad9\""),
+            1 => Just("\nelement = \"quad9\""),
+        ],
+    )
+        .prop_map(|(a, l, s, x)| format!("around = {a}\nalong = {l}\nsymmetry = \"{s}\"{x}"));
+    let inflate = prop_oneof![
+        (1.05f64..1.8, 1usize..4).prop_map(|(v, n)| format!(
+            "[[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = {v}\nsteps = {n}"
+        )),
+        (0.05f64..1.0, 1usize..4).prop_map(|(v, n)| format!(
+            "[[stage]]\nkind = \"inflate\"\ncontrol = \"pressure\"\ntarget_pressure = {v}\nsteps = {n}"
+        )),
+    ];
+    let next = prop_oneof![
+        Just(String::new()),
+        (0.3f64..1.0, 1usize..4).prop_map(|(r, n)| format!(
+            "[[stage]]\nkind = \"squeeze\"\ntarget_rho = {r}\nsteps = {n}"
+        )),
+        (0.5f64..1.0, 1usize..4).prop_map(|(f, n)| format!(
+            "[[stage]]\nkind = \"confine\"\nsteps = {n}\n[[stage.plane]]\nnormal = [0, 1]\noffset = 2.0\ntarget = {f}\n[[stage.plane]]\nnormal = [0, -1]\noffset = 2.0\ntarget = {f}"
+        )),
+    ];
+    (0.5f64..3.0, 2.0f64..12.0, law, mesh, inflate, next).prop_map(|(r, l, law, mesh, i, n)| {
+        format!(
+            "[geometry]\nradius = {r}\nlength = {}\n[material]\n{law}\n[mesh]\n{mesh}\n{i}\n{n}\n",
+            l * r
+        )
+    })
+}
+
+/// A hostile case file, sometimes with a damaged line.
+fn hostile_case() -> impl Strategy<Value = String> {
+    // mostly ordinary radii and lengths, and one file in eight damaged, so that most inputs
+    // reach the mesh, the model and the run
+    let dimension = prop_oneof![6 => (0.5f64..3.0).prop_map(|v| format!("{v}")), 1 => number()];
     (
-        number(),
-        number(),
+        dimension.clone(),
+        dimension.prop_map(|l| l.replace("0.", "4.")),
         material(),
         mesh_table(),
-        prop::collection::vec(stage(), 0..4),
-        any::<bool>(),
+        // three inputs in four start with an ordinary inflation, so that later stages run
+        (
+            prop::option::weighted(
+                0.75,
+                (1.05f64..1.6, 1usize..4).prop_map(|(v, n)| format!(
+                    "[[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = {v}\nsteps = {n}"
+                )),
+            ),
+            prop::collection::vec(stage(), 0..3),
+        )
+            .prop_map(|(first, rest)| first.into_iter().chain(rest).collect::<Vec<_>>()),
+        prop::bool::weighted(0.125),
         0usize..400,
     )
         .prop_map(|(r, l, mat, mesh, stages, damage, at)| {
@@ -211,8 +346,9 @@ fn mesh_json() -> impl Strategy<Value = String> {
 
 static SEQ: AtomicUsize = AtomicUsize::new(0);
 
-/// Run one input; a panic or a NaN in a message or a finished run's numbers fails.
-fn check(text: &str, mesh: &str) -> Result<(), TestCaseError> {
+/// Run one input; a panic or a NaN in a message or a finished run's numbers fails. `Ok(true)`
+/// when the run finished, `Ok(false)` when it was refused or stopped with a good message.
+fn check(text: &str, mesh: &str) -> Result<bool, TestCaseError> {
     let dir = std::env::temp_dir().join(format!(
         "tubemem-fuzz-{}-{}",
         std::process::id(),
@@ -264,44 +400,75 @@ fn check(text: &str, mesh: &str) -> Result<(), TestCaseError> {
             "panic on input:\n{text}\n--- mesh:\n{mesh}"
         ))),
         Ok(Err(msg)) => {
-            prop_assert!(!msg.trim().is_empty(), "empty error message for:\n{}", text);
-            // a NaN in a message is a missing check upstream, unless it is the user's own value
-            prop_assert!(
-                !msg.contains("NaN") || text.contains("nan"),
-                "NaN in the message `{}` for:\n{}",
-                msg,
-                text
-            );
-            let digits = msg
-                .split(|c: char| !c.is_ascii_digit())
-                .map(str::len)
-                .max()
-                .unwrap_or(0);
-            prop_assert!(
-                digits <= 20,
-                "a number of {} digits in the message `{}` for:\n{}",
-                digits,
-                msg,
-                text
-            );
-            Ok(())
+            if std::env::var_os("TUBEMEM_FUZZ_SHOW").is_some() {
+                eprintln!(
+                    "REFUSED: {}",
+                    msg.chars()
+                        .take(600)
+                        .collect::<String>()
+                        .replace('\n', " / ")
+                );
+            }
+            check_message(&msg, text).map(|()| false)
         }
         Ok(Ok(summary)) => {
-            fn finite(v: &serde_json::Value) -> bool {
-                match v {
-                    serde_json::Value::Number(n) => n.as_f64().is_some_and(f64::is_finite),
-                    serde_json::Value::Array(a) => a.iter().all(finite),
-                    serde_json::Value::Object(o) => o.values().all(finite),
-                    _ => true,
-                }
-            }
             prop_assert!(
                 finite(&summary),
                 "a non-finite number in the summary of:\n{}",
                 text
             );
-            Ok(())
+            Ok(true)
         }
+    }
+}
+
+/// An error message: not empty, no `NaN` unless the input has one, no run of more than 20
+/// digits, and no line longer than the longest a message may quote (an echoed input is cut).
+fn check_message(msg: &str, full_input: &str) -> Result<(), TestCaseError> {
+    let input: String = full_input.chars().take(3000).collect();
+    prop_assert!(
+        !msg.trim().is_empty(),
+        "empty error message for:\n{}",
+        input
+    );
+    // a NaN in a message is a missing check upstream, unless it is the user's own value or the
+    // message says that this value is what is wrong ("… is NaN, not a finite number")
+    let explained = msg.contains("not a finite number") || msg.contains("not finite");
+    prop_assert!(
+        !msg.contains("NaN") || full_input.to_lowercase().contains("nan") || explained,
+        "NaN in the message `{}` for:\n{}",
+        msg,
+        input
+    );
+    let digits = msg
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    prop_assert!(
+        digits <= 20,
+        "a number of {} digits in the message `{}` for:\n{}",
+        digits,
+        msg,
+        input
+    );
+    let longest = msg.lines().map(|l| l.chars().count()).max().unwrap_or(0);
+    prop_assert!(
+        longest <= tubemem_material::MAX_MESSAGE_LINE + 60,
+        "a message line of {} characters for an input of {} bytes",
+        longest,
+        input.len()
+    );
+    Ok(())
+}
+
+/// Every number in `v` finite.
+fn finite(v: &serde_json::Value) -> bool {
+    match v {
+        serde_json::Value::Number(n) => n.as_f64().is_some_and(f64::is_finite),
+        serde_json::Value::Array(a) => a.iter().all(finite),
+        serde_json::Value::Object(o) => o.values().all(finite),
+        _ => true,
     }
 }
 
@@ -337,18 +504,21 @@ fn no_input_makes_tubemem_panic() {
     // inputs drawn one by one, so that a long run stops at its deadline
     let strategy = (case_text(), mesh_json());
     let mut ran = 0u64;
+    let mut finished = 0u64;
     while ran < u64::from(cases) && t0.elapsed().as_secs() < seconds {
         let (text, mesh) = strategy
             .new_tree(&mut runner)
             .expect("the strategy always produces a value")
             .current();
         ran += 1;
-        if let Err(e) = check(&text, &mesh) {
-            panic!("fuzz input {ran} failed: {e}");
+        match check(&text, &mesh) {
+            Ok(done) => finished += u64::from(done),
+            Err(e) => panic!("fuzz input {ran} failed: {e}"),
         }
     }
     eprintln!(
-        "fuzz: {ran} inputs in {:.1} s, no failure",
+        "fuzz (runs): {ran} inputs ({finished} finished, {} refused or stopped with a message) in {:.1} s, no failure",
+        ran - finished,
         t0.elapsed().as_secs_f64()
     );
 }
@@ -395,4 +565,348 @@ fn reported_crash_inputs_are_errors_now() {
     for (text, mesh) in seeds {
         check(&text, &mesh).unwrap();
     }
+}
+
+/// A fit's test data as a CSV file (issue #61): headers in either order, with or without a
+/// unit, extra columns, decimal commas, text, non-finite and extreme values, a missing header.
+fn fit_csv() -> impl Strategy<Value = String> {
+    let header = prop_oneof![
+        Just("stretch,nominal_stress_mpa"),
+        Just("stretch,nominal_stress_kpa"),
+        Just("stretch,nominal_stress_pa"),
+        Just("nominal_stress_mpa,stretch"),
+        Just("stretch,nominal_stress"),
+        Just("stretch,stress_mpa,temperature"),
+        Just("time,stretch,nominal_stress_mpa"),
+        Just("a,b"),
+        Just(""),
+    ];
+    let value = prop_oneof![
+        6 => (0.0f64..3.0).prop_map(|v| format!("{v}")),
+        1 => Just("nan".to_string()),
+        1 => Just("inf".to_string()),
+        1 => Just("1e300".to_string()),
+        1 => Just("-1e300".to_string()),
+        1 => Just("0,5".to_string()),
+        1 => Just("x".to_string()),
+        1 => Just(String::new()),
+    ];
+    (
+        header,
+        prop::collection::vec((1.0f64..3.0, value.clone(), value), 0..12),
+        any::<bool>(),
+    )
+        .prop_map(|(h, rows, exact)| {
+            let mut t = format!("{h}\n");
+            for (l, a, b) in rows {
+                // exact data of a neo-Hookean law (μ = 0.3 MPa) are a fit's easiest input
+                if exact {
+                    t += &format!("{l},{}\n", 0.3 * (l - 1.0 / (l * l)));
+                } else if h.starts_with("time") {
+                    t += &format!("{a},{l},{b}\n");
+                } else {
+                    t += &format!("{l},{a}\n");
+                }
+            }
+            t
+        })
+}
+
+/// An atlas file: the CI atlas's template with its `[atlas]` keys drawn from ordinary and
+/// hostile values (empty lists, non-positive lengths, three-component normals, huge grids).
+fn atlas_text() -> impl Strategy<Value = String> {
+    let list = |ok: &'static str| {
+        prop_oneof![
+            4 => Just(ok.to_string()),
+            1 => Just("[]".to_string()),
+            1 => Just("[-1, 0]".to_string()),
+            1 => Just("[nan]".to_string()),
+            1 => Just("[1e308, 2e308]".to_string()),
+            1 => (2usize..2000).prop_map(|n| format!(
+                "[{}]",
+                (0..n).map(|i| format!("{}", 1.1 + i as f64 * 1e-3)).collect::<Vec<_>>().join(", ")
+            )),
+        ]
+    };
+    let extra = prop_oneof![
+        3 => Just(String::new()),
+        1 => Just("quantities = []".to_string()),
+        1 => Just("quantities = [\"w\", \"force\", \"nonsense\"]".to_string()),
+        1 => Just("max_runs = 0".to_string()),
+        1 => Just("max_runs = 3".to_string()),
+        1 => Just("[[atlas.plane]]\nnormal = [0, 1, 5]\noffset = 1.2".to_string()),
+        1 => Just("[[atlas.plane]]\nnormal = [0, 0]\noffset = 1.2".to_string()),
+        1 => Just("along_per_radius = 1e300".to_string()),
+    ];
+    (
+        list("[1.2, 1.3]"),
+        list("[1.0, 0.9]"),
+        list("[10, 20, 40]"),
+        list("[1e-2, 1e-3]"),
+        extra,
+    )
+        .prop_map(|(s, r, l, e, x)| {
+            let along = if x.starts_with("along") {
+                String::new()
+            } else {
+                "along_per_radius = 4\n".to_string()
+            };
+            format!(
+                "[geometry]\nradius = 1.0\nthickness = 0.01\ncaps = \"hemisphere\"\n[material]\nmodel = \"abb\"\nshear_modulus = 1.0\nkuhn = 30\n[mesh]\naround = 16\nsymmetry = \"eighth\"\n[atlas]\nstretches = {s}\nrho = {r}\nlengths = {l}\nepsilon = {e}\n{along}{x}\n"
+            )
+        })
+}
+
+/// A verification suite: checks whose names, kinds, tolerances and cases are drawn from
+/// ordinary and hostile values (names with dots and slashes, NaN or negative tolerances, a
+/// rel_err outside (0, 1), missing cases, duplicates).
+fn suite_text() -> impl Strategy<Value = String> {
+    let name = prop_oneof![
+        4 => "[a-z]{1,8}".prop_map(|s| s),
+        1 => Just("..".to_string()),
+        1 => Just(".".to_string()),
+        1 => Just("a/b".to_string()),
+        1 => Just("".to_string()),
+        1 => Just("ä ü".to_string()),
+    ];
+    let kind = prop_oneof![
+        Just("closed-form"),
+        Just("convergence"),
+        Just("reference"),
+        Just("gold"),
+        Just("invariance"),
+        Just("nonsense"),
+    ];
+    let tol = prop_oneof![
+        4 => (1e-6f64..1.0).prop_map(|v| format!("{{ value = {v}, source = \"fuzz\" }}")),
+        1 => Just("{ value = nan, source = \"fuzz\" }".to_string()),
+        1 => Just("{ value = -1.0, source = \"fuzz\" }".to_string()),
+        1 => Just("{ value = 1.0 }".to_string()),
+        1 => Just("1.0".to_string()),
+    ];
+    let case = prop_oneof![
+        4 => Just("case.toml"),
+        1 => Just("missing.toml"),
+        1 => Just("/dev/zero"),
+        1 => Just("."),
+    ];
+    let extra = prop_oneof![
+        4 => Just(String::new()),
+        1 => Just("rel_err = 2.0".to_string()),
+        1 => Just("rel_err = nan".to_string()),
+        1 => Just("abs_zero = -1.0".to_string()),
+        1 => Just("meshes = [8, 0]".to_string()),
+        1 => Just("start = -10".to_string()),
+        1 => Just("refinement = 1.0".to_string()),
+    ];
+    prop::collection::vec((name, kind, tol, case, extra), 0..5).prop_map(|checks| {
+        checks
+            .into_iter()
+            .map(|(n, k, t, c, x)| {
+                format!("[[check]]\nname = \"{n}\"\ncase = \"{c}\"\nkind = \"{k}\"\ntolerance.w = {t}\n{x}\n")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    })
+}
+
+/// One input of the library-level generators, in a scratch folder `dir`.
+#[derive(Debug, Clone)]
+enum LibraryInput {
+    /// a text law, then a closed-form inflation to `to` and a flattening to `rho`
+    Law(String, f64, f64),
+    Fit(String, &'static str),
+    Atlas(String),
+    Suite(String),
+}
+
+fn library_input() -> impl Strategy<Value = LibraryInput> {
+    prop_oneof![
+        3 => (text_law(), 1.0f64..8.0, 0.05f64..1.5).prop_map(|(l, t, r)| LibraryInput::Law(l, t, r)),
+        2 => (fit_csv(), prop_oneof![Just("neo-hookean"), Just("yeoh"), Just("mooney-rivlin"), Just("ogden")])
+            .prop_map(|(c, m)| LibraryInput::Fit(c, m)),
+        2 => atlas_text().prop_map(LibraryInput::Atlas),
+        2 => suite_text().prop_map(LibraryInput::Suite),
+    ]
+}
+
+/// Run one library-level input: a panic fails; an error must name its cause (as
+/// [`check_message`]); a returned closed-form state, fit or plan must be finite, and a
+/// returned closed-form state must be a tensed membrane under a non-negative pressure (issue
+/// #61: a compressive branch is reported as such, never returned).
+/// `Ok(true)` when the input was accepted, `Ok(false)` when it was refused with a good message.
+fn check_library(input: &LibraryInput, dir: &Path) -> Result<bool, TestCaseError> {
+    use tubemem_gps::Hypothesis;
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        dir.join("case.toml"),
+        include_str!("../../../cases/small_abb30_ls1.2.toml"),
+    )
+    .unwrap();
+    let started = Instant::now();
+    let full = format!("{input:?}");
+    let shown: String = full.chars().take(3000).collect();
+    let outcome = std::panic::catch_unwind(|| -> Result<serde_json::Value, String> {
+        match input {
+            LibraryInput::Law(body, to, rho) => {
+                let spec: tubemem_material::MaterialSpec = toml::from_str(body)
+                    .map_err(|e| tubemem_material::tidy_numbers(&e.to_string()))?;
+                let law = spec.build().map_err(|e| e.to_string())?;
+                let mut out = vec![];
+                for hyp in [Hypothesis::Gps, Hypothesis::Ps] {
+                    match tubemem_gps::inflation_curve(law.as_ref(), hyp, 1.0, *to, 4) {
+                        Ok(states) => {
+                            for s in &states {
+                                if s.n_s < 0.0 || s.w < 0.0 {
+                                    return Ok(
+                                        serde_json::json!({"compressive": true, "n_s": s.n_s, "w": s.w}),
+                                    );
+                                }
+                            }
+                            out.push(serde_json::to_value(&states).unwrap());
+                        }
+                        Err(e) => return Err(e.to_string()),
+                    }
+                    let initial = to.max(1.05);
+                    match tubemem_gps::flatten(law.as_ref(), hyp, initial, rho * initial) {
+                        Ok(s) => {
+                            if s.n_s < 0.0 || s.w < 0.0 {
+                                return Ok(
+                                    serde_json::json!({"compressive": true, "n_s": s.n_s, "w": s.w}),
+                                );
+                            }
+                            out.push(serde_json::to_value(s).unwrap());
+                        }
+                        Err(e) => return Err(e.to_string()),
+                    }
+                }
+                Ok(serde_json::Value::Array(out))
+            }
+            LibraryInput::Fit(csv, model) => {
+                let path = dir.join("data.csv");
+                std::fs::write(&path, csv).unwrap();
+                let file = tubemem_app::fit::read_test_file(
+                    &path,
+                    tubemem_material::fit::Mode::Uniaxial,
+                    None,
+                )
+                .map_err(|e| tubemem_app::error_chain(&e))?;
+                let data = [file.data];
+                let start = tubemem_app::fit::default_start(model, &data)
+                    .map_err(|e| tubemem_app::error_chain(&e))?;
+                let r = tubemem_app::fit::run_fit(&start, &data)
+                    .map_err(|e| tubemem_app::error_chain(&e))?;
+                Ok(serde_json::to_value(&r).unwrap())
+            }
+            LibraryInput::Atlas(text) => {
+                let atlas = tubemem_app::atlas::Atlas::parse(text, dir)
+                    .map_err(|e| tubemem_app::error_chain(&e))?;
+                // every member's case is a valid case (checked, not run)
+                for m in atlas.members.iter().take(50) {
+                    Case::parse(&m.case_text).map_err(|e| tubemem_app::error_chain(&e))?;
+                }
+                Ok(serde_json::json!({"members": atlas.members.len()}))
+            }
+            LibraryInput::Suite(text) => {
+                let path = dir.join("suite.toml");
+                std::fs::write(&path, text).unwrap();
+                let (_, checks) = tubemem_app::verify::suite::read_suite(&path)
+                    .map_err(|e| tubemem_app::error_chain(&e))?;
+                Ok(serde_json::json!({"checks": checks.len()}))
+            }
+        }
+    });
+    let seconds = started.elapsed().as_secs_f64();
+    prop_assert!(
+        seconds < 10.0,
+        "{seconds:.1} s (over the 10 s limit) for:\n{shown}"
+    );
+    match outcome {
+        Err(_) => Err(TestCaseError::fail(format!("panic on input:\n{shown}"))),
+        Ok(Err(msg)) => {
+            if std::env::var_os("TUBEMEM_FUZZ_SHOW").is_some() {
+                eprintln!(
+                    "REFUSED: {}",
+                    msg.chars()
+                        .take(600)
+                        .collect::<String>()
+                        .replace('\n', " / ")
+                );
+            }
+            check_message(&msg, &full).map(|()| false)
+        }
+        Ok(Ok(v)) => {
+            prop_assert!(
+                v.get("compressive").is_none(),
+                "a compressive closed-form state returned ({v}) for:\n{shown}"
+            );
+            prop_assert!(finite(&v), "a non-finite number in {v} for:\n{shown}");
+            Ok(true)
+        }
+    }
+}
+
+/// The library-level generators (issue #61): energies as text through the closed form, fit
+/// CSVs through the reader and the fit, atlas files through the planner, verify suites
+/// through the reader. 64 inputs in the test command (fixed seed); more with
+/// `TUBEMEM_FUZZ_CASES` and `TUBEMEM_FUZZ_SECONDS`, as the run-level test above.
+#[test]
+fn no_law_fit_atlas_or_suite_input_makes_tubemem_panic() {
+    let cases: u32 = std::env::var("TUBEMEM_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(64);
+    let seconds: u64 = std::env::var("TUBEMEM_FUZZ_SECONDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(600);
+    let t0 = Instant::now();
+    let config = Config {
+        cases,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let mut runner = if std::env::var_os("TUBEMEM_FUZZ_CASES").is_some() {
+        TestRunner::new(config)
+    } else {
+        TestRunner::new_with_rng(
+            config,
+            proptest::test_runner::TestRng::deterministic_rng(
+                proptest::test_runner::RngAlgorithm::ChaCha,
+            ),
+        )
+    };
+    let dir = std::env::temp_dir().join(format!("tubemem-fuzz-lib-{}", std::process::id()));
+    let strategy = library_input();
+    let mut counts = [0u64; 4];
+    let mut refused = 0u64;
+    let mut ran = 0u64;
+    while ran < u64::from(cases) && t0.elapsed().as_secs() < seconds {
+        let input = strategy
+            .new_tree(&mut runner)
+            .expect("the strategy always produces a value")
+            .current();
+        ran += 1;
+        counts[match input {
+            LibraryInput::Law(..) => 0,
+            LibraryInput::Fit(..) => 1,
+            LibraryInput::Atlas(_) => 2,
+            LibraryInput::Suite(_) => 3,
+        }] += 1;
+        match check_library(&input, &dir) {
+            Ok(accepted) => refused += u64::from(!accepted),
+            Err(e) => panic!("library fuzz input {ran} failed: {e}"),
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    eprintln!(
+        "fuzz (laws, fits, atlases, suites): {ran} inputs ({} laws, {} fits, {} atlases, {} suites; {} accepted, {refused} refused with a message) in {:.1} s, no failure",
+        counts[0],
+        counts[1],
+        counts[2],
+        counts[3],
+        ran - refused,
+        t0.elapsed().as_secs_f64()
+    );
 }

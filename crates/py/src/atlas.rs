@@ -56,9 +56,12 @@ pub(crate) fn atlas<'py>(
     atlas: PathBuf,
     out: PathBuf,
     client: Option<&Bound<'py, PyAny>>,
-    workers: Option<usize>,
+    workers: Option<&Bound<'py, PyAny>>,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let workers = workers
+        .map(|w| crate::convert::int_arg(w, "workers", 1, 4096, "at least 1 (and at most 4096)"))
+        .transpose()?;
     let text = tubemem_mesh::io::read_text_limited(&atlas, tubemem_app::case::MAX_CASE_FILE_BYTES)
         .map_err(|e| PyValueError::new_err(format!("cannot read {}: {e}", atlas.display())))?;
     let base = atlas
@@ -72,9 +75,6 @@ pub(crate) fn atlas<'py>(
             tubemem_app::error_chain(&e)
         ))
     })?;
-    if workers == Some(0) {
-        return Err(PyValueError::new_err("atlas: workers = 0: at least 1"));
-    }
     // what the end needs, checked before any member runs: the Dataset (xarray) and atlas.nc
     // (written with the scipy engine)
     for (module, why) in [

@@ -157,7 +157,8 @@ pub(crate) fn dict_message(msg: &str, text: &str) -> String {
             .strip_prefix("unknown field `")
             .and_then(|r| r.split('`').next())
         {
-            if !path.ends_with(&format!(".{key}")) {
+            // (a table's own header line names the key already: an unknown top-level table)
+            if path != key && !path.ends_with(&format!(".{key}")) {
                 path = format!("{path}.{key}");
             }
         }

@@ -190,40 +190,18 @@ pub(crate) fn curve_table<'py, S: Send>(
     Ok(Bound::new(py, Table::from_columns(py, cols)?)?.into_any())
 }
 
-/// A curve's `points` (default 100): any Python or numpy integer; a negative or huge one is a
-/// ValueError naming it (not an OverflowError of the conversion), a non-integer a TypeError.
+/// A curve's `points` (default 100): at least 2, at most [`tubemem_gps::MAX_CURVE_POINTS`].
 pub(crate) fn point_count(points: Option<&Bound<'_, PyAny>>) -> PyResult<usize> {
     let Some(p) = points else {
         return Ok(100);
     };
-    if p.is_instance_of::<pyo3::types::PyBool>() {
-        return Err(pyo3::exceptions::PyTypeError::new_err(
-            "points: an integer number of points, not a bool",
-        ));
-    }
-    let n: i128 = match p.call_method0("__index__").and_then(|i| i.extract::<i64>()) {
-        Ok(n) => n.into(),
-        // an integer beyond i64 (its __index__ works, the conversion overflows)
-        Err(_) if p.call_method0("__index__").is_ok() => i128::MAX,
-        Err(_) => {
-            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-                "points = {p}: an integer number of points"
-            )))
-        }
-    };
-    if n < 2 {
-        return Err(PyValueError::new_err(format!(
-            "points = {p}: a curve needs at least 2 points"
-        )));
-    }
-    usize::try_from(n)
-        .ok()
-        .filter(|&n| n <= tubemem_gps::MAX_CURVE_POINTS)
-        .ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "points = {p}: a curve may have at most 10,000,000 points"
-            ))
-        })
+    crate::convert::int_arg(
+        p,
+        "points",
+        2,
+        tubemem_gps::MAX_CURVE_POINTS,
+        "a curve needs at least 2 points and may have at most 10,000,000 points",
+    )
 }
 
 /// `points` free-inflation states equally spaced in λs from `stretch_from` to `stretch_to`: a

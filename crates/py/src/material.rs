@@ -212,7 +212,7 @@ fn test_data(
 /// `evaluations`, `warnings` and `stress_unit` ("Pa" where the files' headers named a unit and
 /// the moduli are in Pa; None where the data's numbers were taken as they are).
 #[pyfunction]
-#[pyo3(signature = (law, uniaxial=None, equibiaxial=None, pure_shear=None, fix=None, bounds=None, starts=tubemem_material::fit::DEFAULT_STARTS))]
+#[pyo3(signature = (law, uniaxial=None, equibiaxial=None, pure_shear=None, fix=None, bounds=None, starts=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit<'py>(
     py: Python<'py>,
@@ -222,8 +222,18 @@ pub(crate) fn fit<'py>(
     pure_shear: Option<&Bound<'py, PyAny>>,
     fix: Option<std::collections::BTreeMap<String, f64>>,
     bounds: Option<std::collections::BTreeMap<String, (f64, f64)>>,
-    starts: usize,
+    starts: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let starts = match starts {
+        None => tubemem_material::fit::DEFAULT_STARTS,
+        Some(s) => crate::convert::int_arg(
+            s,
+            "starts",
+            0,
+            10_000,
+            "the number of starts besides the law's own, from 0 to 10,000",
+        )?,
+    };
     let mut data = vec![];
     let mut named = vec![];
     for (arg, mode, what) in [

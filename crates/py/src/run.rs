@@ -270,7 +270,14 @@ impl Run {
         self.steps.borrow(py).to_pandas(py)
     }
     /// The VTU file of frame `k` (0: the reference state; k: after the k-th converged step).
-    fn vtu(&self, k: usize) -> PyResult<PathBuf> {
+    fn vtu(&self, k: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+        let k = crate::convert::int_arg(
+            k,
+            "k",
+            0,
+            usize::MAX,
+            &format!("the run has frames 0 to {}", self.frames.saturating_sub(1)),
+        )?;
         if k >= self.frames {
             return Err(PyValueError::new_err(format!(
                 "frame {k}: the run has frames 0 to {}",

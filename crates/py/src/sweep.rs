@@ -177,10 +177,16 @@ pub(crate) fn sweep<'py>(
     out: PathBuf,
     params: Option<&Bound<'py, PyAny>>,
     client: Option<&Bound<'py, PyAny>>,
-    workers: Option<usize>,
+    workers: Option<&Bound<'py, PyAny>>,
     progress: Option<&Bound<'py, PyAny>>,
-    processes: Option<usize>,
+    processes: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let count = |v: Option<&Bound<'py, PyAny>>, name: &str| {
+        v.map(|w| crate::convert::int_arg(w, name, 1, 4096, "at least 1 (and at most 4096)"))
+            .transpose()
+    };
+    let workers = count(workers, "workers")?;
+    let processes = count(processes, "processes")?;
     let mut texts = vec![];
     for (i, c) in cases.try_iter()?.enumerate() {
         let c = c?;

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 /// `TUBEMEM_PYTHON_REF`, else a checkout's above the case or the working folder). `epsilon`
 /// (with `case=`) is the accuracy asked for, relative (default 1e-3), as `--epsilon`.
 #[pyfunction]
-#[pyo3(signature = (suites=None, out=PathBuf::from("tubemem-verify"), case=None, quick=false, jobs=0, filter=None, update_gold=false, python=None, python_ref=None, epsilon=None))]
+#[pyo3(signature = (suites=None, out=PathBuf::from("tubemem-verify"), case=None, quick=false, jobs=None, filter=None, update_gold=false, python=None, python_ref=None, epsilon=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn verify<'py>(
     py: Python<'py>,
@@ -25,7 +25,7 @@ pub(crate) fn verify<'py>(
     out: PathBuf,
     case: Option<PathBuf>,
     quick: bool,
-    jobs: usize,
+    jobs: Option<&Bound<'py, PyAny>>,
     filter: Option<String>,
     update_gold: bool,
     python: Option<PathBuf>,
@@ -33,6 +33,18 @@ pub(crate) fn verify<'py>(
     epsilon: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     use tubemem_app::verify::{self as v, report::Results, VerifyOptions};
+    let jobs = jobs
+        .map(|j| {
+            crate::convert::int_arg(
+                j,
+                "jobs",
+                0,
+                4096,
+                "the checks run at once, from 0 (one per core) to 4096",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0);
     let python = match python {
         Some(p) => Some(p),
         None => Some(

@@ -284,7 +284,8 @@ def test_the_closed_form_takes_arrays_and_agrees_with_the_scalar_calls():
         v["pressure"]
     with pytest.raises(ValueError, match=r"stretch\[1\] = 0.5"):
         tubemem.gps_inflate(np.array([1.2, 0.5]))
-    with pytest.raises(ValueError, match="a number or an array"):
+    # a string is the wrong type (issue #61: "1.3" had been taken as 1.3)
+    with pytest.raises(TypeError, match="a number or an array"):
         tubemem.gps_inflate("abc")
 
 
@@ -584,7 +585,7 @@ def test_numpy_integers_and_strided_arrays_are_taken_as_numpy_users_pass_them():
     t = tubemem.gps_inflation_curve(1.5, points=np.int64(7)).to_pandas()
     assert len(t) == 7
     assert len(tubemem.gps_inflation_curve(1.5).to_pandas()) == 100
-    with pytest.raises(TypeError, match="an integer number of points"):
+    with pytest.raises(TypeError, match="points = 2.5: an integer"):
         tubemem.gps_inflation_curve(1.5, points=2.5)
 
 
@@ -761,6 +762,9 @@ def test_fit_takes_files_or_arrays_and_says_what_the_data_do_not_determine():
     r = tubemem.fit({"model": "svk", "young_modulus": 2.0, "poisson_ratio": 0.2}, uniaxial=np.c_[l, p])
     assert any("poisson_ratio" in w for w in r["warnings"]), r["warnings"]
     with pytest.raises(ValueError, match="more points than parameters"):
+        tubemem.fit("yeoh", uniaxial=([1.1, 1.2], [0.1, 0.2]))
+    # a 2 × 2 array reads either way (issue #61): refused, with the tuple to give instead
+    with pytest.raises(ValueError, match="2 × 2 array is ambiguous"):
         tubemem.fit("yeoh", uniaxial=np.c_[[1.1, 1.2], [0.1, 0.2]])
     with pytest.raises(ValueError, match="give test data"):
         tubemem.fit("yeoh")

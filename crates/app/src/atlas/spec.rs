@@ -150,6 +150,11 @@ fn bad(key: &str, message: impl Into<String>) -> AtlasError {
     }
 }
 
+/// `n` with its noun: "1 stretch", "2 stretches".
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 /// A name part for a number: 1.3 → "1.3", 40 → "40".
 fn tag(v: f64) -> String {
     format!("{v}")
@@ -212,14 +217,20 @@ impl Atlas {
             };
             spec.quantities = q.iter().map(|s| s.to_string()).collect();
         }
+        if spec.max_runs == 0 {
+            return Err(bad(
+                "atlas.max_runs",
+                "= 0 allows no run: give the most member runs the atlas may start (≥ 1), or leave the key out for 1000",
+            ));
+        }
         let runs = spec.stretches.len().saturating_mul(spec.lengths.len());
         if runs > spec.max_runs {
             return Err(bad(
                 "atlas.max_runs",
                 &format!(
-                    "the grid has {} stretches × {} lengths = {runs} member runs, more than max_runs = {}: check the grid, or raise `max_runs` to run it on purpose",
-                    spec.stretches.len(),
-                    spec.lengths.len(),
+                    "the grid has {} × {} = {runs} member runs, more than max_runs = {}: check the grid, or raise `max_runs` to run it on purpose",
+                    count(spec.stretches.len(), "stretch", "stretches"),
+                    count(spec.lengths.len(), "length", "lengths"),
                     spec.max_runs
                 ),
             ));
