@@ -465,10 +465,24 @@ fn bad_laws_are_refused_with_their_reason() {
             PrincipalLaw::new("(I1 - 3)", &BTreeMap::new(), 1.0).map(|l| Box::new(l) as _),
             "the variables are l",
         ),
+        // found by the fuzz run (issue #61): minors of a 1e150 tangent overflowed to NaN; now
+        // those of ℂ / max|ℂij|, each finite
+        (
+            PrincipalLaw::new("1e150*(l-3)^2", &BTreeMap::new(), 1.0).map(|l| Box::new(l) as _),
+            "leading minors of ℂ / 4.000e150: -1.000e0",
+        ),
+        (
+            InvariantLaw::new("-1e150 * (I1 - 3)", &BTreeMap::new(), 1.0)
+                .map(|l| Box::new(l) as _),
+            "not positive definite",
+        ),
     ];
     for (r, needle) in cases {
         let msg = r.expect_err(needle).to_string();
         assert!(msg.contains(needle), "expected `{needle}` in: {msg}");
+        if msg.contains("leading minors") {
+            assert!(!msg.contains("NaN") && !msg.contains("inf"), "{msg}");
+        }
     }
     // locking is a typed error at the limit
     assert!(matches!(

@@ -50,16 +50,38 @@ fn check_reference(law: &dyn MembraneLaw) -> Result<(), MaterialError> {
             "it cannot be evaluated at the reference state ({e})"
         ))
     })?;
-    // ℂ at C = I in Voigt form: positive definite when its leading minors are
-    let c = t.tangent;
+    // ℂ at C = I in Voigt form: positive definite when its leading minors are; taken of
+    // ℂ / max|ℂij| (the same signs), so that an energy of 1e150 does not overflow them
+    let scale = t
+        .tangent
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    if !scale.is_finite() {
+        return Err(inadmissible(
+            "its tangent at the reference state is not finite".to_string(),
+        ));
+    }
+    let s = if scale > 0.0 { scale } else { 1.0 };
+    let c = t.tangent.map(|row| row.map(|v| v / s));
     let m1 = c[0][0];
     let m2 = c[0][0] * c[1][1] - c[0][1] * c[1][0];
     let m3 = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1])
         - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
         + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
     if !(m1 > 0.0 && m2 > 0.0 && m3 > 0.0) {
+        // the minors as they are, or of ℂ / max|ℂij| where they would overflow
+        let whole = [m1 * s, m2 * s * s, m3 * s * s * s];
+        let minors = if whole.iter().all(|m| m.is_finite()) {
+            format!(
+                "leading minors {:.3e}, {:.3e}, {:.3e}",
+                whole[0], whole[1], whole[2]
+            )
+        } else {
+            format!("leading minors of ℂ / {s:.3e}: {m1:.3e}, {m2:.3e}, {m3:.3e}")
+        };
         return Err(inadmissible(format!(
-            "its tangent at the reference state is not positive definite (leading minors {m1:.3e}, {m2:.3e}, {m3:.3e}): the unstretched membrane would not resist every small deformation (is the sign of the energy right, and its modulus positive?)"
+            "its tangent at the reference state is not positive definite ({minors}): the unstretched membrane would not resist every small deformation (is the sign of the energy right, and its modulus positive?)"
         )));
     }
     Ok(())
