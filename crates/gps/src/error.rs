@@ -38,7 +38,8 @@ pub enum GpsError {
     },
     /// Newton did not converge, even after step cut-back.
     #[error(
-        "{stage} did not converge at {at}: residual {residual:.3e} after {iterations} iterations"
+        "{stage} did not converge at {at}: {}",
+        residual_words(*residual, *iterations)
     )]
     NoConvergence {
         stage: &'static str,
@@ -46,6 +47,18 @@ pub enum GpsError {
         residual: f64,
         iterations: usize,
     },
+}
+
+/// The residual of a Newton solve that did not converge, in words: a non-finite one says that
+/// the equations could not be evaluated (never "residual NaN").
+fn residual_words(residual: f64, iterations: usize) -> String {
+    if residual.is_finite() {
+        format!("residual {residual:.3e} after {iterations} iterations")
+    } else {
+        format!(
+            "the equations could not be evaluated after {iterations} iterations (the residual is not a finite number: the law's stress or tangent overflows, vanishes or is undefined on this path)"
+        )
+    }
 }
 
 pub(crate) fn invalid(name: &'static str, value: f64, requirement: &'static str) -> GpsError {

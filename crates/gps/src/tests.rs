@@ -506,3 +506,40 @@ fn appendix_f_initial_slopes_of_svk_for_three_poisson_ratios() {
         assert!(rel(ps, eq102) < 1e-6, "ν = {nu}: {ps} vs eq. 102 {eq102}");
     }
 }
+
+/// Found by the fuzz run (issue #61): a law whose stress saturates (W = tanh(I2 (I1 − 3)))
+/// flattened from λs* = 7.75 made the flattening's residual NaN, printed as "residual NaN".
+/// The failure is still reported (there is no tensile state to find), now in words and with
+/// no NaN.
+#[test]
+fn a_flattening_whose_equations_cannot_be_evaluated_says_so_without_nan() {
+    let law = tubemem_material::laws::expression::InvariantLaw::new(
+        "tanh(I2 * (I1 - 3))",
+        &std::collections::BTreeMap::new(),
+        1.0,
+    )
+    .unwrap();
+    let initial = 7.75374362545259;
+    match flatten(
+        &law,
+        Hypothesis::Gps,
+        initial,
+        0.05108719656971267 * initial,
+    ) {
+        Ok(s) => assert!(
+            s.w.is_finite() && s.n_s >= 0.0 && s.force.is_finite(),
+            "{s:?}"
+        ),
+        Err(e) => {
+            let msg = e.to_string();
+            assert!(!msg.contains("NaN"), "{msg}");
+        }
+    }
+    let e = GpsError::NoConvergence {
+        stage: "flattening",
+        at: "ρ = 1".into(),
+        residual: f64::NAN,
+        iterations: 1,
+    };
+    assert!(e.to_string().contains("could not be evaluated"), "{e}");
+}

@@ -472,8 +472,7 @@ fn bad_laws_are_refused_with_their_reason() {
             "leading minors of ℂ / 4.000e150: -1.000e0",
         ),
         (
-            InvariantLaw::new("-1e150 * (I1 - 3)", &BTreeMap::new(), 1.0)
-                .map(|l| Box::new(l) as _),
+            InvariantLaw::new("-1e150 * (I1 - 3)", &BTreeMap::new(), 1.0).map(|l| Box::new(l) as _),
             "not positive definite",
         ),
     ];

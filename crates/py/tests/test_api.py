@@ -261,6 +261,56 @@ def test_ctrl_c_interrupts_a_run_within_seconds_and_keeps_its_steps(tmp_path):
     assert '"interrupted"' in (out / "run.json").read_text()
 
 
+def test_ctrl_c_interrupts_verify_within_a_second_and_keeps_its_report(tmp_path):
+    """Issue #61: `tubemem.verify` had ignored Ctrl-C until every check had run, then lost the
+    result. A process verifying a suite of long checks is sent SIGINT once the first check is
+    running: it raises KeyboardInterrupt within a second (the checks stop at their next Newton
+    iteration; the wait is polled every 50 ms), and results.json is written."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    case = (
+        SMALL.replace("steps = 4", "steps = 2000")
+        .replace("around = 16", "around = 64")
+        .replace("along = 24", "along = 192")
+    )
+    (tmp_path / "case.toml").write_text(case)
+    suite = tmp_path / "suite.toml"
+    suite.write_text(
+        "".join(
+            f'[[check]]\nname = "c{i}"\ncase = "case.toml"\nkind = "closed-form"\n'
+            'tolerance.w = { value = 1.0, source = "test" }\n\n'
+            for i in range(3)
+        )
+    )
+    out = tmp_path / "v"
+    script = (
+        "import signal\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "import tubemem, sys\n"
+        "try:\n"
+        f"    tubemem.verify([{str(suite)!r}], out={str(out)!r}, jobs=1)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(3)\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    t0 = time.time()
+    # the first check's run writes its steps: it is running
+    while time.time() - t0 < 60 and not (out / "c0" / "run" / "steps.csv").exists():
+        time.sleep(0.01)
+    assert (out / "c0" / "run" / "steps.csv").exists()
+    t1 = time.time()
+    p.send_signal(signal.SIGINT)
+    stdout, _ = p.communicate(timeout=30)
+    elapsed = time.time() - t1
+    assert p.returncode == 3 and "interrupted" in stdout, stdout
+    assert elapsed < 1.0, f"{elapsed:.2f} s from Ctrl-C to the prompt"
+    assert (out / "results.json").exists()
+
+
 def test_the_closed_form_takes_arrays_and_agrees_with_the_scalar_calls():
     import numpy as np
 
