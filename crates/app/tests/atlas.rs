@@ -113,6 +113,22 @@ fn the_ci_atlas_predicts_lengths_it_did_not_run() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("outside the atlas's grid"), "{e}");
+    // issue #61: below every length run the end-effect law is not known (refused); beyond the
+    // longest it is the law's extrapolation (answered, and marked so)
+    let e = atlas::predict::predict(&json, 1.3, 0.8, 0.001)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("below every length the atlas ran"), "{e}");
+    assert_eq!(at[0].length_extent, atlas::fit::Extent::Within);
+    let far = atlas::predict::predict(&json, 1.3, 0.8, 400.0).unwrap();
+    assert_eq!(far[0].length_extent, atlas::fit::Extent::BeyondRuns);
+    // atlas.csv says where each minimum length lies against the runs
+    let table = String::from_utf8(csv.clone()).unwrap();
+    assert!(table
+        .lines()
+        .next()
+        .unwrap()
+        .contains("min_length_ratio,min_length_extent,"));
     std::fs::remove_dir_all(&out).unwrap();
 }
 
@@ -303,6 +319,85 @@ symmetry = "eighth"
     assert!(e.to_string().contains("holds no atlas"), "{e}");
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
     std::fs::remove_dir_all(&out).unwrap();
+    // issue #61: the grid's size is guarded before any member is built; an empty quantity
+    // list and a plane normal of three components are refused
+    let big: Vec<String> = (0..400)
+        .map(|i| format!("{}", 1.1 + 1e-3 * f64::from(i)))
+        .collect();
+    let e = err(&ok.replace("[1.3]", &format!("[{}]", big.join(", "))));
+    assert!(
+        e.contains("atlas.max_runs") && e.contains("400 stretches × 3 lengths = 1200"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "{ok}max_runs = 2
+"
+    ));
+    assert!(
+        e.contains("1 stretch × 3 lengths = 3") && e.contains("max_runs = 2"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "{ok}max_runs = 0
+"
+    ));
+    assert!(
+        e.contains("atlas.max_runs") && e.contains("allows no run"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "{ok}quantities = []
+"
+    ));
+    assert!(
+        e.contains("atlas.quantities") && e.contains("is empty"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "{ok}{}",
+        planes.replacen("[0, 1]", "[0, 1, 5]", 1)
+    ));
+    assert!(
+        e.contains("line 17") && e.contains("normal") && e.contains("has 3 components"),
+        "{e}"
+    );
+}
+
+/// Issue #61: two atlases into one folder had failed each other's members; the folder is now
+/// locked while an atlas writes into it, the second refused naming the holder, and free again
+/// once the first lets go (as when its process ends, however it ends).
+#[test]
+fn an_atlas_folder_is_locked_while_an_atlas_writes_into_it() {
+    let (_, text) = ci_atlas();
+    let out = tmp("lock");
+    let first = atlas::prepare(&text, &out).unwrap();
+    let e = atlas::prepare(&text, &out).err().unwrap();
+    let msg = tubemem_app::error_chain(&e);
+    assert!(
+        msg.contains("another tubemem command")
+            && msg.contains(&format!("pid {}", std::process::id())),
+        "{msg}"
+    );
+    drop(first);
+    let again = atlas::prepare(&text, &out).unwrap();
+    drop(again);
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Issue #61: the missing members of an interrupted atlas are summarised, not listed (9,867
+/// names had been printed).
+#[test]
+fn missing_members_are_summarised() {
+    let names: Vec<String> = (0..9867).map(|i| format!("ls1.{i}_lr10")).collect();
+    let s = atlas::missing_summary(&names);
+    assert!(
+        s.len() < 400 && s.contains("9864 more") && s.contains("ls1.0_lr10"),
+        "{s}"
+    );
+    assert_eq!(
+        atlas::missing_summary(&names[..2]).matches("_lr10").count(),
+        2
+    );
 }
 
 /// The `atlas-point` verify kind through a suite, as a user writes it: a coarse atlas (its

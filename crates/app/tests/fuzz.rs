@@ -472,26 +472,20 @@ fn finite(v: &serde_json::Value) -> bool {
     }
 }
 
-/// The generated inputs: 48 in the test command, more with `TUBEMEM_FUZZ_CASES`, for at most
-/// `TUBEMEM_FUZZ_SECONDS`.
-#[test]
-fn no_input_makes_tubemem_panic() {
-    let cases: u32 = std::env::var("TUBEMEM_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(48);
-    let seconds: u64 = std::env::var("TUBEMEM_FUZZ_SECONDS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(600);
-    let t0 = Instant::now();
+/// The runner of a fuzz test, its number of inputs and its time limit: `default_cases` inputs
+/// from a fixed seed in the test command; with `TUBEMEM_FUZZ_CASES` (and `TUBEMEM_FUZZ_SECONDS`,
+/// default 600) a long run from a fresh seed, which explores.
+fn fuzz_runner(default_cases: u32) -> (TestRunner, u32, u64) {
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u64>().ok());
+    let cases =
+        env("TUBEMEM_FUZZ_CASES").map_or(default_cases, |c| c.min(u64::from(u32::MAX)) as u32);
+    let seconds = env("TUBEMEM_FUZZ_SECONDS").unwrap_or(600);
     let config = Config {
         cases,
         failure_persistence: None,
         ..Config::default()
     };
-    // the short run of the test command is deterministic (a fixed seed); a long run explores
-    let mut runner = if std::env::var_os("TUBEMEM_FUZZ_CASES").is_some() {
+    let runner = if std::env::var_os("TUBEMEM_FUZZ_CASES").is_some() {
         TestRunner::new(config)
     } else {
         TestRunner::new_with_rng(
@@ -501,6 +495,15 @@ fn no_input_makes_tubemem_panic() {
             ),
         )
     };
+    (runner, cases, seconds)
+}
+
+/// The generated inputs: 48 in the test command, more with `TUBEMEM_FUZZ_CASES`, for at most
+/// `TUBEMEM_FUZZ_SECONDS`.
+#[test]
+fn no_input_makes_tubemem_panic() {
+    let (mut runner, cases, seconds) = fuzz_runner(48);
+    let t0 = Instant::now();
     // inputs drawn one by one, so that a long run stops at its deadline
     let strategy = (case_text(), mesh_json());
     let mut ran = 0u64;
@@ -557,6 +560,15 @@ fn reported_crash_inputs_are_errors_now() {
         // towards 1e308 for over ten minutes and the locator ignored the interrupt
         (
             "[geometry]\nradius = 2.3874449059406295\nlength = 1.0486937012836541\n[material]\nmodel = \"abb\"\nshear_modulus = 1.0\nkuhn = 77\n[mesh]\naround = 8\nalong = 16\nsymmetry = \"quarter\"\nfit_contact_edge = true\n[[stage]]\nkind = \"inflate\"\ncontrol = \"pressure\"\ntarget_pressure = 1e308\nsteps = 2\n[[stage]]\nkind = \"squeeze\"\ntarget_rho = 1.7142699393509986\nsteps = 4\n".to_string(),
+            String::new(),
+        ),
+        // found by the 30-minute run of 2026-12-07: a principal energy of 7000 terms; the
+        // run's closed-form limit-point scan took minutes and ignored the interrupt (28 s here)
+        (
+            format!(
+                "[geometry]\nradius = 1.14\nlength = 2.1\n[material]\nmodel = \"principal\"\nshear_modulus = 1.0\nenergy = \"{}\"\n[mesh]\naround = 16\nalong = 12\nsymmetry = \"eighth\"\n[[stage]]\nkind = \"inflate\"\ncontrol = \"volume\"\ntarget_stretch = 1.59\nsteps = 3\n",
+                vec!["(l - 3)"; 7000].join(" + ")
+            ),
             String::new(),
         ),
         // a case file that is /dev/zero is covered by `Case::read`'s size limit; a mesh file too
@@ -853,30 +865,8 @@ fn check_library(input: &LibraryInput, dir: &Path) -> Result<bool, TestCaseError
 /// `TUBEMEM_FUZZ_CASES` and `TUBEMEM_FUZZ_SECONDS`, as the run-level test above.
 #[test]
 fn no_law_fit_atlas_or_suite_input_makes_tubemem_panic() {
-    let cases: u32 = std::env::var("TUBEMEM_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(64);
-    let seconds: u64 = std::env::var("TUBEMEM_FUZZ_SECONDS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(600);
+    let (mut runner, cases, seconds) = fuzz_runner(64);
     let t0 = Instant::now();
-    let config = Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    };
-    let mut runner = if std::env::var_os("TUBEMEM_FUZZ_CASES").is_some() {
-        TestRunner::new(config)
-    } else {
-        TestRunner::new_with_rng(
-            config,
-            proptest::test_runner::TestRng::deterministic_rng(
-                proptest::test_runner::RngAlgorithm::ChaCha,
-            ),
-        )
-    };
     let dir = std::env::temp_dir().join(format!("tubemem-fuzz-lib-{}", std::process::id()));
     let strategy = library_input();
     let mut counts = [0u64; 4];

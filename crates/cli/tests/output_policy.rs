@@ -187,6 +187,26 @@ fn inputs(dir: &Path) {
     std::fs::write(dir.join("atlas.toml"), atlas).unwrap();
 }
 
+/// A command line of the property below with its placeholders filled in: `OUT` the output,
+/// `OUTDIR` a run folder, `SIDE.x` a second output, `IN_name` the input `name` in `d` (the fit's
+/// data as data.svg where `data_svg`).
+fn expand(args: &[&str], d: &Path, out: &Path, data_svg: bool) -> Vec<String> {
+    let path = |p: std::path::PathBuf| p.to_str().unwrap().to_string();
+    args.iter()
+        .map(|a| match *a {
+            "OUT" => path(out.to_path_buf()),
+            "OUTDIR" => path(d.join("run")),
+            "SIDE.svg" => path(d.join("side.svg")),
+            "SIDE.csv" => path(d.join("side.csv")),
+            a => match a.strip_prefix("IN_") {
+                Some("data.csv") if data_svg => path(d.join("data.svg")),
+                Some(name) => path(d.join(name)),
+                None => a.to_string(),
+            },
+        })
+        .collect()
+}
+
 /// Issue #61's output policy, by property: every subcommand and every output option, pointed
 /// at one of its own inputs (the path itself, through `..`, a symbolic link and a hard link to
 /// it) or at an existing file of the user's (or a folder holding one under an output's name),
@@ -327,22 +347,9 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
         let d = root.join(format!("{i}-fresh"));
         std::fs::create_dir_all(&d).unwrap();
         inputs(&d);
-        let args: Vec<String> = args
-            .iter()
-            .map(|a| match *a {
-                "OUT" if args.contains(&"--figure") && !args.contains(&"SIDE.svg") => {
-                    d.join("fresh.svg").to_str().unwrap().to_string()
-                }
-                "OUT" => d.join("fresh").to_str().unwrap().to_string(),
-                "OUTDIR" => d.join("run").to_str().unwrap().to_string(),
-                "SIDE.svg" => d.join("side.svg").to_str().unwrap().to_string(),
-                "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
-                a => match a.strip_prefix("IN_") {
-                    Some(name) => d.join(name).to_str().unwrap().to_string(),
-                    None => a.to_string(),
-                },
-            })
-            .collect();
+        let figure = args.contains(&"--figure") && !args.contains(&"SIDE.svg");
+        let out = d.join(if figure { "fresh.svg" } else { "fresh" });
+        let args = expand(args, &d, &out, false);
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         let o = tubemem(&refs);
         assert!(
@@ -420,26 +427,8 @@ fn every_output_option_refuses_inputs_links_and_users_files() {
             } else {
                 out
             };
-            let args: Vec<String> = args
-                .iter()
-                .map(|a| match *a {
-                    "OUT" => out.to_str().unwrap().to_string(),
-                    "OUTDIR" => d.join("run").to_str().unwrap().to_string(),
-                    "SIDE.svg" => d.join("side.svg").to_str().unwrap().to_string(),
-                    "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
-                    "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
-                    "SIDE.svg" => d.join("side.svg").to_str().unwrap().to_string(),
-                    "SIDE.csv" => d.join("side.csv").to_str().unwrap().to_string(),
-                    a => match a.strip_prefix("IN_") {
-                        Some(name) if fit && name == "data.csv" && hazard != "users-file" => {
-                            // the data moved to data.svg above (or its link points there)
-                            d.join("data.svg").to_str().unwrap().to_string()
-                        }
-                        Some(name) => d.join(name).to_str().unwrap().to_string(),
-                        None => a.to_string(),
-                    },
-                })
-                .collect();
+            // the data moved to data.svg above (or its link points there)
+            let args = expand(args, &d, &out, fit && hazard != "users-file");
             let before = snapshot(&d);
             let refs: Vec<&str> = args.iter().map(String::as_str).collect();
             let o = tubemem(&refs);

@@ -36,6 +36,9 @@ pub enum GpsError {
         n_s: f64,
         w: f64,
     },
+    /// The caller asked a long computation to stop (Ctrl-C during a run's limit-point scan).
+    #[error("interrupted")]
+    Interrupted,
     /// Newton did not converge, even after step cut-back.
     #[error(
         "{stage} did not converge at {at}: {}",

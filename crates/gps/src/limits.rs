@@ -174,11 +174,25 @@ fn area(path: &InflationPath, a: f64, b: f64, p: f64, panels: usize) -> Result<f
 
 /// Limit points and Maxwell pressure of the free-inflation curve.
 pub fn limit_points(law: &dyn MembraneLaw, hyp: Hypothesis) -> Result<Limits, GpsError> {
+    limit_points_until(law, hyp, &|| false)
+}
+
+/// [`limit_points`], stopped with [`GpsError::Interrupted`] as soon as `stop` says so (checked
+/// at every state of the scan: for an energy of thousands of terms the scan takes minutes, and
+/// a run's Ctrl-C must not wait for it).
+pub fn limit_points_until(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    stop: &dyn Fn() -> bool,
+) -> Result<Limits, GpsError> {
     let mut path = InflationPath::new(law, hyp);
     // Scan.
     let mut samples: Vec<(f64, f64)> = Vec::new(); // (λs, dϖ/dλs)
     let mut ls = 1.0;
     loop {
+        if stop() {
+            return Err(GpsError::Interrupted);
+        }
         match path.at(ls) {
             Ok((s, dw, _)) => {
                 path.table.push((ls, s.lambda_z));

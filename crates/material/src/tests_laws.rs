@@ -676,3 +676,18 @@ fn yeoh_with_a_negative_c30_is_stable_up_to_its_limit_and_refuses_beyond() {
         shipped.stable_limit()
     );
 }
+
+/// Issue #61 (found by the fuzz run): a law's name quotes at most an excerpt of a long energy
+/// (a run's header had printed a 50 KB energy whole).
+#[test]
+fn a_long_energy_is_named_by_an_excerpt() {
+    let long = vec!["(l - 3)"; 7000].join(" + ");
+    let law = PrincipalLaw::new(&long, &BTreeMap::new(), 1.0).unwrap();
+    let name = law.name();
+    assert!(
+        name.len() < 300 && name.contains("(69997 characters)"),
+        "{name}"
+    );
+    let short = InvariantLaw::new("(I1 - 3) / 2", &BTreeMap::new(), 1.0).unwrap();
+    assert_eq!(short.name(), "energy W = (I1 - 3) / 2");
+}

@@ -102,7 +102,9 @@ pub(crate) fn verify<'py>(
             })?
             .map_err(|e| match raised.take() {
                 Some(k) => k,
-                None => TubememError::new_err(e.chain()),
+                // an error of the whole run is one of its set-up (check failures are results):
+                // a bad value, named as the Python call names it (`out`, not `--out`)
+                None => PyValueError::new_err(crate::case::pythonic(&e.chain())),
             })?;
             (names, r, None)
         }
@@ -113,7 +115,8 @@ pub(crate) fn verify<'py>(
         }
     };
     let results = Results::new(names, t0.elapsed().as_secs_f64(), &results, verdict);
-    v::report::write_all(&out, &results).map_err(|e| TubememError::new_err(e.chain()))?;
+    v::report::write_all(&out, &results)
+        .map_err(|e| TubememError::new_err(crate::case::pythonic(&e.chain())))?;
     if let Some(e) = raised {
         // the report of what ran is on disk; say where, then raise the interrupt
         let msg = format!(

@@ -53,6 +53,7 @@ pub(super) struct StageStart {
 fn gps_limits(
     spec: &tubemem_material::MaterialSpec,
     law: &dyn tubemem_material::MembraneLaw,
+    interrupt: Option<&std::sync::Arc<std::sync::atomic::AtomicBool>>,
 ) -> Option<Limits> {
     use std::collections::HashMap;
     use std::sync::{Mutex, OnceLock};
@@ -62,7 +63,13 @@ fn gps_limits(
     if let Some(l) = memo.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
         return *l;
     }
-    let limits = tubemem_gps::limits::limit_points(law, Hypothesis::Gps).ok();
+    let stop = || interrupt.is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
+    let limits = match tubemem_gps::limits::limit_points_until(law, Hypothesis::Gps, &stop) {
+        // not memoized: the next run of this law scans again; this one stops at its first
+        // Newton iteration
+        Err(tubemem_gps::GpsError::Interrupted) => return None,
+        r => r.ok(),
+    };
     memo.lock()
         .unwrap_or_else(|e| e.into_inner())
         .insert(key, limits);
@@ -102,7 +109,7 @@ impl<'a> Runner<'a> {
             check_memory(3 * mesh.nodes.len(), options.force)?;
         }
         let law = case.material.build()?;
-        let limits = gps_limits(&case.material, law.as_ref());
+        let limits = gps_limits(&case.material, law.as_ref(), options.interrupt.as_ref());
         let model = model_of(case, mesh, options.interrupt.clone())?;
         let state = model.reference_state();
         let v0 = model.multiplicity() * model.mesh().volume();

@@ -127,11 +127,26 @@ impl InvariantLaw {
     }
 }
 
+/// An energy's text as a law's name quotes it: whole up to 160 characters, else its first 120
+/// and the count (a run's header and every message name the law; a 50 KB energy had been
+/// printed whole).
+fn excerpt(text: &str) -> String {
+    let n = text.chars().count();
+    if n <= 160 {
+        text.to_string()
+    } else {
+        format!(
+            "{}… ({n} characters)",
+            text.chars().take(120).collect::<String>()
+        )
+    }
+}
+
 impl MembraneLaw for InvariantLaw {
     fn name(&self) -> String {
         format!(
             "energy W = {}{}",
-            self.expr.text(),
+            excerpt(self.expr.text()),
             parameters_text(&self.parameters)
         )
     }
@@ -205,7 +220,7 @@ impl PrincipalLaw {
         let expr = Expr::parse(energy, &STRETCH_VARIABLE, parameters)?;
         let name = format!(
             "energy W = Σ w(λi), w(l) = {}{}",
-            expr.text(),
+            excerpt(expr.text()),
             parameters_text(parameters)
         );
         let law = Self {
