@@ -498,11 +498,62 @@ fn fuzz_runner(default_cases: u32) -> (TestRunner, u32, u64) {
     (runner, cases, seconds)
 }
 
+/// The failing inputs of a fuzz test. In the test command the first one fails the test at
+/// once; in a long run (`TUBEMEM_FUZZ_CASES`) each is written whole, with its message, to
+/// `target/fuzz-findings/<test>-<n>.txt` and the run goes on, so that one finding does not end
+/// a 30-minute run; the test fails at its end if there was any.
+struct Findings {
+    test: &'static str,
+    long: bool,
+    count: usize,
+}
+
+impl Findings {
+    fn new(test: &'static str) -> Self {
+        Findings {
+            test,
+            long: std::env::var_os("TUBEMEM_FUZZ_CASES").is_some(),
+            count: 0,
+        }
+    }
+
+    fn folder() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/fuzz-findings")
+    }
+
+    fn record(&mut self, n: u64, failure: &str, input: &str) {
+        if !self.long {
+            panic!("fuzz input {n} failed: {failure}");
+        }
+        self.count += 1;
+        let dir = Self::folder();
+        let _ = std::fs::create_dir_all(&dir);
+        let path = dir.join(format!("{}-{n}.txt", self.test));
+        let _ = std::fs::write(&path, format!("{failure}\n=== input ===\n{input}\n"));
+        let head: String = failure.chars().take(200).collect();
+        eprintln!(
+            "fuzz ({}): input {n} failed, written to {}: {head}",
+            self.test,
+            path.display()
+        );
+    }
+
+    fn finish(&self) {
+        assert!(
+            self.count == 0,
+            "{} failing inputs, written to {}",
+            self.count,
+            Self::folder().display()
+        );
+    }
+}
+
 /// The generated inputs: 48 in the test command, more with `TUBEMEM_FUZZ_CASES`, for at most
 /// `TUBEMEM_FUZZ_SECONDS`.
 #[test]
 fn no_input_makes_tubemem_panic() {
     let (mut runner, cases, seconds) = fuzz_runner(48);
+    let mut found = Findings::new("runs");
     let t0 = Instant::now();
     // inputs drawn one by one, so that a long run stops at its deadline
     let strategy = (case_text(), mesh_json());
@@ -516,7 +567,7 @@ fn no_input_makes_tubemem_panic() {
         ran += 1;
         match check(&text, &mesh) {
             Ok(done) => finished += u64::from(done),
-            Err(e) => panic!("fuzz input {ran} failed: {e}"),
+            Err(e) => found.record(ran, &format!("{e}"), &format!("{text}\n--- mesh:\n{mesh}")),
         }
     }
     eprintln!(
@@ -524,6 +575,7 @@ fn no_input_makes_tubemem_panic() {
         ran - finished,
         t0.elapsed().as_secs_f64()
     );
+    found.finish();
 }
 
 /// The crash inputs reported before, as regression seeds: each is now a typed error (or runs).
@@ -866,6 +918,7 @@ fn check_library(input: &LibraryInput, dir: &Path) -> Result<bool, TestCaseError
 #[test]
 fn no_law_fit_atlas_or_suite_input_makes_tubemem_panic() {
     let (mut runner, cases, seconds) = fuzz_runner(64);
+    let mut found = Findings::new("library");
     let t0 = Instant::now();
     let dir = std::env::temp_dir().join(format!("tubemem-fuzz-lib-{}", std::process::id()));
     let strategy = library_input();
@@ -886,7 +939,7 @@ fn no_law_fit_atlas_or_suite_input_makes_tubemem_panic() {
         }] += 1;
         match check_library(&input, &dir) {
             Ok(accepted) => refused += u64::from(!accepted),
-            Err(e) => panic!("library fuzz input {ran} failed: {e}"),
+            Err(e) => found.record(ran, &format!("{e}"), &format!("{input:?}")),
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -899,4 +952,5 @@ fn no_law_fit_atlas_or_suite_input_makes_tubemem_panic() {
         ran - refused,
         t0.elapsed().as_secs_f64()
     );
+    found.finish();
 }
