@@ -279,6 +279,10 @@ fn bad_suites_exit_with_2_and_a_clear_message() {
         ("[[check]]\nname = \"x\"\ncase = \"missing.toml\"\nkind = \"gold\"\n", "missing.toml"),
         ("[[check]]\nname = \"x\"\ncase = \"SMALL\"\nkind = \"end-effect\"\nlengths = [4.0]\nlaw = \"inverse\"\n", "at least three"),
         ("[[check]]\nname = \"x\"\ncase = { geometry = { radius = 1.0, length = 8.0 } }\nkind = \"gold\"\n", "its case"),
+        // issue #61: keys of another kind are refused, not ignored; a gold tolerance is checked
+        ("[[check]]\nname = \"x\"\ncase = \"SMALL\"\nkind = \"closed-form\"\ntolerance.w = { value = 1e-3, source = \"s\" }\nrel_err = nan\n", "`rel_err` belongs to gold checks"),
+        ("[[check]]\nname = \"x\"\ncase = \"SMALL\"\nkind = \"gold\"\nrel_err = nan\n", "`rel_err` = NaN: must be a finite relative tolerance"),
+        ("[[check]]\nname = \"x\"\ncase = \"SMALL\"\nkind = \"gold\"\nabs_zero = -1.0\n", "`abs_zero` = -1: must be finite"),
     ] {
         let (code, err, _) = verify(&d, suite, &[], &[]);
         assert_eq!(code, 2, "{suite}\n{err}");

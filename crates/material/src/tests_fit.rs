@@ -486,3 +486,45 @@ fn fixed_and_bounded_parameters_are_held_and_reported() {
         assert!(e.contains(needle), "{e}");
     }
 }
+
+/// Issue #61 (the probe's exact data): neo-Hookean data computed from the law itself are
+/// reproduced to round-off by the neo-Hookean law and by Yeoh (its C20 = C30 = 0); each fit
+/// is converged (the cosine of a round-off residual with a column is noise, and had made these
+/// fits "NOT CONVERGED"), and Yeoh's zero coefficients are determined, not "not determined".
+#[test]
+fn data_a_law_reproduces_exactly_are_a_converged_fit() {
+    let nh = MaterialSpec::NeoHookean { shear_modulus: 0.3 };
+    let law = nh.build().unwrap();
+    let stretch: Vec<f64> = (0..9).map(|i| 1.0 + 0.1 * f64::from(i)).collect();
+    let stress: Vec<f64> = stretch
+        .iter()
+        .map(|&l| nominal_stress(law.as_ref(), Mode::Uniaxial, l).unwrap())
+        .collect();
+    let data = [TestData {
+        mode: Mode::Uniaxial,
+        stretch,
+        stress,
+    }];
+    for start in [
+        MaterialSpec::NeoHookean { shear_modulus: 1.0 },
+        MaterialSpec::Yeoh {
+            c10: 0.05,
+            c20: 0.01,
+            c30: 0.001,
+        },
+    ] {
+        let r = fit(&start, &data).unwrap();
+        assert!(r.converged, "{}", r.stop_reason);
+        assert!(
+            r.max_relative_residual <= crate::fit::EXACT_FIT,
+            "{}",
+            r.max_relative_residual
+        );
+        assert!(
+            r.parameters.iter().all(|p| p.determined),
+            "{:?}",
+            r.parameters
+        );
+        assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    }
+}

@@ -322,6 +322,22 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
         }
         Ok(())
     };
+    // the gold comparison's keys on a check of another kind would be read by nothing (a
+    // `rel_err = nan` on a closed-form check had passed silently)
+    if c.kind != CheckKind::Gold {
+        for (key, given) in [
+            ("gold", c.gold.is_some()),
+            ("rel_err", c.rel_err.is_some()),
+            ("abs_zero", c.abs_zero.is_some()),
+        ] {
+            if given {
+                return Err(err(format!(
+                    "`{key}` belongs to gold checks; a {} check does not read it: remove it",
+                    c.kind.label()
+                )));
+            }
+        }
+    }
     match c.kind {
         CheckKind::ClosedForm => {
             known(CLOSED_FORM_QUANTITIES, &mut c.tolerance.keys())?;
