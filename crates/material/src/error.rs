@@ -154,19 +154,25 @@ pub enum MaterialError {
     /// the reference state, parameters that contradict each other).
     #[error("the {law} law is not admissible: {reason}")]
     Inadmissible { law: Box<str>, reason: Box<str> },
-    /// The energy or one of its derivatives is not finite at this state.
-    #[error(
-        "the {law} law's {what} is not finite at the stretches λ1 = {}, λ2 = {} (I1 = {}, I2 = {})",
-        Num(stretches[0]), Num(stretches[1]), Num(*i1), Num(*i2)
-    )]
-    NonFinite {
-        law: String,
-        /// what overflowed: the energy or its derivatives, the stress, the tangent
-        what: &'static str,
-        stretches: [f64; 2],
-        i1: f64,
-        i2: f64,
-    },
+    /// A law's energy, stress or tangent overflowed (boxed: the state it names would make
+    /// every error that carries a material error larger).
+    #[error("{0}")]
+    NonFinite(Box<NonFiniteState>),
+}
+
+/// Where a law overflowed: [`MaterialError::NonFinite`].
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error(
+    "the {law} law's {what} is not finite at the stretches λ1 = {}, λ2 = {} (I1 = {}, I2 = {})",
+    Num(stretches[0]), Num(stretches[1]), Num(*i1), Num(*i2)
+)]
+pub struct NonFiniteState {
+    pub law: String,
+    /// what overflowed: the energy or its derivatives, the stress, the tangent
+    pub what: &'static str,
+    pub stretches: [f64; 2],
+    pub i1: f64,
+    pub i2: f64,
 }
 
 impl MaterialError {
@@ -174,13 +180,13 @@ impl MaterialError {
     /// `a` = tr C, `b` = det C (its stretches and I1, I2 are named).
     pub fn non_finite(law: String, what: &'static str, a: f64, b: f64) -> Self {
         let disc = (0.25 * a * a - b).max(0.0).sqrt();
-        MaterialError::NonFinite {
+        MaterialError::NonFinite(Box::new(NonFiniteState {
             law,
             what,
             stretches: [(0.5 * a + disc).sqrt(), (0.5 * a - disc).max(0.0).sqrt()],
             i1: a + 1.0 / b,
             i2: a / b + b,
-        }
+        }))
     }
 }
 

@@ -321,7 +321,7 @@ impl Parser<'_> {
         match self.nodes[e] {
             // x^0 = 1 everywhere, with zero derivatives (through powi its derivative would be
             // 0 · x⁻¹, NaN at x = 0)
-            Node::Const(p) if p == 0.0 => self.push(Node::Const(1.0)),
+            Node::Const(0.0) => self.push(Node::Const(1.0)),
             Node::Const(p) if p == p.trunc() && p.abs() <= 64.0 => {
                 self.push(Node::PowI(base, p as i32))
             }

@@ -48,7 +48,9 @@ pub mod separable;
 mod spec;
 pub mod taylor;
 
-pub use error::{shorten_lines, tidy_numbers, MaterialError, Num, MAX_MESSAGE_LINE};
+pub use error::{
+    shorten_lines, tidy_numbers, MaterialError, NonFiniteState, Num, MAX_MESSAGE_LINE,
+};
 pub use spec::{MaterialSpec, Wrinkling};
 
 /// W(a, b) and its partial derivatives, a = tr C, b = det C (dimensionless, per μ).

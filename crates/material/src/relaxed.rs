@@ -82,6 +82,21 @@ impl<L: MembraneLaw> Relaxed<L> {
             if n2 >= -N2_ROUNDOFF {
                 return Ok(Regime::Taut);
             }
+            // equal stretches (to round-off: C's round-off of 1e-16 makes √D about 1e-8, so
+            // within 1e-6 of a) have equal resultants, and the wrinkled branch's
+            // derivatives need λ1 > λ2 (they divide by λ1² − λ2²): shrunk equally the state is
+            // slack; at or above the reference state a compressive N2 is round-off, and the
+            // state is taut (the law's stiffness, which a sheet started from rest needs). Found
+            // by the fuzz run: a law 100 times stiffer than its declared μ (an energy written
+            // as a sum of 100 terms) has round-off beyond N2_ROUNDOFF at C = I, which had gone
+            // to the wrinkled branch with equal stretches and divided by zero.
+            if disc <= 1e-6 * a {
+                return Ok(if l1 < 1.0 - 1e-12 {
+                    Regime::Slack
+                } else {
+                    Regime::Taut
+                });
+            }
         }
         if l1 > 1.0 {
             let mu = self.natural_width(l1)?;

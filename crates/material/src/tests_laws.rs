@@ -691,3 +691,29 @@ fn a_long_energy_is_named_by_an_excerpt() {
     let short = InvariantLaw::new("(I1 - 3) / 2", &BTreeMap::new(), 1.0).unwrap();
     assert_eq!(short.name(), "energy W = (I1 - 3) / 2");
 }
+
+/// Found by the fuzz run (issue #61): a law 100 times stiffer than its declared μ (an energy
+/// written as a sum of 100 terms) has round-off in N2 beyond the taut cone's allowance at
+/// C = I; relaxed, that state had gone to the wrinkled branch with equal stretches and divided
+/// by zero (a run failed with "λ1 = NaN" at its reference state). Equal stretches at or above
+/// the reference state are taut; shrunk equally they are slack.
+#[test]
+fn a_stiff_text_law_relaxed_is_taut_at_its_reference_state() {
+    let e = vec!["(I1 - 3)"; 100].join(" + ");
+    let r = crate::relaxed::Relaxed::new(InvariantLaw::new(&e, &BTreeMap::new(), 1.0).unwrap());
+    for (a, b) in [(2.0, 1.0), (2.0 + 4e-16, 1.0 + 2e-16), (2.0 - 4e-16, 1.0)] {
+        assert_eq!(
+            r.regime(a, b).unwrap(),
+            crate::relaxed::Regime::Taut,
+            "{a} {b}"
+        );
+        let d = r.derivatives_ab(a, b).unwrap();
+        assert!([d.w, d.w_a, d.w_b, d.w_aa, d.w_ab, d.w_bb]
+            .iter()
+            .all(|v| v.is_finite()));
+    }
+    assert_eq!(
+        r.regime(2.0 * 0.81, 0.81 * 0.81).unwrap(),
+        crate::relaxed::Regime::Slack
+    );
+}

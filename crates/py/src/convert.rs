@@ -71,10 +71,7 @@ fn non_finite_path(obj: &Bound<'_, PyAny>) -> Option<(String, String)> {
             for (i, v) in items.into_iter().enumerate().rev() {
                 todo.push((v, format!("{path}[{i}]")));
             }
-        } else if o.is_instance_of::<PyFloat>()
-            || o.get_type()
-                .module()
-                .is_ok_and(|m| m.to_string() == "numpy")
+        } else if o.is_instance_of::<PyFloat>() || o.get_type().module().is_ok_and(|m| m == "numpy")
         {
             if let Ok(x) = o.extract::<f64>() {
                 if !x.is_finite() {

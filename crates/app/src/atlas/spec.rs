@@ -227,7 +227,7 @@ impl Atlas {
         if runs > spec.max_runs {
             return Err(bad(
                 "atlas.max_runs",
-                &format!(
+                format!(
                     "the grid has {} × {} = {runs} member runs, more than max_runs = {}: check the grid, or raise `max_runs` to run it on purpose",
                     count(spec.stretches.len(), "stretch", "stretches"),
                     count(spec.lengths.len(), "length", "lengths"),
