@@ -538,6 +538,14 @@ impl Findings {
         );
     }
 
+    /// The run's outcome in words, for its summary line.
+    fn outcome(&self) -> String {
+        match self.count {
+            0 => "no failure".to_string(),
+            n => format!("{n} failing inputs (in {})", Self::folder().display()),
+        }
+    }
+
     fn finish(&self) {
         assert!(
             self.count == 0,
@@ -571,9 +579,10 @@ fn no_input_makes_tubemem_panic() {
         }
     }
     eprintln!(
-        "fuzz (runs): {ran} inputs ({finished} finished, {} refused or stopped with a message) in {:.1} s, no failure",
+        "fuzz (runs): {ran} inputs ({finished} finished, {} refused or stopped with a message) in {:.1} s, {}",
         ran - finished,
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        found.outcome()
     );
     found.finish();
 }
@@ -944,13 +953,14 @@ fn no_law_fit_atlas_or_suite_input_makes_tubemem_panic() {
     }
     let _ = std::fs::remove_dir_all(&dir);
     eprintln!(
-        "fuzz (laws, fits, atlases, suites): {ran} inputs ({} laws, {} fits, {} atlases, {} suites; {} accepted, {refused} refused with a message) in {:.1} s, no failure",
+        "fuzz (laws, fits, atlases, suites): {ran} inputs ({} laws, {} fits, {} atlases, {} suites; {} accepted, {refused} refused with a message) in {:.1} s, {}",
         counts[0],
         counts[1],
         counts[2],
         counts[3],
         ran - refused,
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        found.outcome()
     );
     found.finish();
 }
