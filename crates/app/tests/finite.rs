@@ -7,6 +7,9 @@
 //!
 //! 32 laws × stretches from a fixed seed in the test command (about 10 s in release).
 
+mod common;
+
+use common::all_finite;
 use proptest::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
@@ -44,15 +47,6 @@ fn message_says_why(msg: &str) -> Result<(), TestCaseError> {
         msg
     );
     Ok(())
-}
-
-fn all_finite(v: &serde_json::Value) -> bool {
-    match v {
-        serde_json::Value::Number(n) => n.as_f64().is_some_and(f64::is_finite),
-        serde_json::Value::Array(a) => a.iter().all(all_finite),
-        serde_json::Value::Object(o) => o.values().all(all_finite),
-        _ => true,
-    }
 }
 
 /// Every field of a steps.csv that is a number is finite.

@@ -20,6 +20,9 @@
 //! stopped after 2 s by the interrupt flag, so an input that merely runs long is an
 //! `Interrupted` outcome, which is allowed.
 
+mod common;
+
+use common::all_finite;
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -413,7 +416,7 @@ fn check(text: &str, mesh: &str) -> Result<bool, TestCaseError> {
         }
         Ok(Ok(summary)) => {
             prop_assert!(
-                finite(&summary),
+                all_finite(&summary),
                 "a non-finite number in the summary of:\n{}",
                 text
             );
@@ -460,16 +463,6 @@ fn check_message(msg: &str, full_input: &str) -> Result<(), TestCaseError> {
         input.len()
     );
     Ok(())
-}
-
-/// Every number in `v` finite.
-fn finite(v: &serde_json::Value) -> bool {
-    match v {
-        serde_json::Value::Number(n) => n.as_f64().is_some_and(f64::is_finite),
-        serde_json::Value::Array(a) => a.iter().all(finite),
-        serde_json::Value::Object(o) => o.values().all(finite),
-        _ => true,
-    }
 }
 
 /// The runner of a fuzz test, its number of inputs and its time limit: `default_cases` inputs
@@ -914,7 +907,7 @@ fn check_library(input: &LibraryInput, dir: &Path) -> Result<bool, TestCaseError
                 v.get("compressive").is_none(),
                 "a compressive closed-form state returned ({v}) for:\n{shown}"
             );
-            prop_assert!(finite(&v), "a non-finite number in {v} for:\n{shown}");
+            prop_assert!(all_finite(&v), "a non-finite number in {v} for:\n{shown}");
             Ok(true)
         }
     }

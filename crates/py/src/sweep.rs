@@ -215,9 +215,6 @@ pub(crate) fn sweep<'py>(
                 "sweep: workers={w} and processes={p} (its former name) disagree: give one"
             )))
         }
-        (Some(0), _) | (None, Some(0)) => {
-            return Err(PyValueError::new_err("sweep: workers = 0: at least 1"))
-        }
         (w, p) => w
             .or(p)
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |c| c.get())),
