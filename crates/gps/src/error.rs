@@ -36,6 +36,33 @@ pub enum GpsError {
         n_s: f64,
         w: f64,
     },
+    /// A pressure-controlled state past a limit point: between plates at half-gap ρ the section
+    /// carries at most ϖc on its branch (the first maximum of ϖ along the states at that ρ), and
+    /// the pressure asked is above it, so the state jumps (snaps) to another branch, which no
+    /// continuation follows.
+    #[error(
+        "{stage} at {at}: the pressure ϖ = {} is above the largest the section between these plates carries on its branch, ϖc = {} (reached at λs = {}): past this limit point a pressure-controlled section snaps to another state",
+        tubemem_material::Num(*w), tubemem_material::Num(*w_critical), tubemem_material::Num(*lambda_s_critical)
+    )]
+    Unstable {
+        stage: &'static str,
+        at: String,
+        w: f64,
+        w_critical: f64,
+        lambda_s_critical: f64,
+    },
+    /// The plates do not touch the tube: at this pressure the free tube is narrower than the
+    /// gap (its hoop stretch below ρ), so there is no squeezed section to answer with.
+    #[error(
+        "{stage} at {at}: the plates do not touch the tube (the free tube at this pressure has λs = {} < ρ = {})",
+        tubemem_material::Num(*lambda_s), tubemem_material::Num(*rho)
+    )]
+    NoContact {
+        stage: &'static str,
+        at: String,
+        lambda_s: f64,
+        rho: f64,
+    },
     /// The caller asked a long computation to stop (Ctrl-C during a run's limit-point scan).
     #[error("interrupted")]
     Interrupted,

@@ -36,6 +36,7 @@ mod error;
 pub mod limits;
 pub mod linear;
 mod newton;
+pub mod regulated;
 mod resultants;
 mod scales;
 
@@ -252,8 +253,10 @@ pub fn inflation_curve(
 struct Flattening<'a> {
     law: &'a dyn MembraneLaw,
     hyp: Hypothesis,
-    initial: InflationState,
-    /// Boyle's law constant: ϖ* λs*² λz* (eq. 77₂; λz* = 1 under PS, eq. 79₂)
+    /// the state the gas is closed in
+    initial: FlatteningState,
+    /// Boyle's law constant: ϖ* λs*² λz* from a free inflation (eq. 77₂; λz* = 1 under PS,
+    /// eq. 79₂), ϖρ(2λs − ρ)λz from a squeezed state
     gas: f64,
 }
 
@@ -270,34 +273,61 @@ impl<'a> Flattening<'a> {
                 "flattening needs an inflated tube (λs* > 1) holding gas",
             ));
         }
-        let initial = inflate(law, hyp, initial_stretch)?;
-        let gas = initial.w * initial.lambda_s.powi(2) * initial.lambda_z;
+        let s = inflate(law, hyp, initial_stretch)?;
+        let gas = s.w * s.lambda_s.powi(2) * s.lambda_z;
         Ok(Self {
             law,
             hyp,
-            initial,
+            initial: FlatteningState {
+                w: s.w,
+                lambda_s: s.lambda_s,
+                lambda_z: s.lambda_z,
+                n_s: s.n_s,
+                n_z: s.n_z,
+                rho: s.lambda_s,
+                chi: 0.0,
+                force: 0.0,
+                displacement: 0.0,
+            },
             gas,
         })
     }
 
-    fn start(&self) -> FlatteningState {
-        let s = self.initial;
-        FlatteningState {
-            w: s.w,
-            lambda_s: s.lambda_s,
-            lambda_z: s.lambda_z,
-            n_s: s.n_s,
-            n_z: s.n_z,
-            rho: s.lambda_s,
-            chi: 0.0,
-            force: 0.0,
-            displacement: 0.0,
+    /// The gas closed in a squeezed section `s` (its displacement counted from `s.rho`).
+    fn from_section(law: &'a dyn MembraneLaw, hyp: Hypothesis, s: SectionState) -> Self {
+        let lz = match hyp {
+            Hypothesis::Gps => s.lambda_z,
+            Hypothesis::Ps => 1.0,
+        };
+        Self {
+            law,
+            hyp,
+            initial: FlatteningState {
+                w: s.w,
+                lambda_s: s.lambda_s,
+                lambda_z: s.lambda_z,
+                n_s: s.n_s,
+                n_z: s.n_z,
+                rho: s.rho,
+                chi: s.chi,
+                force: s.force,
+                displacement: 0.0,
+            },
+            gas: s.w * s.rho * (2.0 * s.lambda_s - s.rho) * lz,
         }
+    }
+
+    fn start(&self) -> FlatteningState {
+        self.initial
     }
 
     /// Solve at half-gap `rho` from the guess (λs, λz).
     fn solve(&self, rho: f64, guess: [f64; 2]) -> Result<FlatteningState, GpsError> {
-        let at = format!("ρ = {rho} (λs* = {})", self.initial.lambda_s);
+        let at = if self.initial.chi == 0.0 {
+            format!("ρ = {rho} (λs* = {})", self.initial.lambda_s)
+        } else {
+            format!("ρ = {rho} (gas closed at ρ = {})", self.initial.rho)
+        };
         let law = self.law;
         let m = self.gas;
         let fail = |f: newton::Failure, stage: &'static str| f.into_error(stage, &at);
@@ -371,7 +401,7 @@ impl<'a> Flattening<'a> {
             rho,
             chi,
             force: w * chi,
-            displacement: self.initial.lambda_s - rho,
+            displacement: self.initial.rho - rho,
         })
     }
 
@@ -462,6 +492,21 @@ pub fn flatten(
 ) -> Result<FlatteningState, GpsError> {
     let fl = Flattening::new(law, hyp, initial_stretch)?;
     check_rho(rho, initial_stretch)?;
+    fl.continue_to(fl.start(), None, rho)
+}
+
+/// The gas closed in the squeezed section `from`, then the plates moved on to `rho`
+/// (continuation in ρ as [`flatten`]; the displacement counted from `from.rho`).
+pub(crate) fn flatten_from(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    from: SectionState,
+    rho: f64,
+) -> Result<FlatteningState, GpsError> {
+    let fl = Flattening::from_section(law, hyp, from);
+    if rho == from.rho {
+        return Ok(fl.start());
+    }
     fl.continue_to(fl.start(), None, rho)
 }
 
