@@ -593,6 +593,8 @@ impl PlaneSpec {
 pub enum ControlKind {
     Pressure,
     Volume,
+    /// squeeze and confine: the gas closed in at the stage's start (Boyle; the default)
+    Gas,
     /// arc-length continuation in (x, ϖ) to any of the three targets
     ArcLength,
 }
@@ -603,8 +605,10 @@ pub struct StageSpec {
     /// "inflate" (the gas let in), "squeeze" (two plates y = ±r closed on the tube) or
     /// "confine" (any planes moved in)
     pub kind: Kind,
-    /// inflate: "pressure", "volume" or "arc-length"; squeeze and confine (the gas closed):
-    /// none (load steps in the planes' travel) or "arc-length"
+    /// inflate: "pressure", "volume" or "arc-length"; squeeze and confine: "gas" (the default:
+    /// the gas closed in at the stage's start, Boyle), "pressure" (a regulated supply: the
+    /// pressure held at its value at the stage's start, or ramped to `target_pressure`) or
+    /// "arc-length" (the gas closed, the planes' travel continued along the path)
     pub control: Option<ControlKind>,
     /// squeeze only: the final half-gap between the plates as the ratio ρ = r/R (a ratio: the
     /// same number in every unit system); or give `target_gap`
@@ -632,8 +636,9 @@ pub struct StageSpec {
     /// weighted by its share of the element's area; the default of the augmented contact) or
     /// "gauss" (its Gauss points; the default of the penalty)
     pub contact_points: Option<tubemem_fem::contact::ContactPoints>,
-    /// inflate: the gas pressure to reach, a pressure (Pa under `[units] system = "SI"`; the
-    /// reduced pressure ϖ = pR/(μH) otherwise)
+    /// inflate, and squeeze or confine with control = "pressure": the gas pressure to reach
+    /// (ramped with the planes' travel; held at its start value when absent), a pressure (Pa
+    /// under `[units] system = "SI"`; the reduced pressure ϖ = pR/(μH) otherwise)
     pub target_pressure: Option<f64>,
     /// inflate: the mid-span hoop stretch λs* to reach (a ratio), the pressure following as
     /// the multiplier of the constraint
@@ -711,7 +716,10 @@ impl StagePlan {
             (true, _) => Some("arc-length"),
             (false, Target::Pressure(_)) => Some("pressure"),
             (false, Target::Stretch(_) | Target::VolumeRatio(_)) => Some("volume"),
-            (false, Target::Rho(_) | Target::Confine(_)) => None,
+            (false, Target::Rho(_) | Target::Confine(_)) => match self.gas {
+                GasControl::Closed => Some("gas"),
+                GasControl::Regulated { .. } => Some("pressure"),
+            },
         }
     }
 }
@@ -765,6 +773,17 @@ impl StagePlan {
 
     /// The stage label in words, its target in `units`.
     pub fn describe_in(&self, units: &Units) -> String {
+        if let GasControl::Regulated { target_pressure } = self.gas {
+            let v = self.target.value_in(units);
+            let supply = match target_pressure {
+                None => "pressure held".to_string(),
+                Some(p) => format!("pressure ramped to {}", Target::Pressure(p).value_in(units)),
+            };
+            return match self.target {
+                Target::Confine(_) => format!("confine, {supply}, {v}"),
+                _ => format!("squeeze, {supply}, plates to {v}"),
+            };
+        }
         if !self.arc_length {
             return self.target.describe_in(units);
         }
@@ -813,6 +832,21 @@ pub struct StagePlan {
     /// `branch = "follow-stable"` (arc-length stages)
     #[serde(default)]
     pub follow_stable: bool,
+    /// squeeze and confine stages: how the gas is supplied while the planes move
+    #[serde(default)]
+    pub gas: GasControl,
+}
+
+/// How the gas of a squeeze or confine stage is supplied while its planes move.
+#[derive(schemars::JsonSchema, Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GasControl {
+    /// closed in at the stage's start (Boyle: ϖV fixed), `control = "gas"`
+    #[default]
+    Closed,
+    /// a pressure regulator: ϖ held at its value at the stage's start, or ramped linearly
+    /// with the planes' travel to `target_pressure` (reduced), `control = "pressure"`
+    Regulated { target_pressure: Option<f64> },
 }
 
 /// The penetration tolerance (in R) that sets the penalty of a `contact_method = "penalty"`
@@ -879,6 +913,16 @@ impl StageSpec {
             }),
             arc_length: self.control == Some(ControlKind::ArcLength),
             follow_stable: self.branch == Some(BranchSpec::FollowStable),
+            gas: match (self.kind, self.control) {
+                (Kind::Squeeze | Kind::Confine, Some(ControlKind::Pressure)) => {
+                    GasControl::Regulated {
+                        target_pressure: self
+                            .target_pressure
+                            .map(|p| units.to_core(Dimension::Pressure, p)),
+                    }
+                }
+                _ => GasControl::Closed,
+            },
         })
     }
 
@@ -925,19 +969,26 @@ impl StageSpec {
                 "[[stage]] {}: control = \"volume\" takes exactly one target, `target_stretch` (mid-span λs*) or `target_volume_ratio`",
                 i + 1
             ),
-            (Kind::Squeeze, Some(ControlKind::Pressure | ControlKind::Volume), _) => invalid!(
-                "[[stage]] {}: a squeeze keeps the gas closed (Boyle); its only `control` is \"arc-length\" (the plates' travel continued along the path)",
+            (Kind::Inflate, Some(ControlKind::Gas), _) => invalid!(
+                "[[stage]] {}: control = \"gas\" (the gas closed in) belongs to squeeze and confine stages; an inflation lets gas in: control = \"pressure\", \"volume\" or \"arc-length\"",
                 i + 1
             ),
-            (Kind::Squeeze, None | Some(ControlKind::ArcLength), (None, None, None, Some(r))) => Target::Rho(r),
+            (Kind::Squeeze | Kind::Confine, Some(ControlKind::Volume), _) => invalid!(
+                "[[stage]] {}: a {} stage's `control` is \"gas\" (closed in, the default), \"pressure\" (regulated: held, or ramped to `target_pressure`) or \"arc-length\" (the gas closed, continued along the path)",
+                i + 1,
+                if self.kind == Kind::Squeeze { "squeeze" } else { "confine" }
+            ),
+            (Kind::Squeeze, Some(ControlKind::Pressure), (_, None, None, Some(r))) => Target::Rho(r),
+            (Kind::Squeeze, None | Some(ControlKind::Gas | ControlKind::ArcLength), (Some(_), _, _, _)) => invalid!(
+                "[[stage]] {}: `target_pressure` on a squeeze belongs to control = \"pressure\" (a regulated supply); with the gas closed in the pressure follows from Boyle's law",
+                i + 1
+            ),
+            (Kind::Squeeze, None | Some(ControlKind::Gas | ControlKind::ArcLength), (None, None, None, Some(r))) => Target::Rho(r),
             (Kind::Squeeze, _, _) => invalid!("[[stage]] {}: kind = \"squeeze\" takes exactly one target, `target_rho` (the plates' half-gap over R) or `target_gap` (the half-gap as a length)", i + 1),
-            (Kind::Confine, Some(ControlKind::Pressure | ControlKind::Volume), _) => invalid!(
-                "[[stage]] {}: a confine stage keeps the gas closed (Boyle); its only `control` is \"arc-length\" (the planes' travel continued along the path)",
-                i + 1
-            ),
-            (Kind::Confine, None | Some(ControlKind::ArcLength), (None, None, None, None)) => Target::Confine(self.plane.len()),
+            (Kind::Confine, Some(ControlKind::Pressure), (_, None, None, None)) => Target::Confine(self.plane.len()),
+            (Kind::Confine, None | Some(ControlKind::Gas | ControlKind::ArcLength), (None, None, None, None)) => Target::Confine(self.plane.len()),
             (Kind::Confine, _, _) => invalid!(
-                "[[stage]] {}: kind = \"confine\" moves its [[stage.plane]]s to their `target`s; it takes no target_pressure, target_stretch, target_volume_ratio, target_rho or target_gap",
+                "[[stage]] {}: kind = \"confine\" moves its [[stage.plane]]s to their `target`s; it takes no target_stretch, target_volume_ratio, target_rho or target_gap, and `target_pressure` only with control = \"pressure\"",
                 i + 1
             ),
         };
@@ -1034,6 +1085,15 @@ impl StageSpec {
                 i + 1,
                 units.show(d, v)
             );
+        }
+        if let (Kind::Squeeze | Kind::Confine, Some(p)) = (self.kind, self.target_pressure) {
+            if !(p.is_finite() && p > 0.0) {
+                invalid!(
+                    "[[stage]] {}: `target_pressure` = {} is out of range: a regulated squeeze or confinement ramps the pressure to a positive value (the membrane must stay taut to carry the planes)",
+                    i + 1,
+                    units.show(Dimension::Pressure, p)
+                );
+            }
         }
         if self.steps == 0 {
             invalid!("[[stage]] {}: `steps` must be ≥ 1", i + 1);

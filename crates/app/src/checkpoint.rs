@@ -15,6 +15,14 @@ pub struct StageContext {
     pub to: f64,
     /// Boyle's constant of a squeeze (0 otherwise)
     pub pv: f64,
+    /// the pressure ϖ at the stage's start (a regulated squeeze or confinement holds it or
+    /// ramps from it)
+    #[serde(default)]
+    pub start_pressure: f64,
+    /// a closed-gas squeeze that continues a regulated one (the mixed path): the half-gap ρ
+    /// and the pressure ϖ at which the gas was closed in
+    #[serde(default)]
+    pub gas_closed_at: Option<[f64; 2]>,
     /// the contact penalty of a squeeze (0 otherwise)
     pub penalty: f64,
     /// the mid-span λs at the stage start (λs* of a squeeze)

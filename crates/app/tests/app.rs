@@ -675,8 +675,9 @@ fn iterations_csv_accounts_for_every_newton_iteration() {
 /// λs, λz and the plate force to 1e-7 (both stop Newton at 1e-9 of the residual, as in
 /// `a_confine_stage_with_two_plates_is_the_squeeze`); the last step lies on the target (the
 /// plates' position located to 1e-10 of it), steps.csv carries the arc length, and the path has
-/// no negative pivot (a squeeze of a pressurized tube is stable). Pressure or volume control on
-/// a closed-gas stage is refused with the stage, and so is a target the plates could reach only
+/// no negative pivot (a squeeze of a pressurized tube is stable). Volume control on a squeeze
+/// (its controls are the gas closed, a regulated pressure, or arc length) is refused with the
+/// stage, and so is a target the plates could reach only
 /// by passing through the tube (ρ ≤ 0), with "no equilibrium" and why.
 #[test]
 fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
@@ -747,7 +748,9 @@ fn closed_gas_stages_continued_by_arc_length_end_where_the_load_steps_end() {
     .unwrap_err()
     .to_string();
     assert!(
-        err.contains("[[stage]] 2") && err.contains("only `control` is \"arc-length\""),
+        err.contains("[[stage]] 2")
+            && err.contains("\"gas\" (closed in, the default)")
+            && err.contains("\"arc-length\""),
         "{err}"
     );
 }

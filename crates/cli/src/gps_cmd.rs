@@ -72,7 +72,10 @@ impl From<Hyp> for Hypothesis {
 pub enum GpsCommand {
     /// Free inflation (eqs. 66 and 70): one state at --stretch, or a curve --from/--to/--points into --csv.
     Inflate(InflateArgs),
-    /// Flattening between two plates with the gas closed in (eqs. 76–79): one state at --rho, or a curve --to/--points into --csv.
+    /// Flattening between two plates (eqs. 76–79): the gas closed in (--control gas, the
+    /// default) or its pressure regulated (--control pressure: held at the inflated value, or
+    /// --pressure; plates closer than R inflated from zero pressure without --initial-stretch),
+    /// one state at --rho, or a curve --to/--points into --csv.
     Flatten(FlattenArgs),
     /// Pressure maximum and minimum of the inflation curve and the Maxwell pressure.
     Limits(LimitsArgs),
@@ -391,10 +394,20 @@ pub struct FlattenArgs {
     units: UnitArgs,
     #[arg(long, value_enum, default_value = "gps")]
     hypothesis: Hyp,
-    /// The inflated hoop stretch λs* at which the gas is closed in (the case file's
-    /// `target_stretch` of the inflation; `--target-stretch` is an alias).
+    /// The inflated hoop stretch λs* at which the plates start (the case file's
+    /// `target_stretch` of the inflation; `--target-stretch` is an alias). Required with the
+    /// gas closed in.
     #[arg(long, visible_alias = "target-stretch")]
-    initial_stretch: f64,
+    initial_stretch: Option<f64>,
+    /// How the gas is supplied while the plates close: "gas" (closed in at λs*, Boyle) or
+    /// "pressure" (regulated; the case file's `control`).
+    #[arg(long, value_enum, default_value = "gas")]
+    control: GasSupply,
+    /// --control pressure: the pressure the plates end at (ramped from the inflated one; held
+    /// when absent), the reduced pressure ϖ, or in Pa with --radius and --thickness. Without
+    /// --initial-stretch: plates at --rho < 1 hold the stress-free tube, inflated to it.
+    #[arg(long)]
+    pressure: Option<f64>,
     /// Half-gap ρ = r/R (0 < ρ < λs*) for a single state (the case file's `target_rho`;
     /// `--target-rho` is an alias).
     #[arg(long, visible_alias = "target-rho")]
@@ -413,6 +426,15 @@ pub struct FlattenArgs {
     overwrite: bool,
     #[arg(long)]
     json: bool,
+}
+
+/// `--control` of `gps flatten`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GasSupply {
+    /// the gas closed in at λs* (Boyle, eq. 77₂)
+    Gas,
+    /// a regulated pressure (eqs. 76 at a given pressure)
+    Pressure,
 }
 
 #[derive(Args, Debug)]
@@ -471,6 +493,7 @@ pub fn run(cmd: GpsCommand) -> Result<()> {
         GpsCommand::Flatten(_) => &[
             ("initial_stretch", "--initial-stretch"),
             ("rho", "--rho"),
+            ("w", "--pressure"),
             ("points", "--points"),
         ],
         GpsCommand::Confine(_) => &[
@@ -507,12 +530,19 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
                 _ => bail!("give either --stretch λs (one state) or --to, --points and --csv (a curve, with optional --from)"),
             }
         }
+        GpsCommand::Flatten(a) if a.control == GasSupply::Pressure => run_regulated(a),
         GpsCommand::Flatten(a) => {
             let law = a.material.build()?;
             let hyp = a.hypothesis.into();
+            if a.pressure.is_some() {
+                bail!("--pressure belongs to --control pressure (a regulated supply); with the gas closed in the pressure follows from Boyle's law");
+            }
+            let Some(initial_stretch) = a.initial_stretch else {
+                bail!("give --initial-stretch λs*: the gas is closed in the tube inflated to it");
+            };
             match (a.rho, a.to, a.points, &a.csv) {
                 (Some(rho), None, None, None) => {
-                    let s = flatten(law.as_ref(), hyp, a.initial_stretch, rho)?;
+                    let s = flatten(law.as_ref(), hyp, initial_stretch, rho)?;
                     ensure_finite(&flattening_values(&s))?;
                     print_state(&s, a.json, &a.units.units(law.as_ref())?)
                 }
@@ -521,13 +551,13 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
                     let inputs: Vec<&std::path::Path> =
                         law_file.iter().map(|p| p.as_path()).collect();
                     may_write("--csv", csv, &inputs, FLATTENING_HEADER, a.overwrite)?;
-                    let c = flattening_curve(law.as_ref(), hyp, a.initial_stretch, to, points)?;
+                    let c = flattening_curve(law.as_ref(), hyp, initial_stretch, to, points)?;
                     write_csv(csv, FLATTENING_HEADER, c.iter().map(flattening_values))?;
                     crate::say!(
                         "wrote {} {} flattening states (ρ {} → {to}) to {}",
                         c.len(),
                         hyp.label(),
-                        a.initial_stretch,
+                        initial_stretch,
                         csv.display()
                     )?;
                     Ok(())
@@ -543,6 +573,81 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
         }
     }
 }
+
+/// `gps flatten --control pressure`: the regulated section at --rho (from the free tube at
+/// λs*, or from the stress-free tube held by plates at ρ < 1), with the critical pressure of
+/// its plates; or a curve of the regulated squeeze into --csv.
+fn run_regulated(a: FlattenArgs) -> Result<()> {
+    use tubemem_app::units::Dimension;
+    use tubemem_gps::regulated::{
+        between_plates, critical_pressure, free_start, squeeze_at_pressure,
+    };
+    if a.to.is_some() && a.pressure.is_some() && a.initial_stretch.is_none() {
+        bail!("a regulated curve starts from the inflated tube: give --initial-stretch λs*");
+    }
+    let law = a.material.build()?;
+    let units = a.units.units(law.as_ref())?;
+    let hyp: Hypothesis = a.hypothesis.into();
+    let w = a.pressure.map(|p| units.to_core(Dimension::Pressure, p));
+    let values = |s: &tubemem_gps::SectionState| {
+        [
+            s.w, s.lambda_s, s.lambda_z, s.n_s, s.n_z, s.rho, s.chi, s.force,
+        ]
+    };
+    match (a.initial_stretch, a.rho, a.to, a.points, &a.csv) {
+        (ls0, Some(rho), None, None, None) => {
+            let s = match ls0 {
+                Some(ls0) => {
+                    let start = free_start(law.as_ref(), hyp, ls0)?;
+                    if rho >= ls0 {
+                        bail!("--rho {rho} must be below --initial-stretch {ls0}: the plates start at the inflated radius and close");
+                    }
+                    squeeze_at_pressure(law.as_ref(), hyp, start, rho, w.unwrap_or(start.w))?
+                }
+                None => {
+                    let Some(w) = w else {
+                        bail!("give --initial-stretch λs* (the plates close on the inflated tube) or --pressure ϖ (plates at --rho < 1 hold the stress-free tube, inflated to it)");
+                    };
+                    between_plates(law.as_ref(), hyp, rho, w)?
+                }
+            };
+            ensure_finite(&values(&s))?;
+            let mut v = serde_json::to_value(s)?;
+            let c = critical_pressure(law.as_ref(), hyp, rho)?;
+            if let Some(map) = v.as_object_mut() {
+                map.insert("control".into(), "pressure".into());
+                map.insert("w_critical".into(), c.map(|c| c.w).into());
+                map.insert("lambda_s_critical".into(), c.map(|c| c.lambda_s).into());
+            }
+            print_state(&v, a.json, &units)
+        }
+        (Some(ls0), None, Some(to), Some(points), Some(csv)) => {
+            let law_file = law_file(&a.material.law);
+            let inputs: Vec<&std::path::Path> = law_file.iter().map(|p| p.as_path()).collect();
+            may_write("--csv", csv, &inputs, REGULATED_HEADER, a.overwrite)?;
+            let rows =
+                tubemem_gps::regulated::regulated_curve(law.as_ref(), hyp, ls0, to, points, w)?;
+            write_csv(
+                csv,
+                REGULATED_HEADER,
+                rows.iter().map(|s| values(s).to_vec()),
+            )?;
+            crate::say!(
+                "wrote {} {} regulated flattening states (ρ {ls0} → {to}) to {}",
+                rows.len(),
+                hyp.label(),
+                csv.display()
+            )?;
+            Ok(())
+        }
+        _ => bail!(
+            "give --rho ρ (one state) or --initial-stretch, --to, --points and --csv (a curve)"
+        ),
+    }
+}
+
+/// The columns of a regulated flattening curve.
+const REGULATED_HEADER: &str = "w,lambda_s,lambda_z,n_s,n_z,rho,chi,force";
 
 fn print_limits(l: &Limits, json: bool, units: &tubemem_app::units::Units) -> Result<()> {
     use tubemem_app::units::Dimension;

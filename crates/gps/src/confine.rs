@@ -692,18 +692,14 @@ pub fn confine_at_pressure(
             message: "every plane must have the origin (the tube's axis) on the membrane's side: all offsets d > 0".into(),
         });
     }
-    let contact = inflate(law, hyp, r_in.max(1.0))?;
+    if r_in <= 1.0 {
+        return held_from_the_start(law, hyp, &ws, w);
+    }
+    let contact = inflate(law, hyp, r_in)?;
     let free = |st: crate::InflationState| free_state(&st, walls.len(), 1.0);
-    if r_in <= 1.0 || w <= contact.w {
+    if w <= contact.w {
         // the free circle at ϖ: λs on the rising branch up to the contact radius
-        let (mut lo, mut hi) = (1.0, r_in.max(1.0));
-        if w > contact.w {
-            return Err(crate::invalid(
-                "pressure",
-                w,
-                "the walls touch the unstretched tube; give a pressure reached before contact",
-            ));
-        }
+        let (mut lo, mut hi) = (1.0, r_in);
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
             if inflate(law, hyp, mid)?.w < w {
@@ -742,6 +738,40 @@ pub fn confine_at_pressure(
         }
     }
     Ok(cur)
+}
+
+/// Walls that hold the stress-free tube (inradius ≤ R: they touch it before any pressure),
+/// inflated between them to `w`: continued in ϖ from the stress-free section in the walls
+/// (λs = λz = 1), in fiftieths of `w` halved where Newton fails.
+fn held_from_the_start(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    ws: &Walls,
+    w: f64,
+) -> Result<ConfineState, GpsError> {
+    let (mut done, mut guess, mut last) = (0.0, [1.0 + 1e-9, 1.0], None);
+    let mut step = 0.02 * w;
+    let mut cuts = 0;
+    while done < w {
+        let target = (done + step).min(w);
+        match solve_at(law, hyp, ws, 1.0, Load::Pressure(target), guess) {
+            Ok(st) => {
+                guess = [st.lambda_s * (1.0 + 1e-6), st.lambda_z];
+                done = target;
+                last = Some(ConfineState { w: target, ..st });
+            }
+            Err(e) => {
+                cuts += 1;
+                if cuts > 30 {
+                    return Err(e);
+                }
+                step *= 0.5;
+            }
+        }
+    }
+    last.ok_or_else(|| GpsError::Walls {
+        message: "internal error: no pressure step was taken; please report this input".into(),
+    })
 }
 
 /// The reference angles (in [0, 2π), from the x axis, per R = 1) of the ends of every flat

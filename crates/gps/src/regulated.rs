@@ -498,6 +498,46 @@ pub fn free_start(
     })
 }
 
+/// `points` states of a regulated squeeze from the free tube at `initial_stretch` (ρ = λs*)
+/// to `rho_to`, equally spaced in ρ, the pressure held at ϖ(λs*) or ramped linearly to `w`;
+/// each solved from the previous one ([`squeeze_at_pressure`]).
+pub fn regulated_curve(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    initial_stretch: f64,
+    rho_to: f64,
+    points: usize,
+    w: Option<f64>,
+) -> Result<Vec<SectionState>, GpsError> {
+    crate::check_points(points)?;
+    let start = free_start(law, hyp, initial_stretch)?;
+    let target = w.unwrap_or(start.w);
+    check_w(target)?;
+    check_rho(rho_to)?;
+    if rho_to >= initial_stretch {
+        return Err(invalid(
+            "rho",
+            rho_to,
+            "the half-gap ρ must be below λs* (the plates start at the inflated radius)",
+        ));
+    }
+    let mut out = Vec::with_capacity(points);
+    out.push(start);
+    for i in 1..points {
+        let t = i as f64 / (points - 1) as f64;
+        let prev = out[i - 1];
+        let rho = initial_stretch + t * (rho_to - initial_stretch);
+        out.push(squeeze_at_pressure(
+            law,
+            hyp,
+            prev,
+            rho,
+            start.w + t * (target - start.w),
+        )?);
+    }
+    Ok(out)
+}
+
 /// The regulated squeeze of the paper's set-up: inflated to `initial_stretch` λs*, then the
 /// plates moved from λs* to `rho` with the pressure held at its inflated value ϖ*.
 pub fn flatten_at_pressure(

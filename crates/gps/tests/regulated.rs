@@ -249,3 +249,33 @@ fn bad_plates_and_pressures_are_refused_with_the_reason() {
     let e = between_plates(&law, Hypothesis::Gps, 1.2, 0.5).unwrap_err();
     assert!(e.to_string().contains("ρ < 1"), "{e}");
 }
+
+/// Walls that hold the stress-free tube: the confinement at a given pressure in two plates at
+/// ρ = 0.8 is the inflation between fixed plates (two codes: the walls' general solver, and
+/// the states at fixed ρ).
+#[test]
+fn walls_touching_the_stress_free_tube_are_the_inflation_between_fixed_plates() {
+    use tubemem_gps::confine::{confine_at_pressure, Wall};
+    let law = abb30();
+    let walls = [
+        Wall::new(0.0, 1.0, 0.8).unwrap(),
+        Wall::new(0.0, -1.0, 0.8).unwrap(),
+    ];
+    for w in [0.1, 0.5, 1.0] {
+        let c = confine_at_pressure(&law, Hypothesis::Gps, &walls, w).unwrap();
+        let b = between_plates(&law, Hypothesis::Gps, 0.8, w).unwrap();
+        assert!(
+            rel(c.lambda_s, b.lambda_s) < 1e-9,
+            "ϖ {w}: {} vs {}",
+            c.lambda_s,
+            b.lambda_s
+        );
+        assert!(rel(c.lambda_z, b.lambda_z) < 1e-9, "ϖ {w}");
+        assert!(
+            rel(c.walls[0].force, b.force) < 1e-9,
+            "ϖ {w}: {} vs {}",
+            c.walls[0].force,
+            b.force
+        );
+    }
+}

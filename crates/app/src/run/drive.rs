@@ -41,6 +41,8 @@ pub(super) fn drive_stage(
     let parts = LoadParts {
         node: r.node,
         pv: context.pv,
+        start_pressure: context.start_pressure,
+        range: (context.from, context.to),
         penalty: context.penalty,
         enforcement: plan.contact_enforcement(),
         points: plan.contact_points,
@@ -57,15 +59,24 @@ pub(super) fn drive_stage(
     let mut steps: Vec<StepRecord> = restored;
     let mut criticals: Vec<CriticalRecord> = restored_critical;
     let closed_gas = kind.closed_gas();
+    let presses = kind.presses();
     let record_input = RecordInput {
         kind,
         plan,
         law: r.law.as_ref(),
-        start_lambda_s: context.start_lambda_s,
+        start: crate::stage::closed_form::ClosedFormStart {
+            lambda_s: context.start_lambda_s,
+            supply: match (kind.supply(), context.gas_closed_at) {
+                (crate::stage::closed_form::Supply::Closed, Some([rho, w])) => {
+                    crate::stage::closed_form::Supply::ClosedAfterRegulated { rho, w }
+                }
+                (s, _) => s,
+            },
+        },
         half_length: 0.5 * r.case.geometry.length / r.case.geometry.radius,
         every_profile: r.case.output.profiles == ProfileFrames::Every,
-        started_uniform: started_uniform(closed_gas, report),
-        tracked_edges: (r.case.mesh.track_contact_edge && closed_gas).then_some(&r.tracked_edges),
+        started_uniform: started_uniform(presses, report),
+        tracked_edges: (r.case.mesh.track_contact_edge && presses).then_some(&r.tracked_edges),
     };
     // a resumed arc-length stage's path so far decides its direction and where its planes are
     let direction = arc_direction(closed_gas, &steps);
@@ -123,18 +134,18 @@ pub(super) fn drive_stage(
             };
             follow_arc(&arc, &mut r.model, &mut r.state, &mut on_step)
         } else {
-            let mut tracker =
-                r.tube
-                    .filter(|_| closed_gas)
-                    .map(|tube| crate::edge_track::Tracker {
-                        tube,
-                        law: r.law.as_ref(),
-                        pressing: match kind.planes() {
-                            Some(planes) => crate::edge_track::Pressing::Walls(planes.to_vec()),
-                            None => crate::edge_track::Pressing::Plates,
-                        },
-                        edges: r.tracked_edges.clone(),
-                    });
+            let mut tracker = r
+                .tube
+                .filter(|_| presses)
+                .map(|tube| crate::edge_track::Tracker {
+                    tube,
+                    law: r.law.as_ref(),
+                    pressing: match kind.planes() {
+                        Some(planes) => crate::edge_track::Pressing::Walls(planes.to_vec()),
+                        None => crate::edge_track::Pressing::Plates,
+                    },
+                    edges: r.tracked_edges.clone(),
+                });
             // mesh sequencing: the coarse run's steps of this stage lead (a resumed stage from
             // where it stopped)
             let load = kind.load(&parts);
@@ -234,8 +245,8 @@ impl Failed<'_> {
 /// A squeeze or confine stage compares with a closed form that starts from a uniform tube:
 /// not applicable after a stage that ended with a tube that was not uniform (that stage's
 /// index).
-fn started_uniform(closed_gas: bool, report: &RunReport) -> Option<usize> {
-    if !closed_gas {
+fn started_uniform(presses: bool, report: &RunReport) -> Option<usize> {
+    if !presses {
         return None;
     }
     report.stages.last().and_then(|s| match &s.outcome {

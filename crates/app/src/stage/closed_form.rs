@@ -4,14 +4,80 @@
 
 use crate::report::*;
 use crate::{AppError, Result};
-use tubemem_gps::{flatten, inflate, section_at_pressure, Hypothesis};
+use tubemem_gps::regulated::{flatten_closed_from, free_start, squeeze_at_pressure};
+use tubemem_gps::{flatten, inflate, section_at_pressure, FlatteningState, GpsError, Hypothesis};
 use tubemem_material::MembraneLaw;
+
+/// How the closed form's squeeze is supplied with gas, as the FE's stage is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Supply {
+    /// closed in the free tube at λs* (Boyle, eq. 77₂: [`flatten`])
+    Closed,
+    /// a regulated pressure: the section at the FE's own (prescribed) pressure, reached from the
+    /// free tube at λs* by [`squeeze_at_pressure`] (which picks the branch)
+    Regulated,
+    /// the mixed path: squeezed from λs* with the pressure regulated to half-gap `rho` under
+    /// the pressure `w`, then the gas closed in there ([`flatten_closed_from`])
+    ClosedAfterRegulated { rho: f64, w: f64 },
+}
+
+/// Where a stage's closed form starts: the free tube's λs*, and how the gas is supplied.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosedFormStart {
+    pub lambda_s: f64,
+    pub supply: Supply,
+}
+
+/// The flattening at half-gap `rho` from the free tube at `ls0` under `supply`, `w` the FE's
+/// pressure (a regulated supply's).
+pub(crate) fn flattening(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    supply: Supply,
+    ls0: f64,
+    rho: f64,
+    w: f64,
+) -> std::result::Result<FlatteningState, GpsError> {
+    match supply {
+        Supply::Closed => flatten(law, hyp, ls0, rho),
+        Supply::Regulated => {
+            let s = squeeze_at_pressure(law, hyp, free_start(law, hyp, ls0)?, rho, w)?;
+            Ok(FlatteningState {
+                w: s.w,
+                lambda_s: s.lambda_s,
+                lambda_z: s.lambda_z,
+                n_s: s.n_s,
+                n_z: s.n_z,
+                rho: s.rho,
+                chi: s.chi,
+                force: s.force,
+                displacement: ls0 - s.rho,
+            })
+        }
+        Supply::ClosedAfterRegulated { rho: r1, w: w1 } => {
+            let s1 = squeeze_at_pressure(law, hyp, free_start(law, hyp, ls0)?, r1, w1)?;
+            let s = flatten_closed_from(law, hyp, s1, rho)?;
+            Ok(FlatteningState {
+                w: s.w,
+                lambda_s: s.lambda_s,
+                lambda_z: s.lambda_z,
+                n_s: s.n_s,
+                n_z: s.n_z,
+                rho: s.rho,
+                chi: s.chi,
+                force: s.force,
+                displacement: ls0 - s.rho,
+            })
+        }
+    }
+}
 
 /// The closed form at one step (see [`StepClosedForm`]).
 pub(crate) fn step_closed_form(
     law: &dyn MembraneLaw,
     ms: &tubemem_fem::post::MidSpan,
     squeeze: Option<(&tubemem_fem::post::ContactValues, f64)>,
+    supply: Supply,
 ) -> StepClosedForm {
     match squeeze {
         None => StepClosedForm {
@@ -22,7 +88,7 @@ pub(crate) fn step_closed_form(
             local_confine: None,
         },
         Some((c, ls0)) => {
-            let g = flatten(law, Hypothesis::Gps, ls0, c.rho).ok();
+            let g = flattening(law, Hypothesis::Gps, supply, ls0, c.rho, ms.w).ok();
             let local = g.map(|g| {
                 section_at_pressure(law, c.rho, ms.w, [g.lambda_s, g.lambda_z])
                     .map_err(|e| e.to_string())
@@ -46,6 +112,7 @@ pub(crate) fn stage_closed_form(
     ms: &tubemem_fem::post::MidSpan,
     contact: Option<&ContactRecord>,
     last: Option<&StepClosedForm>,
+    supply: Supply,
 ) -> Result<super::StageComparison> {
     let local = last.and_then(|l| l.local.as_ref());
     let one = |hyp: Hypothesis| -> Result<(ClosedFormState, RelativeErrors)> {
@@ -77,9 +144,10 @@ pub(crate) fn stage_closed_form(
                     .filter(|_| hyp == Hypothesis::Gps);
                 let s = match known {
                     Some(s) => s,
-                    None => flatten(law, hyp, c.initial_stretch, c.values.rho).map_err(|e| {
-                        AppError::gps(format!("{} flattening at the FE's ρ", hyp.label()), e)
-                    })?,
+                    None => flattening(law, hyp, supply, c.initial_stretch, c.values.rho, ms.w)
+                        .map_err(|e| {
+                            AppError::gps(format!("{} flattening at the FE's ρ", hyp.label()), e)
+                        })?,
                 };
                 (
                     ClosedFormState::Flattening(s),

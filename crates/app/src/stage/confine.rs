@@ -2,10 +2,10 @@
 //! each moved from its `offset` to its `target` as the load parameter t goes from 0 to 1.
 
 use super::{
-    closed_form, closed_gas_load, penalty_of, LoadParts, RangeInput, StageComparison, StageKind,
+    closed_form, penalty_of, planes_load, LoadParts, RangeInput, StageComparison, StageKind,
     MAX_PENETRATION_FRACTION,
 };
-use crate::case::PlaneSpec;
+use crate::case::{GasControl, PlaneSpec};
 use crate::observer::BoxError;
 use crate::report::{
     rel, ClosedFormState, ContactRecord, RelativeErrors, StepClosedForm, StepRecord,
@@ -24,6 +24,7 @@ use tubemem_material::MembraneLaw;
 #[derive(Clone, Debug)]
 pub struct Confine {
     pub planes: Vec<PlaneSpec>,
+    pub gas: GasControl,
 }
 
 impl StageKind for Confine {
@@ -32,7 +33,25 @@ impl StageKind for Confine {
     }
 
     fn closed_gas(&self) -> bool {
+        self.gas == GasControl::Closed
+    }
+
+    fn presses(&self) -> bool {
         true
+    }
+
+    fn target_pressure(&self) -> Option<f64> {
+        match self.gas {
+            GasControl::Regulated { target_pressure } => target_pressure,
+            GasControl::Closed => None,
+        }
+    }
+
+    fn supply(&self) -> closed_form::Supply {
+        match self.gas {
+            GasControl::Closed => closed_form::Supply::Closed,
+            GasControl::Regulated { .. } => closed_form::Supply::Regulated,
+        }
     }
 
     fn range(&self, input: &RangeInput) -> std::result::Result<(f64, f64, f64), String> {
@@ -114,7 +133,9 @@ impl StageKind for Confine {
 
     fn load(&self, parts: &LoadParts) -> Box<dyn Fn(f64) -> Load> {
         let planes = self.planes.clone();
-        closed_gas_load(parts, move |t, penalty| fe_planes(&planes, t, penalty))
+        planes_load(parts, self.gas, move |t, penalty| {
+            fe_planes(&planes, t, penalty)
+        })
     }
 
     fn arc_monitor(&self, _model: &Model, _node: usize) -> Box<dyn Fn(&State) -> f64> {
@@ -142,10 +163,11 @@ impl StageKind for Confine {
         law: &dyn MembraneLaw,
         ms: &MidSpan,
         _contact: Option<&ContactRecord>,
-        start_lambda_s: f64,
+        start: closed_form::ClosedFormStart,
         stage: usize,
     ) -> std::result::Result<(StepClosedForm, Vec<WallValues>), BoxError> {
-        let mut cf = closed_form::step_closed_form(law, ms, None);
+        let start_lambda_s = start.lambda_s;
+        let mut cf = closed_form::step_closed_form(law, ms, None, start.supply);
         let Some(c) = info.load.contact.as_ref() else {
             return Ok((cf, vec![]));
         };
@@ -175,8 +197,13 @@ impl StageKind for Confine {
             .collect::<std::result::Result<Vec<_>, _>>()
         {
             cf.gps_inflation = None;
-            cf.gps_confine = confine(law, Hypothesis::Gps, &gw, start_lambda_s).ok();
             cf.local_confine = confine_at_pressure(law, Hypothesis::Gps, &gw, ms.w).ok();
+            cf.gps_confine = match self.gas {
+                GasControl::Closed => confine(law, Hypothesis::Gps, &gw, start_lambda_s).ok(),
+                // regulated: the confinement at the prescribed pressure is the section at
+                // the FE's pressure
+                GasControl::Regulated { .. } => cf.local_confine.clone(),
+            };
         }
         Ok((cf, w))
     }
@@ -189,10 +216,16 @@ impl StageKind for Confine {
         ms: &MidSpan,
         contact: Option<&ContactRecord>,
         last: Option<&StepRecord>,
-        start_lambda_s: f64,
+        start: closed_form::ClosedFormStart,
     ) -> Result<StageComparison> {
-        let mut out =
-            closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form))?;
+        let start_lambda_s = start.lambda_s;
+        let mut out = closed_form::stage_closed_form(
+            law,
+            ms,
+            contact,
+            last.map(|l| &l.closed_form),
+            start.supply,
+        )?;
         let Some(last) = last else {
             return Ok(out);
         };
@@ -208,12 +241,16 @@ impl StageKind for Confine {
             lambda_z: Some(rel(ms.lambda_z, c.lambda_z)),
             ..Default::default()
         };
+        let closed_or_regulated = |hyp: Hypothesis| match self.gas {
+            GasControl::Closed => confine(law, hyp, &walls, start_lambda_s),
+            GasControl::Regulated { .. } => confine_at_pressure(law, hyp, &walls, ms.w),
+        };
         let g = match &last.closed_form.gps_confine {
             Some(g) => g.clone(),
-            None => confine(law, Hypothesis::Gps, &walls, start_lambda_s)
+            None => closed_or_regulated(Hypothesis::Gps)
                 .map_err(|e| AppError::gps("GPS for the confine stage's walls", e))?,
         };
-        let p = confine(law, Hypothesis::Ps, &walls, start_lambda_s)
+        let p = closed_or_regulated(Hypothesis::Ps)
             .map_err(|e| AppError::gps("PS for the confine stage's walls", e))?;
         out.gps_errors = errors(&g);
         out.ps_errors = errors(&p);

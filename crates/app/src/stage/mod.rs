@@ -6,8 +6,13 @@
 //! | kind | type | load parameter | closed form |
 //! |---|---|---|---|
 //! | inflate | [`inflate::Inflate`] (pressure, stretch or volume control) | ϖ, λs at a node, or V | GPS/PS inflation |
-//! | squeeze | [`squeeze::Squeeze`] | plate half-gap h (gas closed) | GPS/PS flattening, section at the FE's ϖ |
-//! | confine | [`confine::Confine`] | t ∈ [0, 1] along the planes' paths (gas closed) | GPS/PS confinement by the same walls |
+//! | squeeze | [`squeeze::Squeeze`] (gas closed or regulated) | plate half-gap h | GPS/PS flattening (Boyle, or at the held pressure), section at the FE's ϖ |
+//! | confine | [`confine::Confine`] (gas closed or regulated) | t ∈ [0, 1] along the planes' paths | GPS/PS confinement by the same walls |
+//!
+//! How a squeeze or confine stage's gas is supplied ([`GasControl`]) is one value the kind
+//! holds: closed in (ϖV fixed, the load [`Loading::Gas`]) or regulated (ϖ prescribed at each
+//! value of the load parameter, [`Loading::Pressure`], held or ramped linearly from the
+//! stage's start to its `target_pressure`); the closed form follows it ([`closed_form::Supply`]).
 //!
 //! **Adding a stage kind**: a `Target` variant in [`crate::case`] (its TOML key, its validation
 //! and its `describe`), a type here implementing [`StageKind`] (its range, load, arc-length
@@ -26,7 +31,7 @@ pub mod setup;
 pub mod squeeze;
 pub mod summary;
 
-use crate::case::{PenaltySpec, PlaneSpec, StagePlan, Target};
+use crate::case::{GasControl, PenaltySpec, PlaneSpec, StagePlan, Target};
 use crate::observer::BoxError;
 use crate::report::{
     ClosedFormState, ContactRecord, FinalContact, LocalSection, RelativeErrors, StepClosedForm,
@@ -35,7 +40,7 @@ use crate::report::{
 use crate::Result;
 use tubemem_fem::contact::{ContactPoints, Enforcement};
 use tubemem_fem::continuation::ArcLoading;
-use tubemem_fem::model::{Load, Model, State};
+use tubemem_fem::model::{Load, Loading, Model, State};
 use tubemem_fem::post::{MidSpan, WallValues};
 use tubemem_fem::stepping::StepInfo;
 use tubemem_gps::limits::Limits;
@@ -54,6 +59,10 @@ pub struct LoadParts {
     pub node: usize,
     /// ϖV of the closed gas (squeeze and confine), 0 otherwise
     pub pv: f64,
+    /// the pressure ϖ at the stage's start (a regulated stage's held pressure)
+    pub start_pressure: f64,
+    /// the load parameter's range (from, to)
+    pub range: (f64, f64),
     /// the planes' penalty κ (squeeze and confine)
     pub penalty: f64,
     pub enforcement: Enforcement,
@@ -98,6 +107,11 @@ pub trait StageKind {
     /// Whether the gas is closed in (ϖV fixed at the stage's start): the load parameter is
     /// the planes' then, not a pressure or a volume.
     fn closed_gas(&self) -> bool {
+        false
+    }
+
+    /// Whether the stage moves planes against the tube (squeeze, confine), whatever its gas.
+    fn presses(&self) -> bool {
         false
     }
 
@@ -155,9 +169,15 @@ pub trait StageKind {
         _model: &Model,
         _state: &State,
         _info: &StepInfo<'_>,
-        _start_lambda_s: f64,
+        _start: closed_form::ClosedFormStart,
     ) -> Option<ContactRecord> {
         None
+    }
+
+    /// How the closed form's squeeze is supplied with gas (closed, or regulated as the stage;
+    /// the run makes a closed one that follows a regulated squeeze the mixed path).
+    fn supply(&self) -> closed_form::Supply {
+        closed_form::Supply::Closed
     }
 
     /// The closed form of one step and the walls' values (confine), or an error that stops
@@ -171,11 +191,16 @@ pub trait StageKind {
         law: &dyn MembraneLaw,
         ms: &MidSpan,
         contact: Option<&ContactRecord>,
-        start_lambda_s: f64,
+        start: closed_form::ClosedFormStart,
         _stage: usize,
     ) -> std::result::Result<(StepClosedForm, Vec<WallValues>), BoxError> {
         Ok((
-            closed_form::step_closed_form(law, ms, contact.map(|c| (&c.values, start_lambda_s))),
+            closed_form::step_closed_form(
+                law,
+                ms,
+                contact.map(|c| (&c.values, start.lambda_s)),
+                start.supply,
+            ),
             vec![],
         ))
     }
@@ -188,9 +213,9 @@ pub trait StageKind {
         ms: &MidSpan,
         contact: Option<&ContactRecord>,
         last: Option<&StepRecord>,
-        _start_lambda_s: f64,
+        start: closed_form::ClosedFormStart,
     ) -> Result<StageComparison> {
-        closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form))
+        closed_form::stage_closed_form(law, ms, contact, last.map(|l| &l.closed_form), start.supply)
     }
 
     /// Said when the final tube is not uniform and the kind knows why (an inflation past the
@@ -217,23 +242,45 @@ pub fn kind_of(plan: &StagePlan, planes: &[PlaneSpec]) -> Box<dyn StageKind> {
         Target::VolumeRatio(r) => Box::new(inflate::Inflate {
             control: inflate::Control::VolumeRatio(r),
         }),
-        Target::Rho(rho) => Box::new(squeeze::Squeeze { rho }),
+        Target::Rho(rho) => Box::new(squeeze::Squeeze { rho, gas: plan.gas }),
         Target::Confine(_) => Box::new(confine::Confine {
             planes: planes.to_vec(),
+            gas: plan.gas,
         }),
     }
 }
 
-/// The load of a closed-gas stage: the gas ϖV fixed, and the planes `planes(value, κ)` at each
+impl LoadParts {
+    /// A regulated stage's pressure at load parameter `v`: its start pressure held, or ramped
+    /// linearly over the load parameter's range to `target` (exactly `target` at its end).
+    pub fn regulated_pressure(&self, v: f64, target: Option<f64>) -> f64 {
+        let (from, to) = self.range;
+        match target {
+            None => self.start_pressure,
+            Some(t) if v == to || from == to => t,
+            Some(t) => self.start_pressure + (t - self.start_pressure) * (v - from) / (to - from),
+        }
+    }
+}
+
+/// The load of a stage with planes: the gas as `gas` supplies it (ϖV fixed, or the regulated
+/// pressure at each value of the load parameter), and the planes `planes(value, κ)` at each
 /// value of the load parameter, with the stage's enforcement and contact points.
-fn closed_gas_load(
+fn planes_load(
     parts: &LoadParts,
+    gas: GasControl,
     planes: impl Fn(f64, f64) -> tubemem_fem::contact::Contact + 'static,
 ) -> Box<dyn Fn(f64) -> Load> {
     let p = *parts;
     Box::new(move |v| {
+        let loading = match gas {
+            GasControl::Closed => Loading::Gas { pv: p.pv },
+            GasControl::Regulated { target_pressure } => {
+                Loading::Pressure(p.regulated_pressure(v, target_pressure))
+            }
+        };
         Load::with_contact(
-            tubemem_fem::model::Loading::Gas { pv: p.pv },
+            loading,
             planes(v, p.penalty)
                 .with_enforcement(p.enforcement)
                 .with_points(p.points),

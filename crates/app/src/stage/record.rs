@@ -21,7 +21,8 @@ pub struct RecordInput<'a> {
     /// the law of the closed form (without the tension-field relaxation)
     pub law: &'a dyn MembraneLaw,
     /// the mid-span λs* the stage's closed form starts from
-    pub start_lambda_s: f64,
+    /// where the stage's closed form starts (λs*, the gas supply)
+    pub start: super::closed_form::ClosedFormStart,
     /// the tube's half-length L/(2R)
     pub half_length: f64,
     /// `[output] profiles = "every"`
@@ -44,7 +45,7 @@ pub(crate) fn step_record(
 ) -> Result<StepRecord, BoxError> {
     let i = r.plan.index;
     let ms = midspan(m, st).map_err(|e| Box::new(e) as BoxError)?;
-    let contact = r.kind.step_contact(m, st, info, r.start_lambda_s);
+    let contact = r.kind.step_contact(m, st, info, r.start);
 
     let mut vals = vec![
         ms.w,
@@ -78,16 +79,9 @@ pub(crate) fn step_record(
             values: vals,
         }) as BoxError);
     }
-    let (closed_form, walls) = r.kind.step_closed_form(
-        m,
-        st,
-        info,
-        r.law,
-        &ms,
-        contact.as_ref(),
-        r.start_lambda_s,
-        i,
-    )?;
+    let (closed_form, walls) =
+        r.kind
+            .step_closed_form(m, st, info, r.law, &ms, contact.as_ref(), r.start, i)?;
     let profile = if r.every_profile {
         ring_profile(m, st, info.load.contact.as_ref()).map_err(|e| Box::new(e) as BoxError)?
     } else {

@@ -66,7 +66,7 @@ pub(crate) fn setup_stage(
     // the controlled value before any pre-stress: where the stage's steps are measured from
     let from_before = kind.controlled_value(model, state, node);
     let closed_gas = kind.closed_gas();
-    if state.p == 0.0 && !closed_gas && !run.guided {
+    if state.p == 0.0 && !kind.presses() && !run.guided {
         let estimate = kind.pressure_estimate(run.law);
         let mut pre = settings;
         // an arc-length stage always starts pre-stressed: its first tangent needs the
@@ -151,6 +151,12 @@ pub(crate) fn setup_stage(
         from,
         to,
         pv: if closed_gas { pv } else { 0.0 },
+        start_pressure: state.p,
+        gas_closed_at: if closed_gas && kind.presses() && kind.planes().is_none() {
+            gas_closed_at(report)
+        } else {
+            None
+        },
         penalty,
         // a squeeze that continues a squeeze compares with the flattening from the same λs*
         // and a confine that continues a confine from the same λs* too
@@ -159,4 +165,22 @@ pub(crate) fn setup_stage(
             .or(previous_confine)
             .unwrap_or(start.lambda_s),
     })
+}
+
+/// Where the gas of a closed-gas squeeze was closed in, if the squeezes just before it began
+/// with a regulated one (the mixed path): that stage's final half-gap and pressure. `None`: the
+/// gas was closed in the free tube (the paper's squeeze).
+fn gas_closed_at(report: &RunReport) -> Option<[f64; 2]> {
+    for s in report.stages.iter().rev() {
+        let StageOutcome::Finished(f) = &s.outcome else {
+            return None;
+        };
+        let (crate::case::Target::Rho(_), Some(c)) = (s.plan.target, f.final_state.contact) else {
+            return None;
+        };
+        if let crate::case::GasControl::Regulated { .. } = s.plan.gas {
+            return Some([c.rho, f.final_state.midspan.w]);
+        }
+    }
+    None
 }

@@ -1,6 +1,8 @@
-//! The squeeze: the gas closed in, the tube pressed between frictionless plates y = ±h.
+//! The squeeze: the tube pressed between frictionless plates y = ±h, the gas closed in or
+//! regulated.
 
-use super::{closed_gas_load, penalty_of, LoadParts, RangeInput, StageKind};
+use super::{closed_form::Supply, penalty_of, planes_load, LoadParts, RangeInput, StageKind};
+use crate::case::GasControl;
 use crate::report::ContactRecord;
 use tubemem_fem::contact::{Contact, MovingPlanes};
 use tubemem_fem::continuation::ArcLoading;
@@ -12,6 +14,7 @@ use tubemem_fem::stepping::StepInfo;
 #[derive(Clone, Copy, Debug)]
 pub struct Squeeze {
     pub rho: f64,
+    pub gas: GasControl,
 }
 
 impl StageKind for Squeeze {
@@ -20,7 +23,25 @@ impl StageKind for Squeeze {
     }
 
     fn closed_gas(&self) -> bool {
+        self.gas == GasControl::Closed
+    }
+
+    fn presses(&self) -> bool {
         true
+    }
+
+    fn target_pressure(&self) -> Option<f64> {
+        match self.gas {
+            GasControl::Regulated { target_pressure } => target_pressure,
+            GasControl::Closed => None,
+        }
+    }
+
+    fn supply(&self) -> Supply {
+        match self.gas {
+            GasControl::Closed => Supply::Closed,
+            GasControl::Regulated { .. } => Supply::Regulated,
+        }
     }
 
     fn range(&self, input: &RangeInput) -> Result<(f64, f64, f64), String> {
@@ -48,7 +69,7 @@ impl StageKind for Squeeze {
     }
 
     fn load(&self, parts: &LoadParts) -> Box<dyn Fn(f64) -> Load> {
-        closed_gas_load(parts, Contact::plates)
+        planes_load(parts, self.gas, Contact::plates)
     }
 
     fn arc_monitor(&self, _model: &Model, _node: usize) -> Box<dyn Fn(&State) -> f64> {
@@ -70,8 +91,9 @@ impl StageKind for Squeeze {
         model: &Model,
         state: &State,
         info: &StepInfo<'_>,
-        start_lambda_s: f64,
+        start: super::closed_form::ClosedFormStart,
     ) -> Option<ContactRecord> {
+        let start_lambda_s = start.lambda_s;
         info.load.contact.as_ref().and_then(|c| {
             midspan_contact(model, state, c).map(|values| ContactRecord {
                 values,

@@ -50,7 +50,7 @@ pub(crate) fn stage_report(
     let wrinkling = wrinkle_report(model, state, i)?;
     let comparison =
         r.kind
-            .stage_comparison(r.law, &ms, contact.as_ref(), steps.last(), r.start_lambda_s)?;
+            .stage_comparison(r.law, &ms, contact.as_ref(), steps.last(), r.start)?;
     let summary = StageSummary {
         index: i,
         kind: r.kind.name().into(),
@@ -86,7 +86,7 @@ pub(crate) fn stage_report(
         relative_error_vs_gps_at_fe_pressure: comparison.local_errors,
         walls: comparison.walls,
         planes: r.kind.planes().map(<[_]>::to_vec).unwrap_or_default(),
-        initial_stretch: r.kind.planes().map(|_| r.start_lambda_s),
+        initial_stretch: r.kind.planes().map(|_| r.start.lambda_s),
         critical_points: criticals,
         nonuniformity: stage_nonuniformity,
         gps_applicable: stage_nonuniformity.is_none_or(|u| u <= NONUNIFORM)
