@@ -617,6 +617,12 @@ fn run_regulated(a: FlattenArgs) -> Result<()> {
             if let Some(map) = v.as_object_mut() {
                 map.insert("control".into(), "pressure".into());
                 map.insert("w_critical".into(), c.map(|c| c.w).into());
+                if units.is_si() {
+                    map.insert(
+                        "critical_pressure_pa".into(),
+                        c.map(|c| units.from_core(Dimension::Pressure, c.w)).into(),
+                    );
+                }
                 map.insert("lambda_s_critical".into(), c.map(|c| c.lambda_s).into());
             }
             print_state(&v, a.json, &units)

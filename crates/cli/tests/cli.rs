@@ -2543,3 +2543,97 @@ fn fit_recovers_the_synthetic_law_and_names_bad_data() {
         "jm",
     );
 }
+
+/// Issue #62: `gps flatten --control pressure`. The regulated state holds the inflated
+/// pressure (the free inflation's, bit for bit) and is the section at that pressure
+/// (`tubemem_gps::regulated` is tested against explicit states in crates/gps/tests); the plates
+/// of a neo-Hookean tube at ρ = 0.8 have a critical pressure, the ABB tube's none; plates at
+/// ρ < 1 inflate the stress-free tube without --initial-stretch; a pressure above the critical
+/// one, and --pressure with the gas closed, are refused naming why.
+#[test]
+fn a_regulated_flattening_holds_the_pressure_and_names_the_critical_one() {
+    let abb = ["--material", "abb", "--kuhn", "30"];
+    let nh = ["--material", "neo-hookean"];
+    fn with<'a>(base: &[&'a str], m: &[&'a str]) -> Vec<&'a str> {
+        let mut a = base.to_vec();
+        a.extend_from_slice(m);
+        a
+    }
+    let free = json(&with(
+        &["gps", "inflate", "--stretch", "1.3", "--json"],
+        &abb,
+    ));
+    let reg = json(&with(
+        &[
+            "gps",
+            "flatten",
+            "--control",
+            "pressure",
+            "--initial-stretch",
+            "1.3",
+            "--rho",
+            "0.8",
+            "--json",
+        ],
+        &abb,
+    ));
+    assert_eq!(reg["w"], free["w"]);
+    assert_eq!(reg["control"], "pressure");
+    assert!(reg["w_critical"].is_null());
+    let chi = reg["chi"].as_f64().unwrap();
+    let ls = reg["lambda_s"].as_f64().unwrap();
+    assert!((chi - (ls - 0.8)).abs() < 1e-12);
+    let between = json(&with(
+        &[
+            "gps",
+            "flatten",
+            "--control",
+            "pressure",
+            "--rho",
+            "0.8",
+            "--pressure",
+            "1.2",
+            "--json",
+        ],
+        &nh,
+    ));
+    let wc = between["w_critical"].as_f64().unwrap();
+    assert!(wc > 1.2 && wc < 1.5, "{wc}");
+    assert_eq!(between["w"].as_f64().unwrap(), 1.2);
+    let o = tubemem(&with(
+        &[
+            "gps",
+            "flatten",
+            "--control",
+            "pressure",
+            "--rho",
+            "0.8",
+            "--pressure",
+            "1.5",
+        ],
+        &nh,
+    ));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("snaps") && err.contains("ϖc"),
+        "{err}"
+    );
+    let o = tubemem(&with(
+        &[
+            "gps",
+            "flatten",
+            "--initial-stretch",
+            "1.3",
+            "--rho",
+            "0.8",
+            "--pressure",
+            "0.5",
+        ],
+        &abb,
+    ));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("--control pressure"),
+        "{err}"
+    );
+}
