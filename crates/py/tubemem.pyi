@@ -44,9 +44,27 @@ def gps_inflation_curve(
     hypothesis: str = "gps",
 ) -> Table: ...
 def gps_flatten(
-    initial_stretch: float, rho: ArrayLike, material: MaterialLike = None, hypothesis: str = "gps"
+    initial_stretch: float,
+    rho: ArrayLike,
+    material: MaterialLike = None,
+    hypothesis: str = "gps",
+    *,
+    control: str = "gas",
+    pressure: Optional[float] = None,
 ) -> Union[dict[str, float], Table]:
-    """Squeeze between two plates with the gas closed in (eqs. 76–77 GPS, 78–79 PS)."""
+    """Squeeze between two plates: control="gas", the gas closed in (eqs. 76–77 GPS, 78–79 PS);
+    control="pressure", regulated (eqs. 76 at the inflated pressure held, or ramped to
+    `pressure`)."""
+
+def gps_between_plates(
+    rho: float, w: float, material: MaterialLike = None, hypothesis: str = "gps"
+) -> dict[str, float]:
+    """Plates at rho < 1 hold the stress-free tube, inflated between them to the pressure w."""
+
+def gps_critical_pressure(
+    rho: float, material: MaterialLike = None, hypothesis: str = "gps"
+) -> Optional[dict[str, float]]:
+    """The first maximum of the pressure along the sections between plates at rho (None: none)."""
 
 def gps_flattening_curve(
     initial_stretch: float,

@@ -110,6 +110,24 @@ pub struct SectionState {
     pub force: f64,
 }
 
+impl SectionState {
+    /// The state as a flattening state, its displacement counted from the half-gap
+    /// `initial_stretch` (λs* − ρ, eq. 81).
+    pub fn as_flattening(&self, initial_stretch: f64) -> FlatteningState {
+        FlatteningState {
+            w: self.w,
+            lambda_s: self.lambda_s,
+            lambda_z: self.lambda_z,
+            n_s: self.n_s,
+            n_z: self.n_z,
+            rho: self.rho,
+            chi: self.chi,
+            force: self.force,
+            displacement: initial_stretch - self.rho,
+        }
+    }
+}
+
 const MAX_CUTS: usize = 30;
 
 fn at_ls(ls: f64) -> String {
@@ -302,17 +320,7 @@ impl<'a> Flattening<'a> {
         Self {
             law,
             hyp,
-            initial: FlatteningState {
-                w: s.w,
-                lambda_s: s.lambda_s,
-                lambda_z: s.lambda_z,
-                n_s: s.n_s,
-                n_z: s.n_z,
-                rho: s.rho,
-                chi: s.chi,
-                force: s.force,
-                displacement: 0.0,
-            },
+            initial: s.as_flattening(s.rho),
             gas: s.w * s.rho * (2.0 * s.lambda_s - s.rho) * lz,
         }
     }

@@ -18,7 +18,12 @@ create_exception!(
 pub(crate) fn gps_err(e: GpsError) -> PyErr {
     let msg = tubemem_app::error_chain(&e);
     match e {
-        GpsError::InvalidInput { .. } | GpsError::Walls { .. } => PyValueError::new_err(msg),
+        // a pressure above the plates' critical one, or plates the tube does not reach, is
+        // an input with no answer
+        GpsError::InvalidInput { .. }
+        | GpsError::Walls { .. }
+        | GpsError::Unstable { .. }
+        | GpsError::NoContact { .. } => PyValueError::new_err(msg),
         // a material parameter out of range, or a stretch asked for beyond the locking limit,
         // is bad input
         GpsError::Material {

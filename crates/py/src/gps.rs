@@ -224,23 +224,50 @@ pub(crate) fn gps_inflation_curve<'py>(
     })
 }
 
-/// The tube inflated to λs* = `initial_stretch`, the gas closed in (Boyle), squeezed between two
-/// plates to half-gap `rho` (GPS eqs. 76–77, PS eqs. 78–79): dict with w, lambda_s, lambda_z, n_s,
-/// n_z, rho, chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81). `rho` may be a numpy
-/// array: the dict then holds arrays of its shape.
+/// The tube inflated to λs* = `initial_stretch`, squeezed between two plates to half-gap `rho`:
+/// with `control="gas"` (the default) the gas closed in (Boyle; GPS eqs. 76–77, PS eqs.
+/// 78–79), with `control="pressure"` a regulated supply (eqs. 76 at the pressure held at its
+/// inflated value, or ramped to `pressure`). Dict with w, lambda_s, lambda_z, n_s, n_z, rho,
+/// chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81). `rho` may be a numpy array: the
+/// dict then holds arrays of its shape.
 #[pyfunction]
-#[pyo3(signature = (initial_stretch, rho, material=None, hypothesis="gps"))]
+#[pyo3(signature = (initial_stretch, rho, material=None, hypothesis="gps", *, control="gas", pressure=None))]
 pub(crate) fn gps_flatten<'py>(
     py: Python<'py>,
     initial_stretch: f64,
     rho: &Bound<'py, PyAny>,
     material: Option<&Bound<'py, PyAny>>,
     hypothesis: &str,
+    control: &str,
+    pressure: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let law = law(material)?;
     let hyp = self::hypothesis(hypothesis)?;
+    let regulated = match (control, pressure) {
+        ("gas", None) => false,
+        ("pressure", _) => true,
+        ("gas", Some(_)) => {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "pressure: belongs to control=\"pressure\" (a regulated supply); with the gas closed in the pressure follows from Boyle's law",
+            ))
+        }
+        (other, _) => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "control: {other:?} is not a supply: \"gas\" (closed in, Boyle) or \"pressure\" (regulated)"
+            )))
+        }
+    };
+    let one = |r: f64| -> Result<tubemem_gps::FlatteningState, tubemem_gps::GpsError> {
+        if !regulated {
+            return tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r);
+        }
+        use tubemem_gps::regulated::{free_start, squeeze_at_pressure};
+        let start = free_start(law.as_ref(), hyp, initial_stretch)?;
+        let s = squeeze_at_pressure(law.as_ref(), hyp, start, r, pressure.unwrap_or(start.w))?;
+        Ok(s.as_flattening(initial_stretch))
+    };
     if let Ok(r) = real_scalar(rho, "rho")? {
-        let s = tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r).map_err(gps_err)?;
+        let s = one(r).map_err(gps_err)?;
         return to_py(py, &s);
     }
     use tubemem_app::curves::{flattening_values, FLATTENING_HEADER};
@@ -249,12 +276,43 @@ pub(crate) fn gps_flatten<'py>(
         py,
         rho,
         "rho",
-        |r| {
-            tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r)
-                .map(|s| flattening_values(&s))
-        },
+        |r| one(r).map(|s| flattening_values(&s)),
         &keys,
     )
+}
+
+/// Plates at half-gap `rho` < 1 hold the stress-free tube, which is inflated between them to the
+/// pressure `w` (a regulated supply): dict with w, rho, lambda_s, lambda_z, n_s, n_z, chi,
+/// force. Above the critical pressure of the plates (`gps_critical_pressure`) a ValueError
+/// says the section snaps.
+#[pyfunction]
+#[pyo3(signature = (rho, w, material=None, hypothesis="gps"))]
+pub(crate) fn gps_between_plates<'py>(
+    py: Python<'py>,
+    rho: f64,
+    w: f64,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
+    let s = tubemem_gps::regulated::between_plates(law.as_ref(), hyp, rho, w).map_err(gps_err)?;
+    to_py(py, &s)
+}
+
+/// The critical pressure of the section between plates at half-gap `rho`: the first maximum of
+/// ϖ along its states (a pressure-controlled section snaps above it), dict {lambda_s, lambda_z,
+/// w}, or None where ϖ rises until the law locks (or λs = 50).
+#[pyfunction]
+#[pyo3(signature = (rho, material=None, hypothesis="gps"))]
+pub(crate) fn gps_critical_pressure<'py>(
+    py: Python<'py>,
+    rho: f64,
+    material: Option<&Bound<'py, PyAny>>,
+    hypothesis: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (law, hyp) = (law(material)?, self::hypothesis(hypothesis)?);
+    let c = tubemem_gps::regulated::critical_pressure(law.as_ref(), hyp, rho).map_err(gps_err)?;
+    to_py(py, &c)
 }
 
 /// `points` flattening states equally spaced in ρ from λs* down to `rho_to`: a `Table` with the

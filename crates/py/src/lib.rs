@@ -38,6 +38,7 @@ use pyo3::prelude::*;
 ///
 /// Closed form: gps_inflate, gps_flatten (numbers → dict; numpy arrays → Table),
 /// gps_inflation_curve, gps_flattening_curve (→ Table), gps_section_at_pressure, gps_limits,
+/// gps_between_plates, gps_critical_pressure (the regulated squeeze, issue #62),
 /// resultants. A Table is named numpy columns: t["w"], t.columns, t.to_pandas().
 /// FE runs: run (a case as path, TOML text or dict → Run: steps and profiles as Tables),
 /// run_case, run_case_text (→ the summary dict), default_case; progress= a callable, "tqdm" or
@@ -57,6 +58,8 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gps::gps_inflation_curve, m)?)?;
     m.add_function(wrap_pyfunction!(gps::gps_flatten, m)?)?;
     m.add_function(wrap_pyfunction!(gps::gps_flattening_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(gps::gps_between_plates, m)?)?;
+    m.add_function(wrap_pyfunction!(gps::gps_critical_pressure, m)?)?;
     m.add_function(wrap_pyfunction!(gps::gps_section_at_pressure, m)?)?;
     m.add_function(wrap_pyfunction!(gps::gps_limits, m)?)?;
     m.add_function(wrap_pyfunction!(gps::resultants, m)?)?;

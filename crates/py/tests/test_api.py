@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 import pytest
+from scipy import optimize
 
 import tubemem
 from tubemem_ref import closed_form as cf
@@ -84,6 +85,49 @@ def test_flattening_matches_the_scipy_closed_form_and_the_local_section():
         assert rel(loc["chi"], s["chi"]) < TOL
     # PS is stiffer than GPS in the squeeze (paper Figs. 6-7)
     assert tubemem.gps_flatten(1.3, 0.8, hypothesis="ps")["force"] > curve["force"][-1]
+
+
+def _between(ls, rho, law):
+    """The section between plates at rho with hoop stretch ls (eqs. 76 with the pressure
+    eliminated): N_z = (1 - rho/(2 ls)) N_s solved for lz by brentq; (w, lz)."""
+    q = 1.0 - rho / (2.0 * ls)
+    g = lambda lz: (lambda r: r[1] - q * r[0])(cf.resultants(ls, lz, law))
+    lz = optimize.brentq(g, 0.5, 3.0, xtol=1e-15)
+    return cf.resultants(ls, lz, law)[0] / rho, lz
+
+
+def test_the_regulated_squeeze_and_the_critical_pressure_match_scipy():
+    # issue #62: the pressure held at the inflated value, the section at rho = 0.8 found by
+    # brentq on the explicit states (python_ref's resultants), not by the Rust Newton
+    abb = ("abb", 30.0)
+    w0 = cf.gps_inflation(1.3, 30.0)[0]
+    s = tubemem.gps_flatten(1.3, 0.8, control="pressure")
+    ls = optimize.brentq(lambda x: _between(x, 0.8, abb)[0] - w0, 1.0 + 1e-12, 3.0, xtol=1e-15)
+    assert rel(s["w"], w0) < TOL
+    assert rel(s["lambda_s"], ls) < TOL and rel(s["lambda_z"], _between(ls, 0.8, abb)[1]) < TOL
+    assert rel(s["force"], w0 * (ls - 0.8)) < TOL
+    # arrays of rho, and the closed gas refuses a pressure
+    t = tubemem.gps_flatten(1.3, np.array([1.0, 0.8]), control="pressure")
+    assert rel(t["lambda_s"][1], ls) < TOL
+    with pytest.raises(ValueError, match="control"):
+        tubemem.gps_flatten(1.3, 0.8, pressure=0.5)
+    # neo-Hookean between fixed plates at rho = 0.8: the first maximum of w along the states,
+    # by scipy's bounded minimization (xatol 1e-10: w is flat there, its value to ~1e-16)
+    nh = {"model": "neo-hookean", "shear_modulus": 1.0}
+    nh_law = ("mooney-rivlin", 0.0)
+    m = optimize.minimize_scalar(
+        lambda x: -_between(x, 0.8, nh_law)[0], bounds=(1.5, 3.0), method="bounded",
+        options={"xatol": 1e-10},
+    )
+    c = tubemem.gps_critical_pressure(0.8, material=nh)
+    assert rel(c["w"], -m.fun) < 1e-10
+    assert abs(c["lambda_s"] - m.x) < 1e-4
+    assert tubemem.gps_critical_pressure(0.8) is None  # ABB 30 locks first
+    b = tubemem.gps_between_plates(0.8, 1.2, material=nh)
+    ls_b = optimize.brentq(lambda x: _between(x, 0.8, nh_law)[0] - 1.2, 1.0 + 1e-9, m.x, xtol=1e-15)
+    assert rel(b["lambda_s"], ls_b) < TOL
+    with pytest.raises(ValueError, match="snaps"):
+        tubemem.gps_between_plates(0.8, 1.5, material=nh)
 
 
 def test_resultants_are_eq_58_and_take_any_material():

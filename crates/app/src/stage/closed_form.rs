@@ -42,32 +42,11 @@ pub(crate) fn flattening(
         Supply::Closed => flatten(law, hyp, ls0, rho),
         Supply::Regulated => {
             let s = squeeze_at_pressure(law, hyp, free_start(law, hyp, ls0)?, rho, w)?;
-            Ok(FlatteningState {
-                w: s.w,
-                lambda_s: s.lambda_s,
-                lambda_z: s.lambda_z,
-                n_s: s.n_s,
-                n_z: s.n_z,
-                rho: s.rho,
-                chi: s.chi,
-                force: s.force,
-                displacement: ls0 - s.rho,
-            })
+            Ok(s.as_flattening(ls0))
         }
         Supply::ClosedAfterRegulated { rho: r1, w: w1 } => {
             let s1 = squeeze_at_pressure(law, hyp, free_start(law, hyp, ls0)?, r1, w1)?;
-            let s = flatten_closed_from(law, hyp, s1, rho)?;
-            Ok(FlatteningState {
-                w: s.w,
-                lambda_s: s.lambda_s,
-                lambda_z: s.lambda_z,
-                n_s: s.n_s,
-                n_z: s.n_z,
-                rho: s.rho,
-                chi: s.chi,
-                force: s.force,
-                displacement: ls0 - s.rho,
-            })
+            Ok(flatten_closed_from(law, hyp, s1, rho)?.as_flattening(ls0))
         }
     }
 }
