@@ -586,7 +586,7 @@ pub fn section_at_pressure(
     };
     let [ls, lz] = newton::system2(f, guess, 1e-12)
         .map_err(|e| e.into_error("GPS section at a given pressure (eq. 76)", &at))?;
-    let chi = contact_length(
+    contact_length(
         ls,
         rho,
         "GPS section at a given pressure (negative contact length: ϖ too low for ρ)",
@@ -597,7 +597,20 @@ pub fn section_at_pressure(
         at,
         source,
     })?;
-    Ok(SectionState {
+    Ok(section_state(w, rho, ls, lz, &r))
+}
+
+/// The section at half-gap `rho` under pressure `w` with stretches (λs, λz) and their
+/// resultants `r` (χ = λs − ρ, the force ϖχ).
+pub(crate) fn section_state(
+    w: f64,
+    rho: f64,
+    ls: f64,
+    lz: f64,
+    r: &resultants::Resultants,
+) -> SectionState {
+    let chi = ls - rho;
+    SectionState {
         w,
         rho,
         lambda_s: ls,
@@ -606,7 +619,7 @@ pub fn section_at_pressure(
         n_z: r.nz,
         chi,
         force: w * chi,
-    })
+    }
 }
 
 #[cfg(test)]

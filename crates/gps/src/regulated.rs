@@ -274,6 +274,18 @@ pub fn between_plates(
     }
 }
 
+/// A squeeze from `from` moves the plates in, not out.
+fn check_closing(rho: f64, from: &SectionState) -> Result<(), GpsError> {
+    if rho > from.rho {
+        return Err(invalid(
+            "rho",
+            rho,
+            "a squeeze moves the plates in: ρ must not exceed the starting half-gap",
+        ));
+    }
+    Ok(())
+}
+
 fn check_w(w: f64) -> Result<(), GpsError> {
     if w.is_finite() && w > 0.0 {
         Ok(())
@@ -342,16 +354,7 @@ fn polish(
             rho,
         });
     }
-    Ok(SectionState {
-        w,
-        rho,
-        lambda_s: ls,
-        lambda_z: lz,
-        n_s: r.ns,
-        n_z: r.nz,
-        chi,
-        force: w * chi,
-    })
+    Ok(crate::section_state(w, rho, ls, lz, &r))
 }
 
 /// The slope dϖ/dλs of the states at `s.rho` through `s` (see the module): > 0 where a
@@ -385,13 +388,7 @@ pub fn squeeze_at_pressure(
     check_rho(rho)?;
     check_w(w)?;
     check_w(from.w)?;
-    if rho > from.rho {
-        return Err(invalid(
-            "rho",
-            rho,
-            "a squeeze moves the plates in: ρ must not exceed the starting half-gap",
-        ));
-    }
+    check_closing(rho, &from)?;
     let point = |t: f64| (from.rho + t * (rho - from.rho), from.w + t * (w - from.w));
     let predict = |a: &(f64, SectionState), b: Option<&(f64, SectionState)>, t: f64| match b {
         Some(b) if a.0 != b.0 => {
@@ -568,13 +565,7 @@ pub fn flatten_closed_from(
 ) -> Result<SectionState, GpsError> {
     check_rho(rho)?;
     check_w(from.w)?;
-    if rho > from.rho {
-        return Err(invalid(
-            "rho",
-            rho,
-            "a squeeze moves the plates in: ρ must not exceed the starting half-gap",
-        ));
-    }
+    check_closing(rho, &from)?;
     let s = crate::flatten_from(law, hyp, from, rho)?;
     Ok(SectionState {
         w: s.w,
