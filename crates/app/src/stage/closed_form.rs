@@ -21,6 +21,17 @@ pub enum Supply {
     ClosedAfterRegulated { rho: f64, w: f64 },
 }
 
+impl From<crate::case::GasControl> for Supply {
+    /// A stage's own supply (the run makes a closed one after a regulated squeeze the mixed
+    /// path, [`Supply::ClosedAfterRegulated`]).
+    fn from(gas: crate::case::GasControl) -> Self {
+        match gas {
+            crate::case::GasControl::Closed => Supply::Closed,
+            crate::case::GasControl::Regulated { .. } => Supply::Regulated,
+        }
+    }
+}
+
 /// Where a stage's closed form starts: the free tube's λs*, and how the gas is supplied.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClosedFormStart {

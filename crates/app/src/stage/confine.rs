@@ -40,18 +40,8 @@ impl StageKind for Confine {
         true
     }
 
-    fn target_pressure(&self) -> Option<f64> {
-        match self.gas {
-            GasControl::Regulated { target_pressure } => target_pressure,
-            GasControl::Closed => None,
-        }
-    }
-
     fn supply(&self) -> closed_form::Supply {
-        match self.gas {
-            GasControl::Closed => closed_form::Supply::Closed,
-            GasControl::Regulated { .. } => closed_form::Supply::Regulated,
-        }
+        self.gas.into()
     }
 
     fn range(&self, input: &RangeInput) -> std::result::Result<(f64, f64, f64), String> {

@@ -115,7 +115,9 @@ pub trait StageKind {
         false
     }
 
-    /// A pressure-controlled target ϖ, if this is one.
+    /// An inflation's pressure-controlled target ϖ, if this is one (a failure short of it is
+    /// explained by the free inflation's pressure maximum; a regulated squeeze's ramp is not
+    /// such a target).
     fn target_pressure(&self) -> Option<f64> {
         None
     }

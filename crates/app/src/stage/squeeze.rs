@@ -30,18 +30,8 @@ impl StageKind for Squeeze {
         true
     }
 
-    fn target_pressure(&self) -> Option<f64> {
-        match self.gas {
-            GasControl::Regulated { target_pressure } => target_pressure,
-            GasControl::Closed => None,
-        }
-    }
-
     fn supply(&self) -> Supply {
-        match self.gas {
-            GasControl::Closed => Supply::Closed,
-            GasControl::Regulated { .. } => Supply::Regulated,
-        }
+        self.gas.into()
     }
 
     fn range(&self, input: &RangeInput) -> Result<(f64, f64, f64), String> {
