@@ -582,9 +582,6 @@ fn run_regulated(a: FlattenArgs) -> Result<()> {
     use tubemem_gps::regulated::{
         between_plates, critical_pressure, free_start, squeeze_at_pressure,
     };
-    if a.to.is_some() && a.pressure.is_some() && a.initial_stretch.is_none() {
-        bail!("a regulated curve starts from the inflated tube: give --initial-stretch λs*");
-    }
     let law = a.material.build()?;
     let units = a.units.units(law.as_ref())?;
     let hyp: Hypothesis = a.hypothesis.into();

@@ -296,26 +296,6 @@ fn check_w(w: f64) -> Result<(), GpsError> {
 
 /// The section at half-gap `rho` under pressure `w` from `guess` (λs, λz): eqs. (76) by
 /// Newton, both unknowns under GPS, λs alone under PS (λz = 1, N_z the reaction).
-pub fn section(
-    law: &dyn MembraneLaw,
-    hyp: Hypothesis,
-    rho: f64,
-    w: f64,
-    guess: [f64; 2],
-) -> Result<SectionState, GpsError> {
-    check_rho(rho)?;
-    check_w(w)?;
-    if !(guess.iter().all(|g| g.is_finite() && *g > 0.0)) {
-        return Err(invalid(
-            "guess",
-            guess[0],
-            "the initial (λs, λz) must be finite and positive",
-        ));
-    }
-    let at = format!("ρ = {}, ϖ = {}", Num(rho), Num(w));
-    polish(law, hyp, rho, w, guess, &at)
-}
-
 fn polish(
     law: &dyn MembraneLaw,
     hyp: Hypothesis,
@@ -359,7 +339,7 @@ fn polish(
 
 /// The slope dϖ/dλs of the states at `s.rho` through `s` (see the module): > 0 where a
 /// pressure-controlled section is stable.
-pub fn pressure_slope(
+fn pressure_slope(
     law: &dyn MembraneLaw,
     hyp: Hypothesis,
     s: &SectionState,
