@@ -49,23 +49,9 @@ def main():
         return end_effect(a, out, text)
     rows = []
     for n in [int(v) for v in a.around.split(",")]:
-        along = round(n * a.length / 8)
-        case = (
-            text.replace("around = 32", f"around = {n}")
-            .replace("along = 80", f"along = {along}")
-            .replace("length = 20.0", f"length = {a.length}")
-        )
-        path = out / f"around{n}.toml"
-        path.write_text(case)
-        run = out / f"around{n}"
         t0 = time.time()
-        subprocess.run(
-            [a.bin, "run", str(path), "--out", str(run), "--overwrite"],
-            check=True,
-            stdout=subprocess.DEVNULL,
-        )
+        stage, run = run_variant(a, out, text, f"around{n}", n, a.length)
         wall = time.time() - t0
-        stage = json.loads((run / "summary.json").read_text())["stages"][-1]
         err = stage["relative_error_vs_gps"]
         with open(run / "steps.csv") as f:
             pen = max(
@@ -96,25 +82,33 @@ def main():
     print(table)
 
 
+def run_variant(a, out, text, name, n, length):
+    """The shipped case with `n` around, `length` (in R) and along = n·length/8 (the shipped
+    element aspect), run into OUT/name: its last stage's summary and its folder."""
+    case = (
+        text.replace("around = 32", f"around = {n}")
+        .replace("along = 80", f"along = {round(n * length / 8)}")
+        .replace("length = 20.0", f"length = {length}")
+    )
+    path = out / f"{name}.toml"
+    path.write_text(case)
+    run = out / name
+    subprocess.run(
+        [a.bin, "run", str(path), "--out", str(run), "--overwrite"],
+        check=True,
+        stdout=subprocess.DEVNULL,
+    )
+    return json.loads((run / "summary.json").read_text())["stages"][-1], run
+
+
 def end_effect(a, out, text):
-    n = int(a.around.split(",")[0]) if "," not in a.around else 32
+    # one mesh: the --around given, or 32 when it is the list of the refinement study
+    ns = [int(v) for v in a.around.split(",")]
+    n = ns[0] if len(ns) == 1 else 32
     lengths = [float(v) for v in a.lengths.split(",")]
     errs = {}
     for length in lengths:
-        case = (
-            text.replace("around = 32", f"around = {n}")
-            .replace("along = 80", f"along = {round(4 * length * n / 32)}")
-            .replace("length = 20.0", f"length = {length}")
-        )
-        path = out / f"length{length:g}.toml"
-        path.write_text(case)
-        run = out / f"length{length:g}"
-        subprocess.run(
-            [a.bin, "run", str(path), "--out", str(run), "--overwrite"],
-            check=True,
-            stdout=subprocess.DEVNULL,
-        )
-        stage = json.loads((run / "summary.json").read_text())["stages"][-1]
+        stage, _ = run_variant(a, out, text, f"length{length:g}", n, length)
         errs[length] = [stage["relative_error_vs_gps"][k] for k in KEYS[:3]]
     ref = errs[max(lengths)]
     lines = [
