@@ -61,6 +61,8 @@ fn a_regulated_squeeze_holds_its_pressure_and_ends_at_the_gps_section_of_that_pr
     assert_eq!(c.rho, 0.8);
     assert!(c.penetration < 1e-8, "penetration {}", c.penetration);
     // the closed-gas squeeze to the same ρ ends at another pressure: the control matters
+    // (measured ϖ 0.821 against the held 0.651, 26 % higher; bound 5 %, well inside the
+    // difference and far above any discretization error of either run)
     let closed = Case::parse(&REGULATED.replace("control = \"pressure\"\n", "")).unwrap();
     let rc = run(&closed, "closed", &mut []).into_result().unwrap();
     let w_closed = finished(&rc, 1).final_state.midspan.w;

@@ -121,7 +121,9 @@ def test_the_regulated_squeeze_and_the_critical_pressure_match_scipy():
     )
     c = tubemem.gps_critical_pressure(0.8, material=nh)
     assert rel(c["w"], -m.fun) < 1e-10
-    assert abs(c["lambda_s"] - m.x) < 1e-4
+    # w is flat at its maximum: a rounding of 1e-16 in w moves the located maximum by about
+    # sqrt(2e-16 w/|w''|) ~ 1e-8 (measured 2.4e-8); bound 1e-6
+    assert abs(c["lambda_s"] - m.x) < 1e-6
     assert tubemem.gps_critical_pressure(0.8) is None  # ABB 30 locks first
     b = tubemem.gps_between_plates(0.8, 1.2, material=nh)
     ls_b = optimize.brentq(lambda x: _between(x, 0.8, nh_law)[0] - 1.2, 1.0 + 1e-9, m.x, xtol=1e-15)
