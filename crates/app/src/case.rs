@@ -655,6 +655,18 @@ pub struct StageSpec {
     /// arc-length stages: "follow-stable" switches branch at a bifurcation where the path
     /// loses stability, along the critical mode
     pub branch: Option<BranchSpec>,
+    /// inflate only, after a squeeze: "held" keeps that squeeze's plates where it left them
+    /// while the pressure rises (control = "pressure" or "arc-length" to `target_pressure`):
+    /// the inflation between fixed plates, which snaps at a critical pressure
+    pub plates: Option<PlatesSpec>,
+}
+
+/// `plates` of an inflate stage.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlatesSpec {
+    /// the previous squeeze's plates stay where it left them
+    Held,
 }
 
 /// `contact_method` of a squeeze or confine stage.
@@ -773,6 +785,15 @@ impl StagePlan {
 
     /// The stage label in words, its target in `units`.
     pub fn describe_in(&self, units: &Units) -> String {
+        if self.held_plates {
+            let v = self.target.value_in(units);
+            let how = if self.arc_length {
+                "arc-length continuation"
+            } else {
+                "pressure control"
+            };
+            return format!("inflate between the held plates, {how} to {v}");
+        }
         if let GasControl::Regulated { target_pressure } = self.gas {
             let v = self.target.value_in(units);
             let supply = match target_pressure {
@@ -835,6 +856,10 @@ pub struct StagePlan {
     /// squeeze and confine stages: how the gas is supplied while the planes move
     #[serde(default)]
     pub gas: GasControl,
+    /// an inflation between the previous squeeze's plates, held where it left them
+    /// (`plates = "held"`)
+    #[serde(default)]
+    pub held_plates: bool,
 }
 
 /// How the gas of a squeeze or confine stage is supplied while its planes move.
@@ -923,6 +948,7 @@ impl StageSpec {
                 }
                 _ => GasControl::Closed,
             },
+            held_plates: self.plates == Some(PlatesSpec::Held),
         })
     }
 
@@ -992,6 +1018,12 @@ impl StageSpec {
                 i + 1
             ),
         };
+        if self.plates.is_some() && !matches!(t, Target::Pressure(_)) {
+            invalid!(
+                "[[stage]] {}: `plates = \"held\"` belongs to an inflate stage raising the pressure (control = \"pressure\" or \"arc-length\" with `target_pressure`): the plates of the squeeze before it stay where it left them",
+                i + 1
+            );
+        }
         if self.kind != Kind::Confine && !self.plane.is_empty() {
             invalid!(
                 "[[stage]] {}: [[stage.plane]] belongs to kind = \"confine\" stages",
@@ -1492,10 +1524,26 @@ impl Case {
         let units = self.units();
         let mut plan = Vec::with_capacity(self.stages.len());
         for (i, s) in self.stages.iter().enumerate() {
-            plan.push(s.plan(i, &units)?);
+            let mut p = s.plan(i, &units)?;
+            // held plates are enforced as the squeeze that placed them
+            if let (true, Some(prev)) = (p.held_plates, plan.last()) {
+                let prev: &StagePlan = prev;
+                p.enforcement = prev.enforcement;
+                p.contact_points = prev.contact_points;
+            }
+            plan.push(p);
             if matches!(s.kind, Kind::Squeeze | Kind::Confine) && i == 0 {
                 invalid!(
                     "[[stage]] 1: a squeeze or confine stage needs an inflated tube: put an inflate stage before it"
+                );
+            }
+            let after_plates = i > 0
+                && (self.stages[i - 1].kind == Kind::Squeeze
+                    || self.stages[i - 1].plates.is_some());
+            if s.plates.is_some() && !after_plates {
+                invalid!(
+                    "[[stage]] {}: `plates = \"held\"` holds the plates of the squeeze just before it: put a squeeze stage before this one",
+                    i + 1
                 );
             }
         }

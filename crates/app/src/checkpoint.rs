@@ -23,6 +23,10 @@ pub struct StageContext {
     /// and the pressure ϖ at which the gas was closed in
     #[serde(default)]
     pub gas_closed_at: Option<[f64; 2]>,
+    /// an inflation between held plates (`plates = "held"`): their half-gap, where the squeeze
+    /// before it left them
+    #[serde(default)]
+    pub held_plates: Option<f64>,
     /// the contact penalty of a squeeze (0 otherwise)
     pub penalty: f64,
     /// the mid-span λs at the stage start (λs* of a squeeze)

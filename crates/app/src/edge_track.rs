@@ -69,6 +69,8 @@ impl TubeSpec {
 pub enum Pressing {
     /// plates y = ±h, h the load value
     Plates,
+    /// plates y = ±h held at this h whatever the load value (an inflation between them)
+    HeldPlates(f64),
     /// the stage's planes at the load value t of their path
     Walls(Vec<PlaneSpec>),
 }
@@ -93,8 +95,11 @@ impl Tracker<'_> {
             return Ok(vec![]);
         }
         match &self.pressing {
-            Pressing::Plates => {
-                let rho = value;
+            Pressing::Plates | Pressing::HeldPlates(_) => {
+                let rho = match self.pressing {
+                    Pressing::HeldPlates(h) => h,
+                    _ => value,
+                };
                 // the free circle at ϖ reaches the plates: below ρ = 1 always, above it once
                 // ϖ passes the inflation's pressure at λs = ρ
                 let touches = rho < 1.0

@@ -44,6 +44,7 @@ pub(super) fn drive_stage(
         start_pressure: context.start_pressure,
         range: (context.from, context.to),
         penalty: context.penalty,
+        held_plates: context.held_plates,
         enforcement: plan.contact_enforcement(),
         points: plan.contact_points,
     };
@@ -128,6 +129,7 @@ pub(super) fn drive_stage(
                 last_limit_w0,
                 follow_stable: plan.follow_stable,
                 limits: r.limits.as_ref(),
+                own_max: kind.limit_reference(r.law.as_ref(), context.held_plates),
                 polygon: r.case.mesh.polygon_factor(),
                 node: r.node,
                 pending: &pending,
@@ -140,9 +142,10 @@ pub(super) fn drive_stage(
                 .map(|tube| crate::edge_track::Tracker {
                     tube,
                     law: r.law.as_ref(),
-                    pressing: match kind.planes() {
-                        Some(planes) => crate::edge_track::Pressing::Walls(planes.to_vec()),
-                        None => crate::edge_track::Pressing::Plates,
+                    pressing: match (kind.planes(), context.held_plates) {
+                        (Some(planes), _) => crate::edge_track::Pressing::Walls(planes.to_vec()),
+                        (None, Some(h)) => crate::edge_track::Pressing::HeldPlates(h),
+                        (None, None) => crate::edge_track::Pressing::Plates,
                     },
                     edges: r.tracked_edges.clone(),
                 });
@@ -287,6 +290,8 @@ struct ArcStage<'a> {
     last_limit_w0: Option<f64>,
     follow_stable: bool,
     limits: Option<&'a tubemem_gps::limits::Limits>,
+    /// the stage's own pressure maximum (an inflation between held plates)
+    own_max: Option<crate::report::CriticalReference>,
     polygon: Option<f64>,
     node: usize,
     pending: &'a RefCell<Vec<PendingCritical>>,
@@ -324,6 +329,7 @@ fn follow_arc(
                 &loading.load_at(&c.state),
                 index,
                 a.limits,
+                a.own_max.as_ref(),
                 a.polygon,
                 &last_limit,
                 &mut a.pending.borrow_mut(),

@@ -229,6 +229,7 @@ impl<'a> Runner<'a> {
             node: self.node,
             v0: self.v0,
             guided: self.coarse.as_ref().is_some_and(|c| c.guides(plan.index)),
+            units: self.case.units(),
         };
         let context = setup_stage(kind, plan, &setup, &mut self.model, &mut self.state, report)?;
         Ok(StageStart {

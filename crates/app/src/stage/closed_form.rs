@@ -4,7 +4,9 @@
 
 use crate::report::*;
 use crate::{AppError, Result};
-use tubemem_gps::regulated::{flatten_closed_from, free_start, squeeze_at_pressure};
+use tubemem_gps::regulated::{
+    between_plates, flatten_closed_from, free_start, squeeze_at_pressure,
+};
 use tubemem_gps::{flatten, inflate, section_at_pressure, FlatteningState, GpsError, Hypothesis};
 use tubemem_material::MembraneLaw;
 
@@ -19,6 +21,10 @@ pub enum Supply {
     /// the mixed path: squeezed from λs* with the pressure regulated to half-gap `rho` under
     /// the pressure `w`, then the gas closed in there ([`flatten_closed_from`])
     ClosedAfterRegulated { rho: f64, w: f64 },
+    /// an inflation between held plates: the section between them at the FE's pressure, from
+    /// the stress-free tube ([`between_plates`]) when they are closer than its radius, as
+    /// [`Supply::Regulated`] otherwise
+    HeldPlates,
 }
 
 impl From<crate::case::GasControl> for Supply {
@@ -51,7 +57,8 @@ pub(crate) fn flattening(
 ) -> std::result::Result<FlatteningState, GpsError> {
     match supply {
         Supply::Closed => flatten(law, hyp, ls0, rho),
-        Supply::Regulated => {
+        Supply::HeldPlates if rho < 1.0 => Ok(between_plates(law, hyp, rho, w)?.as_flattening(ls0)),
+        Supply::Regulated | Supply::HeldPlates => {
             let s = squeeze_at_pressure(law, hyp, free_start(law, hyp, ls0)?, rho, w)?;
             Ok(s.as_flattening(ls0))
         }

@@ -78,7 +78,9 @@ pub(crate) struct PendingCritical {
 }
 
 /// The record of a located critical point (its mid-span values, the closed form's limit point
-/// of the same kind, and for a bifurcation the critical mode), queued in `pending`.
+/// of the same kind, and for a bifurcation the critical mode), queued in `pending`. A stage
+/// whose path has its own pressure maximum (`own_max`, [`super::StageKind::limit_reference`])
+/// compares its maxima with that, and nothing else with the free inflation's `limits`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn critical_record(
     model: &mut Model,
@@ -86,32 +88,39 @@ pub(crate) fn critical_record(
     load: &Load,
     stage: usize,
     limits: Option<&tubemem_gps::limits::Limits>,
+    own_max: Option<&CriticalReference>,
     polygon: Option<f64>,
     last_limit: &std::cell::Cell<Option<f64>>,
     pending: &mut Vec<PendingCritical>,
 ) -> std::result::Result<(), tubemem_fem::FemError> {
     let ms = midspan(model, &c.state)?;
-    let reference = limits.and_then(|l| match c.kind {
-        // a mid-span past the uniform curve's minimum (λs beyond it) is in the upper phase of a
-        // bulge, whose pressure is Maxwell's (a uniform tube cannot be there at a limit point)
-        CriticalKind::Bifurcation | CriticalKind::Neutral => None,
-        _ if l.min.is_some_and(|mn| ms.lambda_s > mn.lambda_s) && l.maxwell.is_some() => {
-            l.maxwell.map(|mw| CriticalReference {
-                what: "Maxwell pressure".into(),
-                w: mw.w,
-                lambda_s: mw.lambda_s_upper,
-            })
-        }
-        CriticalKind::LimitMax => l.max.map(|m| CriticalReference {
-            what: "GPS limit point (maximum)".into(),
-            w: m.w,
-            lambda_s: m.lambda_s,
-        }),
-        CriticalKind::LimitMin => l.min.map(|m| CriticalReference {
-            what: "GPS limit point (minimum)".into(),
-            w: m.w,
-            lambda_s: m.lambda_s,
-        }),
+    let limits = limits.filter(|_| own_max.is_none());
+    let own = own_max
+        .filter(|_| c.kind == CriticalKind::LimitMax)
+        .cloned();
+    let reference = own.or_else(|| {
+        limits.and_then(|l| match c.kind {
+            // a mid-span past the uniform curve's minimum (λs beyond it) is in the upper phase of a
+            // bulge, whose pressure is Maxwell's (a uniform tube cannot be there at a limit point)
+            CriticalKind::Bifurcation | CriticalKind::Neutral => None,
+            _ if l.min.is_some_and(|mn| ms.lambda_s > mn.lambda_s) && l.maxwell.is_some() => {
+                l.maxwell.map(|mw| CriticalReference {
+                    what: "Maxwell pressure".into(),
+                    w: mw.w,
+                    lambda_s: mw.lambda_s_upper,
+                })
+            }
+            CriticalKind::LimitMax => l.max.map(|m| CriticalReference {
+                what: "GPS limit point (maximum)".into(),
+                w: m.w,
+                lambda_s: m.lambda_s,
+            }),
+            CriticalKind::LimitMin => l.min.map(|m| CriticalReference {
+                what: "GPS limit point (minimum)".into(),
+                w: m.w,
+                lambda_s: m.lambda_s,
+            }),
+        })
     });
     let (mode, mode_eigenvalue) =
         if matches!(c.kind, CriticalKind::Bifurcation | CriticalKind::Neutral) {

@@ -7,6 +7,7 @@
 //! |---|---|---|---|
 //! | inflate | [`inflate::Inflate`] (pressure, stretch or volume control) | ϖ, λs at a node, or V | GPS/PS inflation |
 //! | squeeze | [`squeeze::Squeeze`] (gas closed or regulated) | plate half-gap h | GPS/PS flattening (Boyle, or at the held pressure), section at the FE's ϖ |
+//! | inflate, `plates = "held"` | [`held::HeldPlates`] | ϖ (the previous squeeze's plates held) | the section between the plates at the FE's ϖ, its critical pressure |
 //! | confine | [`confine::Confine`] (gas closed or regulated) | t ∈ [0, 1] along the planes' paths | GPS/PS confinement by the same walls |
 //!
 //! How a squeeze or confine stage's gas is supplied ([`GasControl`]) is one value the kind
@@ -24,6 +25,7 @@ pub mod closed_form;
 pub mod confine;
 pub mod critical;
 pub mod failure;
+pub mod held;
 pub mod inflate;
 pub mod profile;
 pub mod record;
@@ -65,6 +67,8 @@ pub struct LoadParts {
     pub range: (f64, f64),
     /// the planes' penalty κ (squeeze and confine)
     pub penalty: f64,
+    /// an inflation between held plates: their half-gap
+    pub held_plates: Option<f64>,
     pub enforcement: Enforcement,
     pub points: ContactPoints,
 }
@@ -230,11 +234,23 @@ pub trait StageKind {
     fn planes(&self) -> Option<&[PlaneSpec]> {
         None
     }
+
+    /// The closed form's pressure maximum of the stage's own path, when it is not the free
+    /// inflation's (an inflation between plates held at half-gap `held_plates`): the
+    /// reference of a maximum the arc length locates, and of a target above it.
+    fn limit_reference(
+        &self,
+        _law: &dyn MembraneLaw,
+        _held_plates: Option<f64>,
+    ) -> Option<crate::report::CriticalReference> {
+        None
+    }
 }
 
 /// The kind of a planned stage (`planes`: the stage's `[[stage.plane]]`s).
 pub fn kind_of(plan: &StagePlan, planes: &[PlaneSpec]) -> Box<dyn StageKind> {
     match plan.target {
+        Target::Pressure(target) if plan.held_plates => Box::new(held::HeldPlates { target }),
         Target::Pressure(p) => Box::new(inflate::Inflate {
             control: inflate::Control::Pressure(p),
         }),

@@ -6,6 +6,7 @@ use crate::case::StagePlan;
 use crate::checkpoint::StageContext;
 use crate::observer::BoxError;
 use crate::report::*;
+use crate::units::Dimension;
 use crate::{AppError, Result};
 use tubemem_fem::model::{Model, State};
 use tubemem_fem::post::midspan;
@@ -25,6 +26,8 @@ pub struct SetupInput<'a> {
     /// the stage's steps start from a coarse run's states (`[solver] mesh_sequencing`), which
     /// are loaded: no pre-stress
     pub guided: bool,
+    /// the case's units, for what the set-up says
+    pub units: crate::units::Units,
 }
 
 /// Set up a stage of `kind` at its start. A precondition that fails is recorded in the report
@@ -142,6 +145,22 @@ pub(crate) fn setup_stage(
             return Err(AppError::StageInput { stage: i, message });
         }
     };
+    let held_plates = previous_squeeze.map(|c| c.rho).filter(|_| plan.held_plates);
+    if let (Some(c), crate::case::Target::Pressure(t), false) = (
+        kind.limit_reference(run.law, held_plates),
+        plan.target,
+        plan.arc_length,
+    ) {
+        if t > c.w {
+            report.warnings.push(format!(
+                "stage {i}: the target {} is above the {} ({} at λs = {:.4}): under pressure control the section snaps there, and the run stops near it (control = \"arc-length\" locates the FE's own maximum)",
+                run.units.show(Dimension::Pressure, t),
+                c.what,
+                run.units.show(Dimension::Pressure, c.w),
+                c.lambda_s
+            ));
+        }
+    }
     match (prestressed_from, from_before) {
         (Some(f), _) | (None, Some(f)) => from = f,
         _ => {}
@@ -157,6 +176,7 @@ pub(crate) fn setup_stage(
         } else {
             None
         },
+        held_plates,
         penalty,
         // a squeeze that continues a squeeze compares with the flattening from the same λs*
         // and a confine that continues a confine from the same λs* too

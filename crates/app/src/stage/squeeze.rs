@@ -83,14 +83,25 @@ impl StageKind for Squeeze {
         info: &StepInfo<'_>,
         start: super::closed_form::ClosedFormStart,
     ) -> Option<ContactRecord> {
-        let start_lambda_s = start.lambda_s;
-        info.load.contact.as_ref().and_then(|c| {
-            midspan_contact(model, state, c).map(|values| ContactRecord {
-                values,
-                displacement: start_lambda_s - values.rho,
-                initial_stretch: start_lambda_s,
-                penalty: c.penalty,
-            })
-        })
+        plates_contact(model, state, info, start)
     }
+}
+
+/// The mid-span contact with the plates of a step's load (a squeeze, or an inflation between
+/// held plates), its displacement measured from the free tube's λs* the closed form starts at.
+pub(crate) fn plates_contact(
+    model: &Model,
+    state: &State,
+    info: &StepInfo<'_>,
+    start: super::closed_form::ClosedFormStart,
+) -> Option<ContactRecord> {
+    let start_lambda_s = start.lambda_s;
+    info.load.contact.as_ref().and_then(|c| {
+        midspan_contact(model, state, c).map(|values| ContactRecord {
+            values,
+            displacement: start_lambda_s - values.rho,
+            initial_stretch: start_lambda_s,
+            penalty: c.penalty,
+        })
+    })
 }
