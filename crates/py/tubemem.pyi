@@ -54,7 +54,7 @@ def gps_flatten(
 ) -> Union[dict[str, float], Table]:
     """Squeeze between two plates: control="gas", the gas closed in (eqs. 76–77 GPS, 78–79 PS);
     control="pressure", regulated (eqs. 76 at the inflated pressure held, or ramped to
-    `pressure`)."""
+    `pressure`), with "stiffness": the plates' -d(force)/d(2 rho) at that pressure."""
 
 def gps_between_plates(
     rho: float, w: float, material: MaterialLike = None, hypothesis: str = "gps"

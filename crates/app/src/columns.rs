@@ -35,13 +35,13 @@ pub const STEPS_HEADER: &str = "stage,step,w,lambda_s,lambda_z,n_s,n_z,n_sz,volu
 gps_w,gps_lambda_s,gps_lambda_z,gps_chi,gps_force,local_lambda_s,local_lambda_z,local_chi,local_force,\
 arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
 augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,\
-mesh_refits,plate_force";
+mesh_refits,plate_force,stiffness,gps_stiffness,plate_stiffness";
 
 /// The SI columns steps.csv adds after [`STEPS_HEADER`] with `[units] system = "SI"`: the
 /// mid-span pressure p = ϖ μH/R, the resultants n μH, in a squeeze the plate force per
 /// length force · πμH and the plates' half-gap ρR, then the total force on one plate, and
 /// GPS's pressure and force per length at the step.
-pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m,plate_force_n,gps_pressure_pa,gps_force_n_per_m";
+pub const SI_HEADER: &str = "pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m,half_gap_m,plate_force_n,gps_pressure_pa,gps_force_n_per_m,stiffness_pa,gps_stiffness_pa,plate_stiffness_n_per_m";
 
 /// The columns of critical_points.csv (`kind`: 1 pressure maximum, −1 pressure minimum, 2
 /// bifurcation, as steps.csv's `critical`).
@@ -101,7 +101,7 @@ const PROFILES_COLUMNS: [Column; 13] = [
     RING[8], RING[9],
 ];
 
-const STEPS_COLUMNS: [Column; 40] = [
+const STEPS_COLUMNS: [Column; 43] = [
     STAGE,
     STEP,
     c("w", "reduced mid-span pressure ϖ = pR/(μH) (eq. 67)"),
@@ -169,9 +169,21 @@ const STEPS_COLUMNS: [Column; 40] = [
         "plate_force",
         "squeeze: the total force on one plate (the whole tube, caps included, all symmetry copies) over μHR: the integral of the contact pressure over the plate",
     ),
+    c(
+        "stiffness",
+        "squeeze rows after a stage's first: the plates' effective stiffness −Δforce/Δgap over the step, the gap 2ρ (R), force per length over πμH: in πμH/R",
+    ),
+    c(
+        "gps_stiffness",
+        "the same from GPS's force at the step and the one before (the same two plate positions)",
+    ),
+    c(
+        "plate_stiffness",
+        "squeeze rows after a stage's first: −Δplate_force/Δgap over the step, the whole tube's force on one plate: in μH",
+    ),
 ];
 
-const SI_COLUMNS: [Column; 8] = [
+const SI_COLUMNS: [Column; 11] = [
     c(
         "pressure_pa",
         "with [units] system = \"SI\": the mid-span pressure p = ϖμH/R (Pa)",
@@ -197,6 +209,18 @@ const SI_COLUMNS: [Column; 8] = [
     c(
         "gps_force_n_per_m",
         "with SI units, squeeze rows: GPS's plate force per length, gps_force·πμH (N/m)",
+    ),
+    c(
+        "stiffness_pa",
+        "with SI units: stiffness·πμH/R, the force per length's −ΔF/Δgap (N/m per m of gap: Pa)",
+    ),
+    c(
+        "gps_stiffness_pa",
+        "with SI units: gps_stiffness·πμH/R (Pa)",
+    ),
+    c(
+        "plate_stiffness_n_per_m",
+        "with SI units: plate_stiffness·μH, the total plate force's −ΔF/Δgap (N/m)",
     ),
 ];
 

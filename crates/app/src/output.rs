@@ -163,6 +163,10 @@ pub fn step_row(r: &StepRecord) -> Vec<Option<f64>> {
     );
     v.push(r.edge_tracking.as_ref().map(|t| t.refits as f64));
     v.push(r.contact.as_ref().map(|c| c.values.total_force));
+    match &r.stiffness {
+        Some(k) => v.extend([Some(k.force), k.gps_force, Some(k.plate_force)]),
+        None => v.extend([None; 3]),
+    }
     v
 }
 
@@ -176,7 +180,7 @@ pub(crate) fn steps_header(units: bool) -> String {
 }
 
 /// The [`SI_HEADER`] values of a step (empty where the step has none).
-pub fn si_values(s: &tubemem_gps::Scales, r: &StepRecord) -> [Option<f64>; 8] {
+pub fn si_values(s: &tubemem_gps::Scales, r: &StepRecord) -> [Option<f64>; 11] {
     let v = crate::report::SiValues::of(s, &r.midspan, r.contact.as_ref().map(|c| &c.values));
     let cf = &r.closed_form;
     let (gps_w, gps_force) = match (&cf.gps_inflation, &cf.gps_flattening) {
@@ -193,6 +197,11 @@ pub fn si_values(s: &tubemem_gps::Scales, r: &StepRecord) -> [Option<f64>; 8] {
         v.plate_force_n,
         gps_w.map(|w| s.pressure(w)),
         gps_force.map(|f| s.force_per_length(f)),
+        r.stiffness.map(|k| s.force_per_length(k.force) / s.radius),
+        r.stiffness
+            .and_then(|k| k.gps_force)
+            .map(|k| s.force_per_length(k) / s.radius),
+        r.stiffness.map(|k| s.resultant(k.plate_force)),
     ]
 }
 

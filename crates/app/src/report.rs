@@ -145,6 +145,46 @@ pub struct StepRecord {
     /// node lines were fitted at this step, and how often the mesh moved after its first solve
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub edge_tracking: Option<EdgeTracking>,
+    /// a squeeze step after the stage's first: the plates' stiffness over the step
+    /// ([`Stiffness`])
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<Stiffness>,
+}
+
+/// The effective stiffness of the plates over one squeeze step, a gripper's −dF/dgap: the
+/// secant −ΔF/Δgap between the stage's previous converged step and this one, the gap 2ρ
+/// between the plates (in R). The FE's and the closed form's are taken over the same two plate
+/// positions, so they compare without the step size's error.
+#[derive(Clone, Copy, Debug, Serialize, schemars::JsonSchema, Deserialize, PartialEq)]
+pub struct Stiffness {
+    /// the mid-span force per length: −Δforce/Δ(2ρ), force over πμH, so in πμH/R
+    pub force: f64,
+    /// the same from the closed form's force at the two steps (absent where either has none)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gps_force: Option<f64>,
+    /// the total force on one plate (the whole tube): −Δplate_force/Δ(2ρ), in μH
+    pub plate_force: f64,
+}
+
+impl Stiffness {
+    /// The stiffness over the step from `before` to `after` (the same stage's), if both press
+    /// the plates and the plates moved.
+    pub fn between(before: &StepRecord, after: &StepRecord) -> Option<Self> {
+        let (a, b) = (before.contact.as_ref()?, after.contact.as_ref()?);
+        let dgap = 2.0 * (b.values.rho - a.values.rho);
+        if before.stage != after.stage || dgap == 0.0 || !dgap.is_finite() {
+            return None;
+        }
+        let gps = |r: &StepRecord| r.closed_form.gps_flattening.map(|g| g.force);
+        Some(Self {
+            force: -(b.values.force - a.values.force) / dgap,
+            gps_force: match (gps(before), gps(after)) {
+                (Some(fa), Some(fb)) => Some(-(fb - fa) / dgap),
+                _ => None,
+            },
+            plate_force: -(b.values.total_force - a.values.total_force) / dgap,
+        })
+    }
 }
 
 /// Where the mesh of a step with `[mesh] track_contact_edge` was fitted

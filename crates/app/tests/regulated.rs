@@ -44,6 +44,21 @@ fn a_regulated_squeeze_holds_its_pressure_and_ends_at_the_gps_section_of_that_pr
         let gps = s.closed_form.gps_flattening.expect("GPS at every step");
         assert_eq!(gps.w, inflated);
     }
+    // the gripper's stiffness over each step after the first: FE and GPS secants over the same
+    // two plate positions (measured FE/GPS − 1 from 4.0e-5 to 1.15e-4 on this mesh; bound
+    // 2.5e-4), positive (the force grows as the plates close)
+    assert!(steps[0].stiffness.is_none());
+    for s in &steps[1..] {
+        let k = s.stiffness.expect("a stiffness after the first step");
+        let g = k.gps_force.expect("GPS's");
+        assert!(k.force > 0.0 && k.plate_force > 0.0, "step {}", s.step);
+        assert!(
+            (k.force / g - 1.0).abs() < 2.5e-4,
+            "step {}: {} vs {g}",
+            s.step,
+            k.force
+        );
+    }
     let s = finished(&report, 1);
     assert_eq!(s.control.as_deref(), Some("pressure"));
     assert_eq!(finished(&report, 0).control.as_deref(), Some("volume"));
@@ -108,6 +123,21 @@ fn a_ramped_regulated_squeeze_ends_at_its_target_and_its_si_twin_is_the_same_run
     assert_eq!(sa.gps_applicable, sb.gps_applicable);
     let (ea, eb) = (&sa.relative_error_vs_gps, &sb.relative_error_vs_gps);
     assert!((ea.force.unwrap() - eb.force.unwrap()).abs() < 1e-8);
+    // the stiffness: the same in both (secants of states equal to 1e-9; bound 1e-6), and in
+    // Pa in the SI twin's rows: stiffness·πμH/R
+    let scales = tubemem_gps::Scales::new(r, h, mu).unwrap();
+    for (x, y) in a.stages[1].steps.iter().zip(&b.stages[1].steps).skip(1) {
+        let (kx, ky) = (x.stiffness.unwrap(), y.stiffness.unwrap());
+        assert!(
+            rel(ky.force, kx.force) < 1e-6,
+            "{} vs {}",
+            ky.force,
+            kx.force
+        );
+        let si = tubemem_app::output::si_values(&scales, y);
+        let pa = ky.force * std::f64::consts::PI * mu * h / r;
+        assert!(rel(si[8].unwrap(), pa) < 1e-14, "{:?} vs {pa}", si[8]);
+    }
     // the GPS end state is the section at (ρ, 0.45), reached from the free tube at λs*
     let law = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
     let c = sa.final_state.contact.unwrap();

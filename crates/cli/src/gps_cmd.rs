@@ -580,7 +580,7 @@ fn run_command(cmd: GpsCommand) -> Result<()> {
 fn run_regulated(a: FlattenArgs) -> Result<()> {
     use tubemem_app::units::Dimension;
     use tubemem_gps::regulated::{
-        between_plates, critical_pressure, free_start, squeeze_at_pressure,
+        between_plates, critical_pressure, free_start, plate_stiffness, squeeze_at_pressure,
     };
     let law = a.material.build()?;
     let units = a.units.units(law.as_ref())?;
@@ -611,8 +611,13 @@ fn run_regulated(a: FlattenArgs) -> Result<()> {
             ensure_finite(&values(&s))?;
             let mut v = serde_json::to_value(s)?;
             let c = critical_pressure(law.as_ref(), hyp, rho)?;
+            let k = plate_stiffness(law.as_ref(), hyp, &s)?;
             if let Some(map) = v.as_object_mut() {
                 map.insert("control".into(), "pressure".into());
+                map.insert("stiffness".into(), k.into());
+                if units.is_si() {
+                    map.insert("stiffness_pa".into(), stiffness_si(&units, k).into());
+                }
                 map.insert("w_critical".into(), c.map(|c| c.w).into());
                 if units.is_si() {
                     map.insert(
@@ -630,11 +635,15 @@ fn run_regulated(a: FlattenArgs) -> Result<()> {
             may_write("--csv", csv, &inputs, REGULATED_HEADER, a.overwrite)?;
             let rows =
                 tubemem_gps::regulated::regulated_curve(law.as_ref(), hyp, ls0, to, points, w)?;
-            write_csv(
-                csv,
-                REGULATED_HEADER,
-                rows.iter().map(|s| values(s).to_vec()),
-            )?;
+            let rows = rows
+                .iter()
+                .map(|s| {
+                    let mut v = values(s).to_vec();
+                    v.push(plate_stiffness(law.as_ref(), hyp, s)?);
+                    Ok(v)
+                })
+                .collect::<Result<Vec<_>, tubemem_gps::GpsError>>()?;
+            write_csv(csv, REGULATED_HEADER, rows.iter().cloned())?;
             crate::say!(
                 "wrote {} {} regulated flattening states (ρ {ls0} → {to}) to {}",
                 rows.len(),
@@ -649,8 +658,16 @@ fn run_regulated(a: FlattenArgs) -> Result<()> {
     }
 }
 
-/// The columns of a regulated flattening curve.
-const REGULATED_HEADER: &str = "w,lambda_s,lambda_z,n_s,n_z,rho,chi,force";
+/// The columns of a regulated flattening curve: the state, and the plates' stiffness
+/// −d(force)/d(2ρ) at the held pressure (`tubemem_gps::regulated::plate_stiffness`).
+const REGULATED_HEADER: &str = "w,lambda_s,lambda_z,n_s,n_z,rho,chi,force,stiffness";
+
+/// A plates' stiffness −dF/dgap (the force per length over πμH, the gap in R) in Pa: N/m of
+/// force per length per m of gap.
+fn stiffness_si(units: &tubemem_app::units::Units, k: f64) -> f64 {
+    use tubemem_app::units::Dimension;
+    units.from_core(Dimension::ForcePerLength, k) / units.from_core(Dimension::Length, 1.0)
+}
 
 fn print_limits(l: &Limits, json: bool, units: &tubemem_app::units::Units) -> Result<()> {
     use tubemem_app::units::Dimension;

@@ -352,6 +352,53 @@ fn pressure_slope(
     Ok(fam.at(s.lambda_s, s.lambda_z)?.slope)
 }
 
+/// The effective stiffness of the plates at a pressure-controlled state `s`, a gripper's
+/// −dF/dgap at fixed ϖ: the gap 2ρ, the force ϖχ = ϖ(λs − ρ) (eq. 80), so
+/// −d(ϖχ)/d(2ρ) = ϖ(1 − dλs/dρ)/2, in the force's unit per R. dλs/dρ at fixed ϖ comes from
+/// eqs. (76) differentiated, N_s = ϖρ and N_z = ϖρ − ϖρ²/(2λs):
+///
+/// ```text
+/// [∂N_s/∂λs                  ∂N_s/∂λz] [λs']   [ϖ           ]
+/// [∂N_z/∂λs − ϖρ²/(2λs²)     ∂N_z/∂λz] [λz'] = [ϖ − ϖρ/λs   ]
+/// ```
+///
+/// (under PS λz' = 0 and the first row alone: λs' = ϖ/(∂N_s/∂λs)).
+pub fn plate_stiffness(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    s: &SectionState,
+) -> Result<f64, GpsError> {
+    let (w, rho, ls) = (s.w, s.rho, s.lambda_s);
+    let r = resultants::resultants(law, ls, s.lambda_z).map_err(|source| GpsError::Material {
+        stage: "the plates' stiffness",
+        at: format!("ρ = {}, ϖ = {}", Num(rho), Num(w)),
+        source,
+    })?;
+    let dls = match hyp {
+        Hypothesis::Ps => w / r.jac[0][0],
+        Hypothesis::Gps => {
+            let a = [
+                [r.jac[0][0], r.jac[0][1]],
+                [r.jac[1][0] - w * rho * rho / (2.0 * ls * ls), r.jac[1][1]],
+            ];
+            let b = [w, w - w * rho / ls];
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            (b[0] * a[1][1] - a[0][1] * b[1]) / det
+        }
+    };
+    let k = 0.5 * w * (1.0 - dls);
+    if !k.is_finite() {
+        return Err(GpsError::NoConvergence {
+            stage:
+                "the plates' stiffness (the section's Jacobian is singular: the critical pressure)",
+            at: format!("ρ = {}, ϖ = {}", Num(rho), Num(w)),
+            residual: f64::NAN,
+            iterations: 0,
+        });
+    }
+    Ok(k)
+}
+
 /// A pressure-controlled squeeze: from the state `from` (a free inflation as a
 /// [`SectionState`] with χ = 0 and ρ = λs, or any squeezed state), the plates moved to
 /// half-gap `rho` and the pressure ramped to `w` (held: `w` = `from.w`), both linearly, each

@@ -17,7 +17,7 @@
 
 use tubemem_gps::regulated::{
     between_plates, critical_pressure, flatten_at_pressure, flatten_closed_from, free_start,
-    squeeze_at_pressure,
+    plate_stiffness, squeeze_at_pressure,
 };
 use tubemem_gps::{flatten, GpsError, Hypothesis};
 use tubemem_material::laws::{neo_hookean, AnssariBenamBucchi};
@@ -277,5 +277,36 @@ fn walls_touching_the_stress_free_tube_are_the_inflation_between_fixed_plates() 
             c.walls[0].force,
             b.force
         );
+    }
+}
+
+/// The plates' stiffness at fixed pressure (`plate_stiffness`, implicit differentiation of eqs.
+/// 76) against a central difference of the explicit states of eq. (58) at ρ ± 1e-4 (each state
+/// bisected to 1e-15): ABB 30 and neo-Hookean, GPS and PS. Bound 1e-7: the difference's
+/// truncation, δ² = 1e-8 times the force's third derivative over its first (order 1 here),
+/// well above its rounding (1e-15/1e-4).
+#[test]
+fn the_plates_stiffness_at_fixed_pressure_is_the_derivative_of_the_explicit_force() {
+    let nh = neo_hookean(1.0).unwrap();
+    let abb = abb30();
+    for (law, kn) in [
+        (&abb as &dyn tubemem_material::MembraneLaw, Some(30.0)),
+        (&nh, None),
+    ] {
+        for hyp in [Hypothesis::Gps, Hypothesis::Ps] {
+            let (w0, _) = free(1.3, kn, hyp);
+            for rho in [1.2, 1.0, 0.8] {
+                let force = |r: f64| {
+                    let ls = bisect(|ls| between(ls, r, kn, hyp).0 - w0, r.max(1.0) + 1e-12, 4.0);
+                    w0 * (ls - r)
+                };
+                let d = 1e-4;
+                let fd = -(force(rho + d) - force(rho - d)) / (2.0 * 2.0 * d);
+                let s = flatten_at_pressure(law, hyp, 1.3, rho).unwrap();
+                let k = plate_stiffness(law, hyp, &s).unwrap();
+                assert!(rel(k, fd) < 1e-7, "{hyp:?} {kn:?} ρ {rho}: {k} vs {fd}");
+                assert!(k > 0.0, "the force grows as the plates close");
+            }
+        }
     }
 }

@@ -228,8 +228,9 @@ pub(crate) fn gps_inflation_curve<'py>(
 /// with `control="gas"` (the default) the gas closed in (Boyle; GPS eqs. 76–77, PS eqs.
 /// 78–79), with `control="pressure"` a regulated supply (eqs. 76 at the pressure held at its
 /// inflated value, or ramped to `pressure`). Dict with w, lambda_s, lambda_z, n_s, n_z, rho,
-/// chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81). `rho` may be a numpy array: the
-/// dict then holds arrays of its shape.
+/// chi, force (ϖχ, eq. 80) and displacement (λs* − ρ, eq. 81); regulated, also stiffness: the
+/// plates' −d(force)/d(2ρ) at that pressure (a gripper's dF/dgap, force over πμH per R). `rho`
+/// may be a numpy array: the dict then holds arrays of its shape.
 #[pyfunction]
 #[pyo3(signature = (initial_stretch, rho, material=None, hypothesis="gps", *, control="gas", pressure=None))]
 pub(crate) fn gps_flatten<'py>(
@@ -257,21 +258,45 @@ pub(crate) fn gps_flatten<'py>(
             )))
         }
     };
-    let one = |r: f64| -> Result<tubemem_gps::FlatteningState, tubemem_gps::GpsError> {
-        if !regulated {
-            return tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r);
+    use tubemem_app::curves::{flattening_values, FLATTENING_HEADER};
+    let mut keys: Vec<&str> = FLATTENING_HEADER.split(',').collect();
+    if regulated {
+        use tubemem_gps::regulated::{free_start, plate_stiffness, squeeze_at_pressure};
+        // the regulated state and the plates' stiffness −d(force)/d(2ρ) at its pressure
+        let one = |r: f64| -> Result<(tubemem_gps::FlatteningState, f64), tubemem_gps::GpsError> {
+            let start = free_start(law.as_ref(), hyp, initial_stretch)?;
+            let s = squeeze_at_pressure(law.as_ref(), hyp, start, r, pressure.unwrap_or(start.w))?;
+            Ok((
+                s.as_flattening(initial_stretch),
+                plate_stiffness(law.as_ref(), hyp, &s)?,
+            ))
+        };
+        if let Ok(r) = real_scalar(rho, "rho")? {
+            let (s, k) = one(r).map_err(gps_err)?;
+            let d = to_py(py, &s)?;
+            d.set_item("stiffness", k)?;
+            return Ok(d);
         }
-        use tubemem_gps::regulated::{free_start, squeeze_at_pressure};
-        let start = free_start(law.as_ref(), hyp, initial_stretch)?;
-        let s = squeeze_at_pressure(law.as_ref(), hyp, start, r, pressure.unwrap_or(start.w))?;
-        Ok(s.as_flattening(initial_stretch))
-    };
+        keys.push("stiffness");
+        return vectorized(
+            py,
+            rho,
+            "rho",
+            |r| {
+                one(r).map(|(s, k)| {
+                    let mut v = flattening_values(&s).to_vec();
+                    v.push(k);
+                    v
+                })
+            },
+            &keys,
+        );
+    }
+    let one = |r: f64| tubemem_gps::flatten(law.as_ref(), hyp, initial_stretch, r);
     if let Ok(r) = real_scalar(rho, "rho")? {
         let s = one(r).map_err(gps_err)?;
         return to_py(py, &s);
     }
-    use tubemem_app::curves::{flattening_values, FLATTENING_HEADER};
-    let keys: Vec<&str> = FLATTENING_HEADER.split(',').collect();
     vectorized(
         py,
         rho,

@@ -109,6 +109,14 @@ def test_the_regulated_squeeze_and_the_critical_pressure_match_scipy():
     # arrays of rho, and the closed gas refuses a pressure
     t = tubemem.gps_flatten(1.3, np.array([1.0, 0.8]), control="pressure")
     assert rel(t["lambda_s"][1], ls) < TOL
+    # the gripper's stiffness -d(force)/d(2 rho) at the held pressure: a central difference of
+    # the explicit force at rho +- 1e-4 (truncation ~1e-8 relative, the roots to 1e-15); bound 1e-7
+    d = 1e-4
+    f = lambda r: w0 * (optimize.brentq(lambda x: _between(x, r, abb)[0] - w0, 1.0 + 1e-12, 3.0, xtol=1e-15) - r)
+    fd = -(f(0.8 + d) - f(0.8 - d)) / (4.0 * d)
+    assert rel(s["stiffness"], fd) < 1e-7
+    assert rel(t["stiffness"][1], s["stiffness"]) < TOL
+    assert "stiffness" not in tubemem.gps_flatten(1.3, 0.8)  # closed gas: not this quantity
     with pytest.raises(ValueError, match="control"):
         tubemem.gps_flatten(1.3, 0.8, pressure=0.5)
     # neo-Hookean between fixed plates at rho = 0.8: the first maximum of w along the states,

@@ -5,6 +5,7 @@
 use super::runner::{Runner, StageStart};
 use crate::case::{ProfileFrames, StagePlan};
 use crate::observer::{BoxError, Observer, StepView};
+use crate::report::Stiffness;
 use crate::report::*;
 use crate::stage::critical::{critical_record, PendingCritical, BRANCH_SWITCH_FRACTION};
 use crate::stage::failure::{stage_error, FailureInput};
@@ -97,7 +98,11 @@ pub(super) fn drive_stage(
                 critical_here = Some(p.record.kind);
                 criticals.push(p.record);
             }
-            steps.push(step_record(&record_input, m, st, info, critical_here)?);
+            let mut record = step_record(&record_input, m, st, info, critical_here)?;
+            record.stiffness = steps
+                .last()
+                .and_then(|before| Stiffness::between(before, &record));
+            steps.push(record);
             let view = StepView {
                 report: finished,
                 stage_steps: &steps,

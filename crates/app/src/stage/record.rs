@@ -116,5 +116,6 @@ pub(crate) fn step_record(
             edges: edges.borrow().clone(),
             refits: info.refits,
         }),
+        stiffness: None,
     })
 }
