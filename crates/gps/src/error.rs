@@ -51,6 +51,20 @@ pub enum GpsError {
         w_critical: f64,
         lambda_s_critical: f64,
     },
+    /// A pressure-controlled path that reaches a state where the section between its plates
+    /// stops being stable (dϖ/dλs along the states at that ρ changes sign there) though no
+    /// pressure maximum lies before it on those states (they start on a falling branch): the
+    /// squeeze snaps there.
+    #[error(
+        "{stage} at {at}: the section loses its stability under pressure control at λs = {} (ϖ stops rising along the states between these plates; they carry no higher pressure on this branch): the squeeze snaps here, to a state no continuation follows",
+        tubemem_material::Num(*lambda_s)
+    )]
+    Snaps {
+        stage: &'static str,
+        at: String,
+        w: f64,
+        lambda_s: f64,
+    },
     /// The plates do not touch the tube: at this pressure the free tube is narrower than the
     /// gap (its hoop stretch below ρ), so there is no squeezed section to answer with.
     #[error(

@@ -448,11 +448,11 @@ pub fn squeeze_at_pressure(
                 w_critical: c.state.w,
                 lambda_s_critical: c.state.lambda_s,
             },
-            None => GpsError::NoConvergence {
-                stage: "pressure-controlled squeeze (the pressure slope changed sign)",
+            None => GpsError::Snaps {
+                stage: "pressure-controlled squeeze",
                 at,
-                residual: f64::NAN,
-                iterations: 0,
+                w: s.w,
+                lambda_s: s.lambda_s,
             },
         })
     };
@@ -533,6 +533,23 @@ pub fn regulated_curve(
     points: usize,
     w: Option<f64>,
 ) -> Result<Vec<SectionState>, GpsError> {
+    match regulated_curve_until(law, hyp, initial_stretch, rho_to, points, w)? {
+        (states, None) => Ok(states),
+        (_, Some(e)) => Err(e),
+    }
+}
+
+/// [`regulated_curve`] up to the first state the path cannot reach: the states before it, and
+/// why it stopped ([`GpsError::Unstable`], [`GpsError::Snaps`], [`GpsError::NoContact`], a
+/// failed solve), or `None` when it reached `rho_to`. Bad input is the outer error.
+pub fn regulated_curve_until(
+    law: &dyn MembraneLaw,
+    hyp: Hypothesis,
+    initial_stretch: f64,
+    rho_to: f64,
+    points: usize,
+    w: Option<f64>,
+) -> Result<(Vec<SectionState>, Option<GpsError>), GpsError> {
     crate::check_points(points)?;
     let start = free_start(law, hyp, initial_stretch)?;
     let target = w.unwrap_or(start.w);
@@ -551,15 +568,12 @@ pub fn regulated_curve(
         let t = i as f64 / (points - 1) as f64;
         let prev = out[i - 1];
         let rho = initial_stretch + t * (rho_to - initial_stretch);
-        out.push(squeeze_at_pressure(
-            law,
-            hyp,
-            prev,
-            rho,
-            start.w + t * (target - start.w),
-        )?);
+        match squeeze_at_pressure(law, hyp, prev, rho, start.w + t * (target - start.w)) {
+            Ok(s) => out.push(s),
+            Err(e) => return Ok((out, Some(e))),
+        }
     }
-    Ok(out)
+    Ok((out, None))
 }
 
 /// The regulated squeeze of the paper's set-up: inflated to `initial_stretch` λs*, then the

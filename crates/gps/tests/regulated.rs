@@ -17,7 +17,7 @@
 
 use tubemem_gps::regulated::{
     between_plates, critical_pressure, flatten_at_pressure, flatten_closed_from, free_start,
-    plate_stiffness, squeeze_at_pressure,
+    plate_stiffness, regulated_curve, regulated_curve_until, squeeze_at_pressure,
 };
 use tubemem_gps::{flatten, GpsError, Hypothesis};
 use tubemem_material::laws::{neo_hookean, AnssariBenamBucchi};
@@ -309,4 +309,28 @@ fn the_plates_stiffness_at_fixed_pressure_is_the_derivative_of_the_explicit_forc
             }
         }
     }
+}
+
+/// The paper's tube inflated to λs* = 6 (ABB 𝒩 = 30, GPS: past the inflation's pressure
+/// minimum) and squeezed with the pressure held: the section between the plates stops being
+/// stable before ρ = 3 and the path says so (it had said the residual was not a finite
+/// number); the states before it are all stable. PS goes all the way.
+#[test]
+fn the_regulated_squeeze_from_six_snaps_and_says_so() {
+    let law = abb30();
+    let (states, stop) = regulated_curve_until(&law, Hypothesis::Gps, 6.0, 3.0, 201, None).unwrap();
+    let held = states[0].w;
+    match stop {
+        Some(GpsError::Snaps { w, lambda_s, .. }) => {
+            assert!(rel(w, held) < 1e-12);
+            let last = states.last().unwrap();
+            assert!(last.rho > 3.0 && last.rho < 6.0, "{}", last.rho);
+            assert!(lambda_s > last.rho, "in contact: λs {lambda_s}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let e = regulated_curve(&law, Hypothesis::Gps, 6.0, 3.0, 201, None).unwrap_err();
+    assert!(e.to_string().contains("snaps"), "{e}");
+    let (ps, stop) = regulated_curve_until(&law, Hypothesis::Ps, 6.0, 3.0, 201, None).unwrap();
+    assert!(stop.is_none() && ps.len() == 201);
 }

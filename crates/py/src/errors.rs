@@ -23,6 +23,7 @@ pub(crate) fn gps_err(e: GpsError) -> PyErr {
         GpsError::InvalidInput { .. }
         | GpsError::Walls { .. }
         | GpsError::Unstable { .. }
+        | GpsError::Snaps { .. }
         | GpsError::NoContact { .. } => PyValueError::new_err(msg),
         // a material parameter out of range, or a stretch asked for beyond the locking limit,
         // is bad input
