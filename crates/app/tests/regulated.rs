@@ -296,3 +296,50 @@ fn the_gas_control_keys_are_checked_with_their_stage() {
         }
     }
 }
+
+/// A regulated squeeze's steps are drawn on the pressure-held companion of Fig. 6, against the
+/// pressure-held GPS curve, and not on Fig. 6 itself (whose curves are the closed gas's); a
+/// closed-gas squeeze's steps are drawn on Fig. 6 and not on the companion.
+#[test]
+fn regulated_steps_go_on_the_pressure_held_figure_and_closed_ones_on_the_papers() {
+    use tubemem_app::figures::{write_all, FigureOptions, Overlay};
+    let stage = |control: &str| {
+        format!("{SMALL}\n[[stage]]\nkind = \"squeeze\"\n{control}target_rho = 1.0\nsteps = 3\n")
+    };
+    let texts = |svg: &std::path::Path| -> Vec<String> {
+        std::fs::read_to_string(svg)
+            .unwrap()
+            .split("</text>")
+            .filter_map(|t| t.rsplit_once('>').map(|(_, x)| x.trim().to_string()))
+            .collect()
+    };
+    let opts = FigureOptions {
+        png: false,
+        ..FigureOptions::default()
+    };
+    for (control, label, on_held) in [
+        ("control = \"pressure\"\n", "regulated", true),
+        ("", "closed", false),
+    ] {
+        let case = Case::parse(&stage(control)).unwrap();
+        let report = run(&case, label, &mut []).into_result().unwrap();
+        // the small case inflates to λs* = 1.2: its squeeze has a figure of its own (Fig. 8)
+        let dir = std::env::temp_dir().join(format!("tubemem-fig-{label}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let overlay = Overlay::from_report(&report, label, &dir);
+        let files = write_all(&dir, None, &[overlay], &opts).unwrap();
+        let find = |suffix: &str| {
+            files
+                .iter()
+                .find(|f| f.to_string_lossy().ends_with(suffix))
+                .unwrap_or_else(|| panic!("{suffix} in {files:?}"))
+                .clone()
+        };
+        let held = texts(&find("ls1.2_pressure_held.svg"));
+        let paper = texts(&find("ls1.2.svg"));
+        let fe = format!("FE: {label}");
+        assert_eq!(held.contains(&fe), on_held, "{label}: {held:?}");
+        assert_eq!(paper.contains(&fe), !on_held, "{label}: {paper:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -408,6 +408,8 @@ fn figures_writes_pngs_and_csvs() {
         "fig5_zoom_ls1.3.png",
         "fig6_force_displacement_ls1.3.png",
         "fig7_force_displacement_ls6.0.png",
+        "fig6_force_displacement_ls1.3_pressure_held.png",
+        "fig7_force_displacement_ls6.0_pressure_held.png",
         "fig_lambda_z.png",
     ] {
         let bytes = std::fs::read(d.join(f)).unwrap();
@@ -420,6 +422,8 @@ fn figures_writes_pngs_and_csvs() {
         "inflation_ps.csv",
         "flattening_ls1.3_gps.csv",
         "flattening_ls6.0_ps.csv",
+        "flattening_ls1.3_gps_pressure_held.csv",
+        "flattening_ls6.0_ps_pressure_held.csv",
     ] {
         assert!(
             std::fs::read_to_string(d.join(f)).unwrap().lines().count() > 100,
@@ -467,7 +471,7 @@ fn run_writes_steps_summary_profiles_and_vtu() {
          local_lambda_s,local_lambda_z,local_chi,local_force,\
          arc_length,dw_ds,critical,nonuniformity,gps_applicable,negative_pivots_volume,\
          augmentations,augmentation_iterations,contact_gap,multiplier_change,flat_pressure_deviation,mesh_refits,\
-         plate_force"
+         plate_force,stiffness,gps_stiffness,plate_stiffness"
     );
     let empty_for_inflation = [
         "rho",
@@ -1423,7 +1427,7 @@ fn a_killed_tracked_run_resumes_bit_identical() {
         .lines()
         .next()
         .unwrap()
-        .ends_with(",mesh_refits,plate_force"));
+        .ends_with(",mesh_refits,plate_force,stiffness,gps_stiffness,plate_stiffness"));
     assert_same_run(
         &reference,
         &killed,

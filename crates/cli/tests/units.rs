@@ -245,6 +245,18 @@ fn si_columns_scale(steps: &Path) {
             "gps_force_n_per_m",
             std::f64::consts::PI * MU * H,
         ),
+        // the plates' stiffness −ΔF/Δgap: force per length over gap, and total force over gap
+        (
+            "stiffness",
+            "stiffness_pa",
+            std::f64::consts::PI * MU * H / R,
+        ),
+        (
+            "gps_stiffness",
+            "gps_stiffness_pa",
+            std::f64::consts::PI * MU * H / R,
+        ),
+        ("plate_stiffness", "plate_stiffness_n_per_m", MU * H),
     ];
     for r in &rows {
         for (core, si, f) in pair {

@@ -23,6 +23,30 @@ pub struct SqueezePoint {
     pub target_stretch: Option<f64>,
     /// GPS flattening from the run's λs* at the same ρ, when it has a solution
     pub gps_force: Option<f64>,
+    /// how the step's gas was supplied: the figure it belongs on
+    pub supply: PointSupply,
+}
+
+/// How the gas of a squeeze step was supplied, which decides its figure: the closed gas on the
+/// paper's Figs. 6–7, the regulated supply on their pressure-held companions; an inflation
+/// between held plates on neither (its plates do not move).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PointSupply {
+    Closed,
+    Regulated,
+    HeldPlates,
+}
+
+impl PointSupply {
+    /// The supply of a stage from its kind, its `control` and whether it holds plates.
+    fn of(kind: &str, control: Option<&str>, held: bool) -> Self {
+        match (kind, control) {
+            _ if held => PointSupply::HeldPlates,
+            ("inflate", _) => PointSupply::HeldPlates,
+            (_, Some("pressure")) => PointSupply::Regulated,
+            _ => PointSupply::Closed,
+        }
+    }
 }
 
 /// The FE points of one run to draw over the closed-form curves.
@@ -76,6 +100,18 @@ impl Overlay {
                     force: c.values.force,
                     initial_stretch: c.initial_stretch,
                     gps_force: s.closed_form.gps_flattening.as_ref().map(|g| g.force),
+                    supply: report.stages.get(s.stage.wrapping_sub(1)).map_or(
+                        PointSupply::Closed,
+                        |st| {
+                            let kind = match st.plan.target {
+                                crate::case::Target::Rho(_) | crate::case::Target::Confine(_) => {
+                                    "squeeze"
+                                }
+                                _ => "inflate",
+                            };
+                            PointSupply::of(kind, st.plan.control(), st.plan.held_plates)
+                        },
+                    ),
                 }),
                 None => o.inflation.push((s.midspan.lambda_s, s.midspan.w)),
             }
@@ -120,6 +156,7 @@ impl Overlay {
         // each stage's target λs* (summary.json `stages[k].target`), carried to the squeezes
         // after a stretch-controlled inflation, as from a report
         let mut targets: Vec<Option<f64>> = vec![None];
+        let mut supplies: Vec<PointSupply> = vec![PointSupply::Closed];
         let mut last = None;
         for st in summary
             .get("stages")
@@ -136,6 +173,12 @@ impl Overlay {
                 _ => {}
             }
             targets.push(last);
+            let text = |k: &str| st.get(k).and_then(|v| v.as_str());
+            supplies.push(PointSupply::of(
+                text("kind").unwrap_or("squeeze"),
+                text("control"),
+                false,
+            ));
         }
         let cstage = col("stage").ok();
         let (cw, cls, crho, cdisp, cforce, cgps) = (
@@ -193,6 +236,11 @@ impl Overlay {
                         Some(c) if f.get(c).is_some_and(|v| !v.is_empty()) => Some(num(c)?),
                         _ => None,
                     },
+                    supply: cstage
+                        .and_then(|c| f.get(c))
+                        .and_then(|v| v.parse::<usize>().ok())
+                        .and_then(|st| supplies.get(st).copied())
+                        .unwrap_or(PointSupply::Closed),
                 });
             } else {
                 o.inflation.push((num(cls)?, num(cw)?));

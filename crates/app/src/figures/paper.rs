@@ -1,7 +1,7 @@
 //! The paper's figures for one law: Figs. 5-7 and λz against λs, with their CSVs, and the FE
 //! points of overlaid runs.
 
-use super::overlay::{points_file, same_start, start_tag};
+use super::overlay::{points_file, same_start, start_tag, PointSupply};
 use super::{
     law_label, render_files, same_law, Figure, FigureOptions, Markers, Overlay, Panel, Series,
     SqueezePoint, Stroke, FE_COLORS, GPS_COLOR, GREY, PAPER_LAW, PS_COLOR,
@@ -13,6 +13,7 @@ use crate::{AppError, Result};
 use plotters::style::{RGBColor, BLACK};
 use std::path::{Path, PathBuf};
 use tubemem_gps::limits::limit_points;
+use tubemem_gps::regulated::regulated_curve_until;
 use tubemem_gps::{flattening_curve, inflation_curve, FlatteningState, Hypothesis};
 use tubemem_material::MaterialSpec;
 
@@ -27,6 +28,9 @@ struct Curves {
     inflation: Vec<Vec<tubemem_gps::InflationState>>,
     /// flattening[start][hyp]
     flattening: Vec<Vec<Vec<FlatteningState>>>,
+    /// regulated[start][hyp]: the squeeze with the pressure held at ϖ(λs*), up to where the
+    /// path stops (a pressure-controlled section that snaps), and why it stopped
+    regulated: Vec<Vec<(Vec<FlatteningState>, Option<String>)>>,
     limits: tubemem_gps::limits::Limits,
 }
 
@@ -78,12 +82,41 @@ impl Curves {
             }
             flattening.push(per);
         }
+        let mut regulated = vec![];
+        for &(ls0, _) in &starts {
+            let mut per = vec![];
+            for (h, _) in HYPS {
+                let (c, stop) =
+                    regulated_curve_until(law, h, ls0, 0.5 * ls0, 201, None).map_err(|e| {
+                        AppError::gps(format!("the pressure-held squeeze from λs* = {ls0}"), e)
+                    })?;
+                let c: Vec<FlatteningState> = c.iter().map(|s| s.as_flattening(ls0)).collect();
+                let p = dir.join(format!(
+                    "flattening_ls{}_{}_pressure_held.csv",
+                    start_tag(ls0),
+                    h.label().to_lowercase()
+                ));
+                let text = csv_text(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
+                files.push((p, text.into_bytes()));
+                let stop = stop.map(|_| {
+                    let last = c.last().map_or(ls0, |s| s.rho);
+                    format!(
+                        "{}: the pressure-held section snaps after ρ = {} (its pressure slope changes sign: tubemem gps flatten --control pressure says where)",
+                        h.label(),
+                        tubemem_material::Num(crate::units::round_sig(last))
+                    )
+                });
+                per.push((c, stop));
+            }
+            regulated.push(per);
+        }
         let limits =
             limit_points(law, Hypothesis::Gps).map_err(|e| AppError::gps("the limit points", e))?;
         Ok(Curves {
             starts,
             inflation,
             flattening,
+            regulated,
             limits,
         })
     }
@@ -181,6 +214,15 @@ pub fn write_all(
         files.extend(render_files(
             &axes.force(fig),
             &dir.join(format!("fig{num}_force_displacement_ls{}", start_tag(*ls0))),
+            opts,
+        )?);
+        let held = held_force_figure(*ls0, &curves.regulated[k], per, num, overlays, &name);
+        files.extend(render_files(
+            &axes.force(held),
+            &dir.join(format!(
+                "fig{num}_force_displacement_ls{}_pressure_held",
+                start_tag(*ls0)
+            )),
             opts,
         )?);
     }
@@ -333,7 +375,7 @@ fn force_figure(
         let pts: Vec<&SqueezePoint> = run
             .squeeze
             .iter()
-            .filter(|s| same_start(s.start(), ls0))
+            .filter(|s| same_start(s.start(), ls0) && s.supply == PointSupply::Closed)
             .collect();
         if pts.is_empty() {
             continue;
@@ -369,6 +411,87 @@ fn force_figure(
         notes: vec![],
         ..Figure::new(
             format!("Fig. {num} — flattening from λs* = {tag} ({name})"),
+            "reduced displacement λs* − ρ",
+            "reduced force ϖχ = pc/(πμH)",
+            series,
+        )
+    }
+}
+
+/// The pressure-held companion of Fig. `num`: the force against the displacement from λs* =
+/// `ls0` with the pressure held at ϖ(λs*) (a regulated supply; GPS and PS, `held`, each up to
+/// where it snaps), the closed gas's curves (`closed`) thin and dashed beside them, and the
+/// overlays' regulated squeeze steps from that start with their error against GPS at the same
+/// ρ and pressure.
+fn held_force_figure(
+    ls0: f64,
+    held: &[(Vec<FlatteningState>, Option<String>)],
+    closed: &[Vec<FlatteningState>],
+    num: usize,
+    overlays: &[Overlay],
+    name: &str,
+) -> Figure {
+    let tag = start_tag(ls0);
+    let mut series: Vec<Series> = HYPS
+        .iter()
+        .zip(held)
+        .map(|((h, color), (c, _))| Series {
+            label: format!("{}, pressure held", h.label()),
+            points: c.iter().map(|s| (s.displacement, s.force)).collect(),
+            color: *color,
+            stroke: Stroke::Solid,
+            width: 3,
+        })
+        .collect();
+    series.extend(HYPS.iter().zip(closed).map(|((h, color), c)| Series {
+        label: format!("{}, gas closed (Fig. {num})", h.label()),
+        points: c.iter().map(|s| (s.displacement, s.force)).collect(),
+        color: *color,
+        stroke: Stroke::Dashed,
+        width: 1,
+    }));
+    let mut markers = vec![];
+    let mut errors = vec![];
+    for (run, color) in overlays.iter().zip(FE_COLORS.iter().cycle()) {
+        let pts: Vec<&SqueezePoint> = run
+            .squeeze
+            .iter()
+            .filter(|s| same_start(s.start(), ls0) && s.supply == PointSupply::Regulated)
+            .collect();
+        if pts.is_empty() {
+            continue;
+        }
+        let label = format!("FE: {}", run.label);
+        markers.push(Markers {
+            label: label.clone(),
+            points: pts.iter().map(|s| (s.displacement, s.force)).collect(),
+            color: *color,
+            hollow: true,
+        });
+        let e: Vec<(f64, f64)> = pts
+            .iter()
+            .filter_map(|s| s.gps_force.map(|g| (s.displacement, s.force - g)))
+            .collect();
+        if !e.is_empty() {
+            errors.push(Markers {
+                label,
+                points: e,
+                color: *color,
+                hollow: false,
+            });
+        }
+    }
+    let panel = (!errors.is_empty()).then(|| Panel {
+        y_label: "FE − GPS, same ρ and ϖ".into(),
+        series: vec![],
+        markers: errors,
+    });
+    Figure {
+        markers,
+        panel,
+        notes: held.iter().filter_map(|(_, stop)| stop.clone()).collect(),
+        ..Figure::new(
+            format!("Fig. {num}, pressure held — flattening from λs* = {tag} with a regulated supply ({name})"),
             "reduced displacement λs* − ρ",
             "reduced force ϖχ = pc/(πμH)",
             series,
