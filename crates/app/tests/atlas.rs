@@ -141,7 +141,13 @@ fn the_ps_map_is_the_closed_form_at_every_point() {
         poisson_ratio: 0.3,
     };
     let built = law.build().unwrap();
-    let g = atlas::ps_map::grid(built.as_ref(), (1.05, 1.4), (0.7, 1.4), 9);
+    let g = atlas::ps_map::grid(
+        built.as_ref(),
+        atlas::ps_map::MapSupply::Closed,
+        (1.05, 1.4),
+        (0.7, 1.4),
+        9,
+    );
     let csv = atlas::ps_map::csv(&g);
     let mut checked = 0;
     for line in csv.lines().skip(1) {
@@ -503,4 +509,44 @@ fn a_channel_atlas_chains_its_confine_stages_and_predicts_a_held_out_length() {
         );
     }
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// An atlas whose squeezes hold the pressure (`[atlas.squeeze] control = "pressure"`, the
+/// shipped atlas/regulated.toml) maps PS against GPS with the pressure held: each grid value is
+/// `flatten_at_pressure`'s, to the last bit, and not the closed gas's.
+#[test]
+fn a_regulated_atlas_maps_the_regulated_closed_form() {
+    let built = tubemem_material::laws::AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let g = atlas::ps_map::grid(
+        &built,
+        atlas::ps_map::MapSupply::Regulated,
+        (1.05, 1.4),
+        (0.7, 1.4),
+        7,
+    );
+    let mut checked = 0;
+    for p in g.iter().flatten().filter(|p| p.rho < p.stretch) {
+        for h in [tubemem_gps::Hypothesis::Gps, tubemem_gps::Hypothesis::Ps] {
+            let want = tubemem_gps::regulated::flatten_at_pressure(&built, h, p.stretch, p.rho)
+                .unwrap()
+                .as_flattening(p.stretch);
+            let got = match h {
+                tubemem_gps::Hypothesis::Gps => p.gps.unwrap(),
+                tubemem_gps::Hypothesis::Ps => p.ps.unwrap(),
+            };
+            assert_eq!(got, want);
+            let closed = tubemem_gps::flatten(&built, h, p.stretch, p.rho).unwrap();
+            assert_ne!(
+                got.w, closed.w,
+                "the closed gas compresses: another pressure"
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked > 15, "{checked}");
+    let spec = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../atlas/regulated.toml"),
+    )
+    .unwrap();
+    assert!(spec.contains("control = \"pressure\"") && spec.contains("law = \"exponential\""));
 }

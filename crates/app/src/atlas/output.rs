@@ -314,8 +314,13 @@ pub fn write_all(
         key: "material".into(),
         message: crate::error_chain(&e),
     })?;
+    let supply = match s.squeeze.get("control").and_then(|v| v.as_str()) {
+        Some("pressure") => super::ps_map::MapSupply::Regulated,
+        _ => super::ps_map::MapSupply::Closed,
+    };
     written.extend(super::ps_map::write(
         law.as_ref(),
+        supply,
         &crate::figures::overlay::law_label(&atlas.material),
         stretch,
         rho,

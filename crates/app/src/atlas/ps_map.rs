@@ -1,11 +1,48 @@
 //! Where plane strain fails: |PS/GPS − 1| of the closed forms over a fine (λs*, ρ) grid, for the
-//! atlas's law (both hypotheses squeezed from the same λs*, the gas closed in: eqs. 76–77 with
-//! λz free or λz = 1). No FE: the map is the closed form itself.
+//! atlas's law (both hypotheses squeezed from the same λs*, as the atlas's squeezes are: the gas
+//! closed in, eqs. 76–77, or the pressure held at its inflated value, eqs. 76; with λz free or
+//! λz = 1). No FE: the map is the closed form itself.
 
 use super::AtlasError;
 use crate::figures::{Figure, Series, Stroke};
 use plotters::style::RGBColor;
+use tubemem_gps::regulated::flatten_at_pressure;
 use tubemem_gps::{flatten, FlatteningState, Hypothesis};
+
+/// How the map's squeezes are supplied with gas: as the atlas's squeeze stages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapSupply {
+    /// closed in the tube inflated to λs* (Boyle, eqs. 76–77)
+    Closed,
+    /// held at the inflated pressure ϖ(λs*) by a regulator (eqs. 76; `control = "pressure"`)
+    Regulated,
+}
+
+impl MapSupply {
+    /// The squeeze from λs* = `s` to ρ = `r` under hypothesis `h` (None where it has no
+    /// solution).
+    fn solve(
+        self,
+        law: &dyn MembraneLaw,
+        h: Hypothesis,
+        s: f64,
+        r: f64,
+    ) -> Option<FlatteningState> {
+        match self {
+            MapSupply::Closed => flatten(law, h, s, r).ok(),
+            MapSupply::Regulated => flatten_at_pressure(law, h, s, r)
+                .ok()
+                .map(|x| x.as_flattening(s)),
+        }
+    }
+
+    fn describe(self) -> &'static str {
+        match self {
+            MapSupply::Closed => "the gas closed, eqs. 76–77",
+            MapSupply::Regulated => "the pressure held at its inflated value, eqs. 76",
+        }
+    }
+}
 use tubemem_material::MembraneLaw;
 
 /// The quantities of the map.
@@ -39,9 +76,11 @@ impl PsPoint {
     }
 }
 
-/// The grid: `n` λs* from `stretch.0` to `stretch.1` and `n` ρ from `rho.0` to `rho.1`.
+/// The grid: `n` λs* from `stretch.0` to `stretch.1` and `n` ρ from `rho.0` to `rho.1`, the
+/// squeezes supplied as `supply` says.
 pub fn grid(
     law: &dyn MembraneLaw,
+    supply: MapSupply,
     stretch: (f64, f64),
     rho: (f64, f64),
     n: usize,
@@ -53,7 +92,7 @@ pub fn grid(
             (0..n)
                 .map(|j| {
                     let r = lin(rho.0, rho.1, j);
-                    let solve = |h| (r < s).then(|| flatten(law, h, s, r).ok()).flatten();
+                    let solve = |h| (r < s).then(|| supply.solve(law, h, s, r)).flatten();
                     PsPoint {
                         stretch: s,
                         rho: r,
@@ -89,7 +128,13 @@ pub fn csv(grid: &[Vec<PsPoint>]) -> String {
 }
 
 /// The map of quantity `q`: the contours |PS/GPS − 1| = ε for each ε.
-pub fn figure(grid: &[Vec<PsPoint>], q: &str, epsilon: &[f64], law: &str) -> Figure {
+pub fn figure(
+    grid: &[Vec<PsPoint>],
+    supply: MapSupply,
+    q: &str,
+    epsilon: &[f64],
+    law: &str,
+) -> Figure {
     let xs: Vec<f64> = grid.iter().map(|c| c[0].stretch).collect();
     let ys: Vec<f64> = grid[0].iter().map(|p| p.rho).collect();
     let z: Vec<Vec<f64>> = grid
@@ -134,7 +179,8 @@ pub fn figure(grid: &[Vec<PsPoint>], q: &str, epsilon: &[f64], law: &str) -> Fig
     });
     Figure {
         notes: vec![format!(
-            "{law}: the closed forms only (eqs. 76–77, λz free against λz = 1), {} × {} grid",
+            "{law}: the closed forms only ({}, λz free against λz = 1), {} × {} grid",
+            supply.describe(),
             xs.len(),
             ys.len()
         )],
@@ -149,8 +195,10 @@ pub fn figure(grid: &[Vec<PsPoint>], q: &str, epsilon: &[f64], law: &str) -> Fig
 }
 
 /// Compute and write ps_map.csv and its figures into `out`.
+#[allow(clippy::too_many_arguments)]
 pub fn write(
     law: &dyn MembraneLaw,
+    supply: MapSupply,
     law_label: &str,
     stretch: (f64, f64),
     rho: (f64, f64),
@@ -158,7 +206,7 @@ pub fn write(
     epsilon: &[f64],
     out: &std::path::Path,
 ) -> Result<Vec<std::path::PathBuf>, AtlasError> {
-    let g = grid(law, stretch, rho, n);
+    let g = grid(law, supply, stretch, rho, n);
     let mut written = vec![];
     let p = out.join("ps_map.csv");
     crate::output_file::write_whole(&p, csv(&g).as_bytes())?;
@@ -166,7 +214,7 @@ pub fn write(
     let figures = out.join("figures");
     crate::output_file::create_folder(&figures)?;
     for q in PS_QUANTITIES {
-        let fig = figure(&g, q, epsilon, law_label);
+        let fig = figure(&g, supply, q, epsilon, law_label);
         written.extend(crate::figures::save(
             &fig,
             &figures.join(format!("ps_map_{q}")),
