@@ -368,14 +368,35 @@ fn force_figure(
             width: 3,
         })
         .collect();
+    let (markers, panel) = squeeze_markers(overlays, ls0, PointSupply::Closed, "FE − GPS, same ρ");
+    Figure {
+        markers,
+        panel,
+        notes: vec![],
+        ..Figure::new(
+            format!("Fig. {num} — flattening from λs* = {tag} ({name})"),
+            "reduced displacement λs* − ρ",
+            "reduced force ϖχ = pc/(πμH)",
+            series,
+        )
+    }
+}
+
+/// The overlays' squeeze steps from λs* = `ls0` supplied as `supply`, as markers, and their
+/// error against GPS at the same ρ as a panel under the curves (`y_label`; none without GPS).
+fn squeeze_markers(
+    overlays: &[Overlay],
+    ls0: f64,
+    supply: PointSupply,
+    y_label: &str,
+) -> (Vec<Markers>, Option<Panel>) {
     let mut markers = vec![];
     let mut errors = vec![];
     for (run, color) in overlays.iter().zip(FE_COLORS.iter().cycle()) {
-        // the squeeze steps that start from this λs*
         let pts: Vec<&SqueezePoint> = run
             .squeeze
             .iter()
-            .filter(|s| same_start(s.start(), ls0) && s.supply == PointSupply::Closed)
+            .filter(|s| same_start(s.start(), ls0) && s.supply == supply)
             .collect();
         if pts.is_empty() {
             continue;
@@ -393,7 +414,7 @@ fn force_figure(
             .collect();
         if !e.is_empty() {
             errors.push(Markers {
-                label: label.clone(),
+                label,
                 points: e,
                 color: *color,
                 hollow: false,
@@ -401,21 +422,11 @@ fn force_figure(
         }
     }
     let panel = (!errors.is_empty()).then(|| Panel {
-        y_label: "FE − GPS, same ρ".into(),
+        y_label: y_label.into(),
         series: vec![],
         markers: errors,
     });
-    Figure {
-        markers,
-        panel,
-        notes: vec![],
-        ..Figure::new(
-            format!("Fig. {num} — flattening from λs* = {tag} ({name})"),
-            "reduced displacement λs* − ρ",
-            "reduced force ϖχ = pc/(πμH)",
-            series,
-        )
-    }
+    (markers, panel)
 }
 
 /// The pressure-held companion of Fig. `num`: the force against the displacement from λs* =
@@ -450,42 +461,12 @@ fn held_force_figure(
         stroke: Stroke::Dashed,
         width: 1,
     }));
-    let mut markers = vec![];
-    let mut errors = vec![];
-    for (run, color) in overlays.iter().zip(FE_COLORS.iter().cycle()) {
-        let pts: Vec<&SqueezePoint> = run
-            .squeeze
-            .iter()
-            .filter(|s| same_start(s.start(), ls0) && s.supply == PointSupply::Regulated)
-            .collect();
-        if pts.is_empty() {
-            continue;
-        }
-        let label = format!("FE: {}", run.label);
-        markers.push(Markers {
-            label: label.clone(),
-            points: pts.iter().map(|s| (s.displacement, s.force)).collect(),
-            color: *color,
-            hollow: true,
-        });
-        let e: Vec<(f64, f64)> = pts
-            .iter()
-            .filter_map(|s| s.gps_force.map(|g| (s.displacement, s.force - g)))
-            .collect();
-        if !e.is_empty() {
-            errors.push(Markers {
-                label,
-                points: e,
-                color: *color,
-                hollow: false,
-            });
-        }
-    }
-    let panel = (!errors.is_empty()).then(|| Panel {
-        y_label: "FE − GPS, same ρ and ϖ".into(),
-        series: vec![],
-        markers: errors,
-    });
+    let (markers, panel) = squeeze_markers(
+        overlays,
+        ls0,
+        PointSupply::Regulated,
+        "FE − GPS, same ρ and ϖ",
+    );
     Figure {
         markers,
         panel,
