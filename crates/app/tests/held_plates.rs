@@ -194,6 +194,13 @@ fn a_target_above_the_critical_pressure_is_warned_about_in_the_cases_units() {
         w.contains("5600 Pa") && w.contains("Pa (ϖ = 1.36731"),
         "{w}"
     );
+    // a target below the held pressure (ϖ = 0.18 after the squeeze) is refused in Pa
+    let low = coarse.replace("target_pressure = 1.2", "target_pressure = 0.1");
+    let e = run(&Case::parse(&si(&low, 0.1)).unwrap(), "low-si", &mut [])
+        .error
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("400 Pa") && e.contains("must be above"), "{e}");
     // below ϖc: no warning, and the SI twin is the same run with the same verdicts
     let a = run(&Case::parse(&coarse).unwrap(), "below", &mut [])
         .into_result()

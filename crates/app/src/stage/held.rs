@@ -8,6 +8,7 @@
 
 use super::{closed_form::Supply, LoadParts, RangeInput, StageKind};
 use crate::report::{ContactRecord, CriticalReference};
+use crate::units::Dimension;
 use tubemem_fem::contact::Contact;
 use tubemem_fem::continuation::ArcLoading;
 use tubemem_fem::model::{Load, Loading, Model, State};
@@ -52,9 +53,11 @@ impl StageKind for HeldPlates {
         };
         let p = input.state.p;
         if self.target.is_nan() || self.target <= p {
+            let show = |v: f64| input.units.show(Dimension::Pressure, v);
             return Err(format!(
-                "`target_pressure` (ϖ = {}) must be above the pressure the plates hold the tube at (ϖ = {p:.6}): the stage raises the pressure",
-                tubemem_material::Num(self.target)
+                "`target_pressure` ({}) must be above the pressure the plates hold the tube at ({}): the stage raises the pressure",
+                show(self.target),
+                show(p)
             ));
         }
         Ok((p, self.target, prev.penalty))

@@ -89,6 +89,8 @@ pub struct RangeInput<'a> {
     pub continues_confine: bool,
     /// the stage's `penalty` or `penetration_tolerance`
     pub penalty: Option<PenaltySpec>,
+    /// the case's units, for what a refusal says
+    pub units: &'a crate::units::Units,
 }
 
 /// The closed-form comparison of a stage's final state.

@@ -127,6 +127,7 @@ pub(crate) fn setup_stage(
         previous_squeeze,
         continues_confine: previous_confine.is_some(),
         penalty: plan.penalty,
+        units: &run.units,
     });
     let (mut from, to, penalty) = match range {
         Ok(r) => r,
