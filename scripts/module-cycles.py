@@ -1,9 +1,13 @@
 #!/usr/bin/env python3
-"""Report cycles between the top-level modules of each crate under crates/.
+"""Report cycles between the top-level modules of each crate under crates/, and between the
+files of each module folder.
 
 A module M depends on N when a line of M's code (comments and doc comments left out) names
 `crate::N` or `use super::N` from a direct child, or `use crate::{N, ...}`. The crate root
-(lib.rs) is left out: it declares every module. Exits 1 if any crate has a cycle.
+(lib.rs) is left out: it declares every module. Inside a module folder D, each file (and each
+subfolder, as one unit) depends on a sibling N when its code names `super::N` (or `use
+super::{N, ...}`) or `crate::<D's path>::N`; the folder's mod.rs is left out, as the crate root
+is. Exits 1 if any crate or folder has a cycle.
 """
 import re
 import sys
@@ -81,6 +85,34 @@ for crate in sorted(p for p in root.iterdir() if (p / "src").is_dir()):
         bad = True
         edges = [f"{a}→{b}" for a in comp for b in sorted(graph[a]) if b in comp]
         print(f"{crate.name}: cycle among {', '.join(comp)} ({'; '.join(edges)})")
+
+def file_deps(unit, names, modpath):
+    """The siblings that the files of `unit` (a file, or every file of a subfolder) name."""
+    out = set()
+    for f in unit:
+        for line in code_lines(f):
+            for m in re.finditer(r"super::(\w+)", line):
+                out.add(m.group(1))
+            for m in re.finditer(r"use super::\{([^}]*)\}", line):
+                out.update(x.strip().split("::")[0] for x in m.group(1).split(","))
+            for m in re.finditer(r"crate::" + re.escape(modpath) + r"::(\w+)", line):
+                out.add(m.group(1))
+    return out & names
+
+
+for crate in sorted(p for p in root.iterdir() if (p / "src").is_dir()):
+    src = crate / "src"
+    for d in sorted(x for x in src.rglob("*") if x.is_dir()):
+        units = {p.stem: [p] for p in d.glob("*.rs") if p.name != "mod.rs"}
+        for sub in (x for x in d.iterdir() if x.is_dir()):
+            units[sub.name] = sorted(sub.rglob("*.rs"))
+        modpath = d.relative_to(src).as_posix().replace("/", "::")
+        names = set(units)
+        graph = {n: file_deps(files, names, modpath) - {n} for n, files in units.items()}
+        for comp in sccs(graph):
+            bad = True
+            edges = [f"{a}→{b}" for a in comp for b in sorted(graph[a]) if b in comp]
+            print(f"{crate.name}::{modpath}: file cycle among {', '.join(comp)} ({'; '.join(edges)})")
 if not bad:
-    print("no module cycles")
+    print("no module cycles, and no cycles between the files of a module")
 sys.exit(1 if bad else 0)

@@ -13,6 +13,7 @@
 //!            → points (fits, flags) → atlas.csv, runs.csv, atlas.json, figures/
 //! ```
 
+pub mod contour;
 pub mod fit;
 pub mod member;
 pub mod output;

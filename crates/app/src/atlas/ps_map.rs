@@ -161,7 +161,7 @@ pub fn figure(
         .enumerate()
         .map(|(k, &e)| Series {
             label: format!("|PS/GPS − 1| = {e:e}"),
-            points: super::output::contour(&xs, &ys, &z, e.log10()),
+            points: super::contour::contour(&xs, &ys, &z, e.log10()),
             color: C[k % C.len()],
             stroke: Stroke::Solid,
             width: 2,

@@ -418,9 +418,7 @@ pub fn validate(path: &Path, c: &CheckSpec) -> Result<(), SuiteError> {
                     ));
                 }
             }
-            let a = c
-                .annulus
-                .unwrap_or(super::kinds::tension_field::DEFAULT_ANNULUS);
+            let a = c.annulus.unwrap_or(DEFAULT_ANNULUS);
             if c.tolerance.contains_key("wrinkle_radius") && a.wrinkle_radius().is_none() {
                 return Err(err(format!(
                     "this annulus has no wrinkled zone to measure (Lamé's hoop resultant at the hub is {:.3e} ≥ 0, or T_in R_in > T_out R_out and no tension field balances it): drop `tolerance.wrinkle_radius` or raise t_in",
@@ -585,3 +583,13 @@ pub fn read_suite(path: &Path) -> Result<(String, Vec<Check>), SuiteError> {
     }
     Ok((suite, out))
 }
+
+/// The default annulus: R_in = 1, R_out = 4, T_in = 3 T_out, T_out = 1e-4 (per μH; strains of
+/// 1e-4, where the closed form's linear theory holds to 1e-4). L = 1.8057.
+pub const DEFAULT_ANNULUS: tubemem_fem::tension_field::Annulus =
+    tubemem_fem::tension_field::Annulus {
+        r_in: 1.0,
+        r_out: 4.0,
+        t_in: 3e-4,
+        t_out: 1e-4,
+    };

@@ -10,7 +10,7 @@
 use super::{plot, KindResult};
 use crate::case::Case;
 use crate::figures::{series_color, Figure, Markers, Series, Stroke};
-use crate::verify::suite::Check;
+use crate::verify::suite::{Check, DEFAULT_ANNULUS};
 use crate::verify::{CheckResult, Measure, VerifyOptions};
 use std::path::Path;
 use tubemem_fem::model::Model;
@@ -22,15 +22,6 @@ kind!(
     "tension-field",
     tension_field
 );
-
-/// The default annulus: R_in = 1, R_out = 4, T_in = 3 T_out, T_out = 1e-4 (per μH; strains of
-/// 1e-4, where the closed form's linear theory holds to 1e-4). L = 1.8057.
-pub const DEFAULT_ANNULUS: Annulus = Annulus {
-    r_in: 1.0,
-    r_out: 4.0,
-    t_in: 3e-4,
-    t_out: 1e-4,
-};
 
 fn tension_field(c: &Check, _dir: &Path, _opts: &VerifyOptions, r: &mut CheckResult) -> KindResult {
     let case = Case::parse(&c.case_text).map_err(|e| crate::error_chain(&e))?;
