@@ -653,6 +653,42 @@ impl SiValues {
     }
 }
 
+impl RunReport {
+    /// The report of a run that stopped before its model was built (a case that cannot be
+    /// meshed, a law that cannot be built): the case's own values, no mesh, no stages.
+    pub fn empty(case: &crate::case::Case, label: &str) -> Self {
+        RunReport {
+            case: label.to_string(),
+            mesh: MeshInfo {
+                nodes: 0,
+                elements: 0,
+                equations: 0,
+                symmetry: String::new(),
+                element: String::new(),
+                factor_nnz: 0,
+                factor_flops: 0.0,
+                ordering: String::new(),
+                split_separator: None,
+                reuses_factor: false,
+                contact_edge_fit: None,
+            },
+            material: String::new(),
+            material_spec: case.material.clone(),
+            geometry: GeometryInfo {
+                radius: case.geometry.radius,
+                length: case.geometry.length,
+                thickness: case.geometry.thickness,
+                caps: String::new(),
+            },
+            units: UNITS.into(),
+            case_hash: case.hash().to_string(),
+            scales: case.scales(),
+            stages: vec![],
+            warnings: vec![],
+        }
+    }
+}
+
 pub const UNITS: &str = "dimensionless: R = 1, μH = 1, w = pR/(μH), resultants N/(μH), force = plate force per length/(πμH)";
 
 impl RunReport {

@@ -68,35 +68,7 @@ pub fn run_with(
 ) -> RunOutcome {
     let mut report = None;
     let error = run_inner(case, label, options, observers, &mut report).err();
-    let report = report.unwrap_or_else(|| RunReport {
-        case: label.to_string(),
-        mesh: MeshInfo {
-            nodes: 0,
-            elements: 0,
-            equations: 0,
-            symmetry: String::new(),
-            element: String::new(),
-            factor_nnz: 0,
-            factor_flops: 0.0,
-            ordering: String::new(),
-            split_separator: None,
-            reuses_factor: false,
-            contact_edge_fit: None,
-        },
-        material: String::new(),
-        material_spec: case.material.clone(),
-        geometry: GeometryInfo {
-            radius: case.geometry.radius,
-            length: case.geometry.length,
-            thickness: case.geometry.thickness,
-            caps: String::new(),
-        },
-        units: UNITS.into(),
-        case_hash: case.hash().to_string(),
-        scales: case.scales(),
-        stages: vec![],
-        warnings: vec![],
-    });
+    let report = report.unwrap_or_else(|| RunReport::empty(case, label));
     if let Some(e) = &error {
         for o in observers.iter_mut() {
             o.failed(&report, e);
