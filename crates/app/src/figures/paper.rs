@@ -71,13 +71,7 @@ impl Curves {
                 let c = flattening_curve(law, h, ls0, 0.5 * ls0, 201).map_err(|e| {
                     AppError::gps(format!("the flattening curve from λs* = {ls0}"), e)
                 })?;
-                let p = dir.join(format!(
-                    "flattening_ls{}_{}.csv",
-                    start_tag(ls0),
-                    h.label().to_lowercase()
-                ));
-                let text = csv_text(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
-                files.push((p, text.into_bytes()));
+                flattening_csv(dir, ls0, h, "", &c, files)?;
                 per.push(c);
             }
             flattening.push(per);
@@ -91,13 +85,7 @@ impl Curves {
                         AppError::gps(format!("the pressure-held squeeze from λs* = {ls0}"), e)
                     })?;
                 let c: Vec<FlatteningState> = c.iter().map(|s| s.as_flattening(ls0)).collect();
-                let p = dir.join(format!(
-                    "flattening_ls{}_{}_pressure_held.csv",
-                    start_tag(ls0),
-                    h.label().to_lowercase()
-                ));
-                let text = csv_text(&p, FLATTENING_HEADER, c.iter().map(flattening_values))?;
-                files.push((p, text.into_bytes()));
+                flattening_csv(dir, ls0, h, "_pressure_held", &c, files)?;
                 let stop = stop.map(|_| {
                     let last = c.last().map_or(ls0, |s| s.rho);
                     format!(
@@ -120,6 +108,26 @@ impl Curves {
             limits,
         })
     }
+}
+
+/// The CSV of a flattening curve from λs* = `ls0` under `h`, as
+/// `flattening_ls<λs*>_<hyp><suffix>.csv` in `dir`, appended to `files`.
+fn flattening_csv(
+    dir: &Path,
+    ls0: f64,
+    h: Hypothesis,
+    suffix: &str,
+    curve: &[FlatteningState],
+    files: &mut Vec<(PathBuf, Vec<u8>)>,
+) -> Result<()> {
+    let p = dir.join(format!(
+        "flattening_ls{}_{}{suffix}.csv",
+        start_tag(ls0),
+        h.label().to_lowercase()
+    ));
+    let text = csv_text(&p, FLATTENING_HEADER, curve.iter().map(flattening_values))?;
+    files.push((p, text.into_bytes()));
+    Ok(())
 }
 
 /// How the figures' axes are drawn: dimensionless, or in the overlays' `[units]` when they
