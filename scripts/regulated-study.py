@@ -93,8 +93,12 @@ def main():
 def run_variant(a, out, text, name, n, length):
     """The shipped case with `n` around, `length` (in R) and along = n·length/8 (the shipped
     element aspect), run into OUT/name: its last stage's summary and its folder."""
+    # the contact edges take the 32-around tube's node lines (the shipped case's
+    # edge_fit_around), so 32, 64 and 128 around are nested; a coarser mesh takes its own
+    if n < 32:
+        text = text.replace("edge_fit_around = 32\n", "")
     case = (
-        text.replace("around = 32", f"around = {n}")
+        text.replace("\naround = 32\n", f"\naround = {n}\n")
         .replace("along = 80", f"along = {round(n * length / 8)}")
         .replace("length = 20.0", f"length = {length}")
     )

@@ -504,9 +504,21 @@ pub struct MeshSpec {
     /// carried over to the moved mesh ([`crate::edge_track`])
     #[serde(default)]
     pub track_contact_edge: bool,
+    /// the node lines a fitted or tracked contact edge may take: those of the tube with this
+    /// many elements around (a divisor of `around`, multiple of 8; default `around`, the
+    /// nearest line). With the same value on every mesh of a refinement study the fitted
+    /// meshes are uniform refinements of one another, each element split in two, so the
+    /// observed order is the element's own ([`tubemem_mesh::hoop::HoopMap::fitted`])
+    pub edge_fit_around: Option<usize>,
 }
 
 impl MeshSpec {
+    /// The elements around whose node lines a fitted contact edge takes (`edge_fit_around`,
+    /// else `around`), for a generated tube.
+    pub fn fit_grid(&self) -> Option<usize> {
+        self.edge_fit_around.or(self.around)
+    }
+
     /// The generated tube's polygon factor 1/cos(π/n), n elements around: the n-gon prism's
     /// pressure over the smooth tube's at the same state (`None` for a user mesh). The 9-node
     /// element's cross-section is a chain of parabolic arcs through points of the circle, not a
@@ -1508,6 +1520,20 @@ impl Case {
                 invalid!(
                     "[mesh] `track_contact_edge` fits the mesh at every step: drop `fit_contact_edge` and `contact_edge_angle`, which fit it once for the last stage's end"
                 );
+            }
+        }
+        if let Some(g) = m.edge_fit_around {
+            if !(m.fit_contact_edge || m.contact_edge_angle.is_some() || m.track_contact_edge) {
+                invalid!(
+                    "[mesh] `edge_fit_around` = {g} chooses the node lines a contact edge takes: it needs `fit_contact_edge`, `contact_edge_angle` or `track_contact_edge`"
+                );
+            }
+            if let Some(around) = m.around {
+                if g < 8 || !g.is_multiple_of(8) || g > around || !around.is_multiple_of(g) {
+                    invalid!(
+                        "[mesh] `edge_fit_around` = {g}: must be a multiple of 8 that divides `around` = {around} (the fitted node lines are those of a tube with that many elements around)"
+                    );
+                }
             }
         }
         if let Some(a) = m.contact_edge_angle {

@@ -156,6 +156,7 @@ fn locate(
     coarse.mesh.cap_rows = case.mesh.cap_rows.map(|v| scale(v, false));
     coarse.mesh.fit_contact_edge = false;
     coarse.mesh.contact_edge_angle = None;
+    coarse.mesh.edge_fit_around = None;
     coarse.stages.truncate(k + 1);
     coarse.truncate_plan(k + 1);
     let outcome = solve(&coarse);

@@ -37,6 +37,8 @@ pub struct TubeSpec {
     /// L/R
     pub length: f64,
     pub around: usize,
+    /// the tube whose node lines the edges take (`[mesh] edge_fit_around`, else `around`)
+    pub fit_around: usize,
     pub along: usize,
     pub cap_rows: usize,
     pub symmetry: Symmetry,
@@ -48,7 +50,7 @@ impl TubeSpec {
         let map = if edges.is_empty() {
             None
         } else {
-            Some(HoopMap::fitted(self.around, edges)?)
+            Some(HoopMap::fitted(self.fit_around, edges)?)
         };
         capped_tube_fitted_of(
             self.kind,
@@ -181,6 +183,7 @@ impl TubeSpec {
                 kind: case.mesh.element,
                 length: case.geometry.length / case.geometry.radius,
                 around,
+                fit_around: case.mesh.fit_grid().unwrap_or(around),
                 along,
                 cap_rows: case.mesh.cap_rows.unwrap_or(around / 8),
                 symmetry: case.mesh.symmetry,

@@ -38,7 +38,10 @@ pub(crate) fn mesh_of(
             let (kind, sym) = (case.mesh.element, case.mesh.symmetry);
             let fit = crate::edge_fit::contact_edges(case, solve)?;
             let map = match &fit {
-                Some(f) => Some(HoopMap::fitted(around, &f.edges).map_err(AppError::Mesh)?),
+                Some(f) => Some(
+                    HoopMap::fitted(case.mesh.fit_grid().unwrap_or(around), &f.edges)
+                        .map_err(AppError::Mesh)?,
+                ),
                 None => None,
             };
             match g.caps {

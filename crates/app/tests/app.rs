@@ -1013,6 +1013,32 @@ fn an_edge_fit_it_cannot_make_is_a_clear_error() {
     );
     let msg = Case::parse(&lopsided).unwrap_err().to_string();
     assert!(msg.contains("not symmetric about y = 0"), "{msg}");
+    // `edge_fit_around`: only with a fit, and a multiple of 8 dividing `around` (16 here)
+    let grid = |key: &str, fit: &str| {
+        Case::parse(
+            &format!("{SMALL}{SQUEEZE}").replace("[mesh]", &format!("[mesh]\n{key}\n{fit}")),
+        )
+        .map_err(|e| e.to_string())
+    };
+    let e = grid("edge_fit_around = 8", "").unwrap_err();
+    assert!(
+        e.contains("edge_fit_around") && e.contains("needs `fit_contact_edge`"),
+        "{e}"
+    );
+    for bad in [4, 12, 32] {
+        let e = grid(
+            &format!("edge_fit_around = {bad}"),
+            "track_contact_edge = true",
+        )
+        .unwrap_err();
+        assert!(
+            e.contains(&format!("`edge_fit_around` = {bad}"))
+                && e.contains("divides `around` = 16"),
+            "{e}"
+        );
+    }
+    grid("edge_fit_around = 8", "track_contact_edge = true").unwrap();
+    grid("edge_fit_around = 16", "fit_contact_edge = true").unwrap();
     for key in ["contact_edge_angle = 2.0", "contact_edge_angle = -0.1"] {
         let e = Case::parse(&SMALL.replace("[mesh]", &format!("[mesh]\n{key}")))
             .unwrap_err()

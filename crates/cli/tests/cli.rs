@@ -2633,6 +2633,37 @@ fn a_regulated_flattening_holds_the_pressure_and_names_the_critical_one() {
     assert_eq!(f(&si, "w_critical"), wc);
     assert!((f(&si, "critical_pressure_pa") / (wc * 2e4) - 1.0).abs() < 1e-14);
     assert!((f(&si, "pressure_pa") / 24000.0 - 1.0).abs() < 1e-14);
+    // the gripper's stiffness −d(ϖχ)/d(2ρ) at the held pressure: against a central difference
+    // of the CLI's own force at ρ ± 1e-4 (truncation ~1e-8 relative, rounding ~1e-11; bound
+    // 1e-6). Negative here: 1.2 is near ϖc, where λs grows fast with the gap, so the flat, and
+    // the force, shrink as the plates close
+    let force_at = |rho: &str| {
+        let v = json(&with(
+            &[
+                "gps",
+                "flatten",
+                "--control",
+                "pressure",
+                "--rho",
+                rho,
+                "--pressure",
+                "1.2",
+                "--json",
+            ],
+            &nh,
+        ));
+        v["force"].as_f64().unwrap()
+    };
+    let fd = -(force_at("0.8001") - force_at("0.7999")) / 4e-4;
+    let k = f(&between, "stiffness");
+    assert!(k < 0.0 && (k / fd - 1.0).abs() < 1e-6, "{k} vs {fd}");
+    // in SI: the force per unit length is πμH·ϖχ and the gap 2ρR, so the stiffness is in
+    // units of πμH/R = π · 20 kPa (the same state to 1e-12, its stiffness to 1e-10: a
+    // derivative through the same solve)
+    assert!((f(&si, "stiffness") / k - 1.0).abs() < 1e-10);
+    let pa = std::f64::consts::PI * 2e4 * f(&si, "stiffness");
+    assert!((f(&si, "stiffness_pa") / pa - 1.0).abs() < 1e-14);
+    assert!(between.get("stiffness_pa").is_none());
     let refused = |args: &[&str], m: &[&str], words: &[&str]| {
         let o = tubemem(&with(args, m));
         let err = String::from_utf8_lossy(&o.stderr);

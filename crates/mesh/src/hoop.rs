@@ -28,6 +28,13 @@ impl HoopMap {
     /// nearest corner line of a tube with `around` elements around onto it (the lines x = 0
     /// and y = 0 excepted: an edge nearest one of those moves its neighbour). Two edges that
     /// would move the same line are an error.
+    ///
+    /// The map is one of angles: built with `around` = g, it fits any tube whose elements
+    /// around are a multiple of g, moving lines of the g-element tube. The meshes of n, 2n,
+    /// 4n … around fitted with the same g are then uniform refinements of one another (each
+    /// element between two anchors stretched by the same factor on all of them), where the
+    /// nearest line (g = n) stretches them by factors that differ from mesh to mesh and the
+    /// observed order between two meshes is not the element's.
     pub fn fitted(around: usize, edges: &[f64]) -> Result<Self, MeshError> {
         let quarter = around / 4;
         if quarter < 2 {
