@@ -47,6 +47,7 @@ pub mod relaxed;
 pub mod separable;
 mod spec;
 pub mod taylor;
+pub mod viscoelastic;
 
 pub use error::{
     shorten_lines, tidy_numbers, MaterialError, NonFiniteState, Num, MAX_MESSAGE_LINE,
@@ -448,6 +449,8 @@ mod tests;
 mod tests_fit;
 #[cfg(test)]
 mod tests_laws;
+#[cfg(test)]
+mod tests_visco;
 
 /// An error and its sources, one line (for the tests).
 #[cfg(test)]
