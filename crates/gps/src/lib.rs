@@ -39,6 +39,7 @@ mod newton;
 pub mod regulated;
 mod resultants;
 mod scales;
+pub mod visco;
 
 use error::invalid;
 pub use error::GpsError;

@@ -1,4 +1,5 @@
 //! The QLV Prony law (`viscoelastic`) against closed-form histories.
+#![allow(clippy::needless_range_loop)] // loops over the Voigt components of several tensors at once
 
 use crate::laws::{neo_hookean, AnssariBenamBucchi};
 use crate::viscoelastic::{step_stress_tangent, History, Prony, PronyError, PronyTerm};

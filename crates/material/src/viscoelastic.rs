@@ -78,7 +78,7 @@ impl Prony {
             }
         }
         let sum: f64 = terms.iter().map(|t| t.g).sum();
-        if !(sum < 1.0) {
+        if sum >= 1.0 {
             return Err(PronyError::NoLongTerm { sum });
         }
         Ok(Self { terms })
