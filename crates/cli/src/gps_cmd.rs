@@ -83,6 +83,11 @@ pub enum GpsCommand {
     /// closed in at --initial-stretch and the walls moved in from first contact, or a given
     /// --pressure. One state (--json), a path into --csv, a figure of the section (--figure).
     Confine(ConfineArgs),
+    /// Free inflation in time with a viscoelastic law (a QLV Prony series on the base law):
+    /// the pressure, the hoop stretch or the enclosed volume ramped to --to over --ramp, then
+    /// held for --hold (creep at constant pressure, relaxation at fixed volume); time steps
+    /// doubled until their estimated error is below --tolerance.
+    History(crate::gps_history::HistoryArgs),
 }
 
 #[derive(Args, Debug)]
@@ -501,13 +506,14 @@ pub fn run(cmd: GpsCommand) -> Result<()> {
             ("pressure", "--pressure"),
             ("points", "--points"),
         ],
-        GpsCommand::Limits(_) => &[],
+        GpsCommand::Limits(_) | GpsCommand::History(_) => &[],
     };
     run_command(cmd).map_err(|e| flagged(e, names))
 }
 
 fn run_command(cmd: GpsCommand) -> Result<()> {
     match cmd {
+        GpsCommand::History(a) => crate::gps_history::run(a),
         GpsCommand::Inflate(a) => {
             let law = a.material.build()?;
             let hyp = a.hypothesis.into();

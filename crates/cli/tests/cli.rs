@@ -2701,3 +2701,126 @@ fn a_regulated_flattening_holds_the_pressure_and_names_the_critical_one() {
         &["--control pressure"],
     );
 }
+
+/// Issue #63: `gps history`. Its SI twin (R = 5 mm, H = 0.5 mm, μ = 0.1 MPa: μH/R = 10 kPa, so
+/// 3 kPa is ϖ = 0.3; time in the Prony series' unit either way) is the same history to 1e-12
+/// (the pressure read back through the unit's rounding), with the pressure in Pa too; the
+/// error estimate is reported and below the tolerance asked; a bad series names its term, a
+/// target above the long-term pressure maximum names the maximum.
+#[test]
+fn a_viscoelastic_history_and_its_si_twin_agree_and_bad_input_is_named() {
+    let base = [
+        "gps",
+        "history",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--prony",
+        "0.3:1,0.2:10",
+        "--control",
+        "pressure",
+        "--ramp",
+        "1",
+        "--hold",
+        "20",
+        "--json",
+    ];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        let mut a = base.to_vec();
+        a.extend_from_slice(extra);
+        a
+    }
+    let d = json(&with(&base, &["--to", "0.3", "--tolerance", "1e-9"]));
+    let si = json(&with(
+        &base,
+        &[
+            "--to",
+            "3000",
+            "--tolerance",
+            "1e-9",
+            "--radius",
+            "0.005",
+            "--thickness",
+            "0.0005",
+            "--shear-modulus",
+            "1e5",
+        ],
+    ));
+    let f = |v: &Value, k: &str| v[k].as_f64().unwrap();
+    for k in ["lambda_s", "lambda_z", "w", "time"] {
+        assert!(
+            (f(&si, k) / f(&d, k) - 1.0).abs() < 1e-12,
+            "{k}: {} vs {}",
+            f(&si, k),
+            f(&d, k)
+        );
+    }
+    assert!((f(&si, "pressure_pa") / 3000.0 - 1.0).abs() < 1e-12);
+    assert!(d.get("pressure_pa").is_none());
+    assert!(f(&d, "error_estimate") <= 1e-9 && f(&d, "g_infinity") == 0.5);
+    let refused = |args: Vec<&str>, words: &[&str]| {
+        let o = tubemem(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?}");
+        for w in words {
+            assert!(err.contains(w), "{args:?}: {err}");
+        }
+    };
+    refused(
+        [
+            "gps",
+            "history",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--prony",
+            "0.3:1,0.2:-1",
+            "--control",
+            "pressure",
+            "--to",
+            "0.3",
+        ]
+        .to_vec(),
+        &["prony[1].tau = -1"],
+    );
+    refused(
+        [
+            "gps",
+            "history",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--prony",
+            "0.3:1,x:2",
+            "--control",
+            "pressure",
+            "--to",
+            "0.3",
+        ]
+        .to_vec(),
+        &["--prony term 2", "is not a number"],
+    );
+    refused(
+        [
+            "gps",
+            "history",
+            "--material",
+            "abb",
+            "--kuhn",
+            "30",
+            "--prony",
+            "0.3:1",
+            "--control",
+            "pressure",
+            "--to",
+            "0.6",
+            "--hold",
+            "100",
+        ]
+        .to_vec(),
+        &["long-term pressure maximum ϖ = 0.529823", "bulges"],
+    );
+}
