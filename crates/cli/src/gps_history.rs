@@ -1,16 +1,18 @@
 //! `tubemem gps history`: the GPS free inflation in time with a viscoelastic (QLV Prony) law
 //! ([`tubemem_gps::visco`]): a ramp of the pressure, the hoop stretch or the enclosed volume to
-//! a target, then a hold (creep at constant pressure, relaxation at fixed volume).
+//! a target, then a hold (creep at constant pressure, relaxation at fixed volume); then, with
+//! `--plates-to`, two frictionless plates closing from first contact at a speed, held, and
+//! released (the force–gap loop), the gas closed or the pressure regulated.
 use crate::material_args::{add_si, MaterialArgs, UnitArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use tubemem_app::units::Dimension;
-use tubemem_gps::visco::{inflation_history, Control, Segment};
+use tubemem_gps::visco::{inflation_history, loop_area, Control, Segment, Supply};
 use tubemem_material::viscoelastic::{Prony, PronyTerm};
 
 /// The header of `gps history --csv` (dimensionless columns; SI ones follow with --radius).
-pub const HISTORY_HEADER: &str = "time,w,lambda_s,lambda_z,n_s,n_z";
+pub const HISTORY_HEADER: &str = "time,w,lambda_s,lambda_z,n_s,n_z,rho,chi,force";
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
 pub enum HistoryControl {
@@ -31,6 +33,14 @@ impl From<HistoryControl> for Control {
             HistoryControl::Volume => Control::Volume,
         }
     }
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+pub enum PlateSupply {
+    /// the gas closed in when the plates start (Boyle)
+    Gas,
+    /// the pressure held at its value when the plates start (a regulator)
+    Pressure,
 }
 
 #[derive(Args, Debug)]
@@ -59,7 +69,25 @@ pub struct HistoryArgs {
     /// The hold's duration after the ramp (0: none).
     #[arg(long, default_value_t = 0.0)]
     hold: f64,
-    /// The largest error in ϖ, λs and λz the time steps may leave (their Richardson estimate).
+    /// After the inflation: plates y = ±ρR closing from first contact to this half-gap ρ.
+    #[arg(long)]
+    plates_to: Option<f64>,
+    /// The plates' travel time (0: a jump).
+    #[arg(long, default_value_t = 0.0)]
+    squeeze_time: f64,
+    /// How the gas is supplied while the plates move: closed in ("gas") or regulated at the
+    /// inflated pressure ("pressure").
+    #[arg(long, value_enum, default_value = "gas")]
+    supply: PlateSupply,
+    /// The time the plates are held at --plates-to.
+    #[arg(long, default_value_t = 0.0)]
+    plates_hold: f64,
+    /// Then release the plates back to where they first touched, over --squeeze-time, and
+    /// report the force–gap loop's area (the work the plates did on the tube over the cycle).
+    #[arg(long)]
+    release: bool,
+    /// The largest error in ϖ, λs, λz and the force the time steps may leave (their
+    /// Richardson estimate).
     #[arg(long, default_value_t = 1e-10)]
     tolerance: f64,
     /// Write every step to this CSV file.
@@ -108,11 +136,17 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         Control::Pressure => units.to_core(Dimension::Pressure, a.to),
         _ => a.to,
     };
-    for (flag, v) in [("--ramp", a.ramp), ("--hold", a.hold)] {
+    for (flag, v) in [
+        ("--ramp", a.ramp),
+        ("--hold", a.hold),
+        ("--squeeze-time", a.squeeze_time),
+        ("--plates-hold", a.plates_hold),
+    ] {
         if !(v.is_finite() && v >= 0.0) {
             bail!("{flag} = {v}: a duration must be finite and ≥ 0");
         }
     }
+    let hyp = a.hypothesis.into();
     let mut program = vec![Segment {
         control,
         target: Some(to),
@@ -124,6 +158,50 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             target: None,
             duration: a.hold,
         });
+    }
+    if a.plates_to.is_none() && (a.release || a.squeeze_time > 0.0 || a.plates_hold > 0.0) {
+        bail!("--squeeze-time, --plates-hold and --release move plates: give --plates-to ρ");
+    }
+    let mut release_from = None;
+    if let Some(rho) = a.plates_to {
+        let supply = match a.supply {
+            PlateSupply::Gas => Supply::Gas,
+            PlateSupply::Pressure => Supply::Pressure,
+        };
+        let plates = Control::Plates(supply);
+        // where the plates first touch: the inflated λs (to the history's tolerance)
+        let first = inflation_history(law.as_ref(), &prony, hyp, &program, 16, a.tolerance)
+            .map_err(|e| {
+                anyhow::anyhow!(e).context("the viscoelastic inflation before the plates")
+            })?;
+        let touch = first
+            .points
+            .last()
+            .expect("a history has its start")
+            .lambda_s;
+        if !(rho.is_finite() && rho > 0.0 && rho < touch) {
+            bail!("--plates-to {rho}: the plates close from first contact at ρ = {touch:.6} (the inflated λs): give 0 < ρ < {touch:.6}");
+        }
+        program.push(Segment {
+            control: plates,
+            target: Some(rho),
+            duration: a.squeeze_time,
+        });
+        if a.plates_hold > 0.0 {
+            program.push(Segment {
+                control: plates,
+                target: None,
+                duration: a.plates_hold,
+            });
+        }
+        if a.release {
+            release_from = Some(program.len());
+            program.push(Segment {
+                control: plates,
+                target: Some(touch),
+                duration: a.squeeze_time,
+            });
+        }
     }
     if let Some(csv) = &a.csv {
         let law_file = a
@@ -141,7 +219,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
     let h = inflation_history(
         law.as_ref(),
         &prony,
-        a.hypothesis.into(),
+        hyp,
         &program,
         16,
         a.tolerance,
@@ -171,20 +249,41 @@ pub fn run(a: HistoryArgs) -> Result<()> {
     if let Some(csv) = &a.csv {
         let si = units.is_si();
         let header = if si {
-            format!("{HISTORY_HEADER},pressure_pa,n_s_n_per_m,n_z_n_per_m")
+            format!("{HISTORY_HEADER},pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m")
         } else {
             HISTORY_HEADER.to_string()
         };
-        let rows = h.points.iter().map(|p| {
-            let mut r = vec![p.time, p.w, p.lambda_s, p.lambda_z, p.n_s, p.n_z];
+        // ρ is empty before the plates come (no NaN in a file a user reads)
+        let mut text = format!("{header}\n");
+        for p in &h.points {
+            let mut r = vec![
+                Some(p.time),
+                Some(p.w),
+                Some(p.lambda_s),
+                Some(p.lambda_z),
+                Some(p.n_s),
+                Some(p.n_z),
+                p.rho,
+                Some(p.chi),
+                Some(p.force),
+            ];
             if si {
-                r.push(units.from_core(Dimension::Pressure, p.w));
-                r.push(units.from_core(Dimension::Resultant, p.n_s));
-                r.push(units.from_core(Dimension::Resultant, p.n_z));
+                r.push(Some(units.from_core(Dimension::Pressure, p.w)));
+                r.push(Some(units.from_core(Dimension::Resultant, p.n_s)));
+                r.push(Some(units.from_core(Dimension::Resultant, p.n_z)));
+                r.push(Some(units.from_core(Dimension::ForcePerLength, p.force)));
             }
-            r
-        });
-        tubemem_app::curves::write_csv(csv, &header, rows)
+            if r.iter().flatten().any(|v| !v.is_finite()) {
+                bail!("internal error: a non-finite value was computed at t = {}; please report this input", p.time);
+            }
+            let cells: Vec<String> = r
+                .iter()
+                .map(|v| v.map(|v| v.to_string()).unwrap_or_default())
+                .collect();
+            text.push_str(&cells.join(","));
+            text.push('\n');
+        }
+        tubemem_app::output_file::write_whole(csv, text.as_bytes())
             .map_err(|e| anyhow::anyhow!(e.chain()))?;
     }
     let mut v = serde_json::to_value(last)?;
@@ -193,12 +292,23 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         map.insert("steps_per_segment".into(), h.steps_per_segment.into());
         map.insert("error_estimate".into(), h.error_estimate.into());
         map.insert("g_infinity".into(), prony.g_infinity().into());
+        if let Some(area) = release_from.map(|_| loop_area(&h.points)) {
+            map.insert("loop_area".into(), area.into());
+            if units.is_si() {
+                map.insert(
+                    "loop_area_j_per_m".into(),
+                    units
+                        .from_core(Dimension::Force, std::f64::consts::PI * area)
+                        .into(),
+                );
+            }
+        }
     }
     if a.json {
         crate::say!("{v}")?;
     } else {
         crate::say!(
-            "{} viscoelastic inflation ({} Prony terms, g∞ = {}): at t = {} (the Prony series' time unit) ϖ = {:.9}, λs = {:.9}, λz = {:.9} ({} steps per segment, time-step error ≤ {:.1e}){}",
+            "{} viscoelastic tube ({} Prony terms, g∞ = {}): at t = {} (the Prony series' time unit) ϖ = {:.9}, λs = {:.9}, λz = {:.9} ({} steps per segment, time-step error ≤ {:.1e}){}",
             a.hypothesis_label(),
             prony.terms().len(),
             prony.g_infinity(),
@@ -213,6 +323,37 @@ pub fn run(a: HistoryArgs) -> Result<()> {
                 .map(|c| format!("; wrote {} states to {}", h.points.len(), c.display()))
                 .unwrap_or_default()
         )?;
+        if let Some(rho) = last.rho {
+            let si = units
+                .is_si()
+                .then(|| {
+                    format!(
+                        " ({:.6e} N/m)",
+                        units.from_core(Dimension::ForcePerLength, last.force)
+                    )
+                })
+                .unwrap_or_default();
+            crate::say!(
+                "  plates at ρ = {rho:.6} R: χ = {:.9}, force ϖχ = {:.9} πμH per unit length{si}",
+                last.chi,
+                last.force
+            )?;
+        }
+        if release_from.is_some() {
+            let area = loop_area(&h.points);
+            let si = units
+                .is_si()
+                .then(|| {
+                    format!(
+                        " ({:.6e} J/m)",
+                        units.from_core(Dimension::Force, std::f64::consts::PI * area)
+                    )
+                })
+                .unwrap_or_default();
+            crate::say!(
+                "  force–gap loop: the plates did {area:.6e} πμHR{si} of work per plate and unit length over the cycle (dissipated)"
+            )?;
+        }
         if units.is_si() {
             crate::say!(
                 "  pressure {} Pa",

@@ -1,34 +1,48 @@
-//! The GPS free inflation of a capped tube in time, with a quasi-linear viscoelastic law
+//! The GPS section of a capped tube in time, with a quasi-linear viscoelastic law
 //! ([`tubemem_material::viscoelastic`]): the paper's "mixed algebraic-differential" problem
-//! (Sec. 3.2). Every point of the section has the same stretch history, so the section stays
-//! uniform and eqs. (66) hold at every instant with the hereditary stress:
+//! (Sec. 3.2). Every point of the section has the same stretch history (N_s is uniform around
+//! the section at every instant, frictionless plates or none), so the section stays uniform and
+//! eqs. (66) (free) or (76)–(77) (between plates) hold at every instant with the hereditary
+//! stress of the step ([`step`]).
 //!
-//! ```text
-//! N_s = λs S_s/λz,  N_z = λz S_z/λs,  S = α S⁰(λs, λz) + B   (one step, Prony::step)
-//! N_s = ϖ λs   (hoop)        N_s = 2 N_z   (caps, GPS; PS: λz = 1)
-//! and the control: ϖ(t) given (creep when held), λs(t) given, or v = λs² λz given
-//!   (the enclosed volume per unit reference length over πR²: relaxation at fixed volume)
-//! ```
-//! The load follows a program of segments, each ramping its control linearly in time to a
-//! target (or holding it) over a duration (0: a jump, taken with Δt = 0, the instantaneous
-//! response). Each segment takes equal steps; [`inflation_history`] doubles them until the
-//! Richardson estimate of the error (the update is second order, [`ORDER`]) is below a
-//! tolerance, and reports that estimate.
+//! A load program is a list of segments, each ramping its control linearly in time to a target
+//! (or holding it) over a duration (0: a jump, taken with Δt = 0, the instantaneous response):
+//! the pressure ϖ (creep when held), the hoop stretch λs, the enclosed volume v = λs² λz
+//! (relaxation at fixed volume when held), or the plates' half-gap ρ with the pressure held or
+//! the gas closed at the segment's start (a squeeze at a plate speed, a hold, a release; the
+//! plates start where they touch the tube, and leave it where it is narrower than the gap). Each
+//! segment takes equal steps; [`inflation_history`] doubles them until the Richardson estimate
+//! of the error (the update is second order, [`ORDER`]) is below a tolerance, and reports it.
 
-use crate::{newton, resultants, GpsError, Hypothesis};
+mod step;
+
+use crate::{GpsError, Hypothesis};
+use step::{Fix, StepEquations};
 use tubemem_material::viscoelastic::{History, Prony};
-use tubemem_material::{MaterialError, MembraneLaw, Num};
+use tubemem_material::{MembraneLaw, Num};
+
+/// How the gas is supplied while the plates move.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Supply {
+    /// the pressure held at its value at the segment's start (a regulator)
+    Pressure,
+    /// the gas closed in at the segment's start (Boyle, eq. 77₂)
+    Gas,
+}
 
 /// What a segment controls.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Control {
-    /// the reduced pressure ϖ
+    /// the reduced pressure ϖ of the free tube
     Pressure,
-    /// the hoop stretch λs
+    /// the hoop stretch λs of the free tube
     Stretch,
-    /// the enclosed volume per unit reference length over πR², v = λs² λz
+    /// the free tube's enclosed volume per unit reference length over πR², v = λs² λz
     Volume,
+    /// the half-gap ρ of two frictionless plates y = ±ρR
+    Plates(Supply),
 }
 
 /// One segment of a load program.
@@ -50,6 +64,12 @@ pub struct TimePoint {
     pub lambda_z: f64,
     pub n_s: f64,
     pub n_z: f64,
+    /// the plates' half-gap (None before any plates segment)
+    pub rho: Option<f64>,
+    /// χ = λs − ρ, the reduced contact length (0 without contact)
+    pub chi: f64,
+    /// the reduced force ϖχ on each plate (eq. 80; 0 without contact)
+    pub force: f64,
 }
 
 /// A computed history and its accuracy.
@@ -59,7 +79,8 @@ pub struct TimeHistory {
     pub points: Vec<TimePoint>,
     /// steps per segment of non-zero duration
     pub steps_per_segment: usize,
-    /// the Richardson estimate of the largest error in ϖ, λs or λz over the segment ends,
+    /// the Richardson estimate of the largest error in ϖ, λs, λz or the force over the
+    /// segment ends, or in the plates' work ([`loop_area`]),
     /// |y_n − y_2n|/(2^p − 1) with p = [`ORDER`]
     pub error_estimate: f64,
 }
@@ -70,144 +91,24 @@ pub const ORDER: i32 = 2;
 /// The most steps per segment [`inflation_history`] takes before it gives up: 2^20.
 pub const MAX_STEPS: usize = 1 << 20;
 
-/// The unknowns and resultants at the end of a step.
-struct Solved {
-    ls: f64,
-    lz: f64,
-    ns: f64,
-    nz: f64,
-}
-
-/// One step's equations: the law, the hypothesis, α and the history's stress B.
-struct StepEquations<'a> {
-    law: &'a dyn MembraneLaw,
-    hyp: Hypothesis,
-    alpha: f64,
-    b: [f64; 3],
-}
-
-impl StepEquations<'_> {
-    /// N_s, N_z at (λs, λz) and their Jacobian [[∂N_s/∂λs, ∂N_s/∂λz], [∂N_z/∂λs, ∂N_z/∂λz]].
-    fn resultants(&self, ls: f64, lz: f64) -> Result<(f64, f64, [[f64; 2]; 2]), MaterialError> {
-        let r = resultants::resultants(self.law, ls, lz)?;
-        let (alpha, bs, bz) = (self.alpha, self.b[0], self.b[1]);
-        let ns = alpha * r.ns + bs * ls / lz;
-        let nz = alpha * r.nz + bz * lz / ls;
-        let j = [
-            [
-                alpha * r.jac[0][0] + bs / lz,
-                alpha * r.jac[0][1] - bs * ls / (lz * lz),
-            ],
-            [
-                alpha * r.jac[1][0] - bz * lz / (ls * ls),
-                alpha * r.jac[1][1] + bz / ls,
-            ],
-        ];
-        Ok((ns, nz, j))
-    }
-
-    /// F = N_s − 2 N_z (the caps' balance), its partials in λs and λz.
-    fn axial(&self, ls: f64, lz: f64) -> Result<(f64, f64, f64), MaterialError> {
-        let (ns, nz, j) = self.resultants(ls, lz)?;
-        Ok((
-            ns - 2.0 * nz,
-            j[0][0] - 2.0 * j[1][0],
-            j[0][1] - 2.0 * j[1][1],
-        ))
-    }
-
-    /// Solve the step for the controlled `value` from the guess (λs, λz).
-    fn solve(
-        &self,
-        control: Control,
-        value: f64,
-        guess: [f64; 2],
-        at: &str,
-    ) -> Result<Solved, GpsError> {
-        const STAGE: &str = "viscoelastic inflation (eqs. 66 in time)";
-        let ftol = 1e-13;
-        let fail = |f: newton::Failure| f.into_error(STAGE, at);
-        let (ls, lz) = match (control, self.hyp) {
-            (Control::Pressure, Hypothesis::Gps) => {
-                let x = newton::system2(
-                    |[ls, lz]| {
-                        let (ns, nz, j) = self.resultants(ls, lz)?;
-                        Ok((
-                            [ns - value * ls, ns - 2.0 * nz],
-                            [
-                                [j[0][0] - value, j[0][1]],
-                                [j[0][0] - 2.0 * j[1][0], j[0][1] - 2.0 * j[1][1]],
-                            ],
-                        ))
-                    },
-                    guess,
-                    ftol,
-                )
-                .map_err(fail)?;
-                (x[0], x[1])
-            }
-            (Control::Pressure, Hypothesis::Ps) => {
-                let ls = newton::scalar(
-                    |ls| {
-                        let (ns, _, j) = self.resultants(ls, 1.0)?;
-                        Ok((ns - value * ls, j[0][0] - value))
-                    },
-                    guess[0],
-                    ftol,
-                )
-                .map_err(fail)?;
-                (ls, 1.0)
-            }
-            (Control::Stretch, Hypothesis::Gps) => {
-                let lz = newton::scalar(
-                    |lz| self.axial(value, lz).map(|(f, _, d)| (f, d)),
-                    guess[1],
-                    ftol,
-                )
-                .map_err(fail)?;
-                (value, lz)
-            }
-            (Control::Volume, Hypothesis::Gps) => {
-                // λs = √(v/λz): dλs/dλz = −λs/(2λz)
-                let lz = newton::scalar(
-                    |lz| {
-                        let ls = (value / lz).sqrt();
-                        self.axial(ls, lz)
-                            .map(|(f, ds, dz)| (f, dz - ds * ls / (2.0 * lz)))
-                    },
-                    guess[1],
-                    ftol,
-                )
-                .map_err(fail)?;
-                ((value / lz).sqrt(), lz)
-            }
-            (Control::Stretch, Hypothesis::Ps) => (value, 1.0),
-            (Control::Volume, Hypothesis::Ps) => (value.sqrt(), 1.0),
-        };
-        let (ns, nz, _) = self
-            .resultants(ls, lz)
-            .map_err(|source| GpsError::Material {
-                stage: STAGE,
-                at: at.to_string(),
-                source,
-            })?;
-        if ns.is_nan() || ns <= 0.0 {
-            return Err(GpsError::Compressive {
-                stage: "viscoelastic inflation",
-                at: at.to_string(),
-                n_s: ns,
-                w: ns / ls,
-            });
-        }
-        Ok(Solved { ls, lz, ns, nz })
-    }
-}
-
 fn controlled(p: &TimePoint, c: Control) -> f64 {
     match c {
         Control::Pressure => p.w,
         Control::Stretch => p.lambda_s,
         Control::Volume => p.lambda_s * p.lambda_s * p.lambda_z,
+        // plates not yet there start where they touch the tube
+        Control::Plates(_) => p.rho.unwrap_or(p.lambda_s),
+    }
+}
+
+/// M = ϖ × the enclosed volume per unit reference length over πR² of a state: ϖ ρ(2λs − ρ)λz
+/// in contact, ϖ λs² λz free (λz = 1 under PS, as the state has it).
+fn gas_of(p: &TimePoint) -> f64 {
+    if p.chi > 0.0 {
+        let rho = p.rho.unwrap_or(p.lambda_s);
+        p.w * rho * (2.0 * p.lambda_s - rho) * p.lambda_z
+    } else {
+        p.w * p.lambda_s * p.lambda_s * p.lambda_z
     }
 }
 
@@ -219,6 +120,7 @@ fn check_program(segments: &[Segment]) -> Result<(), GpsError> {
             "a load program needs at least one segment",
         ));
     }
+    let mut plates = false;
     for s in segments {
         if !(s.duration.is_finite() && s.duration >= 0.0) {
             return Err(crate::invalid(
@@ -229,14 +131,14 @@ fn check_program(segments: &[Segment]) -> Result<(), GpsError> {
         }
         if let Some(t) = s.target {
             let ok = match s.control {
-                Control::Pressure => t.is_finite() && t > 0.0,
+                Control::Pressure | Control::Plates(_) => t.is_finite() && t > 0.0,
                 Control::Stretch | Control::Volume => t.is_finite() && t >= 1.0,
             };
             if !ok {
                 return Err(crate::invalid(
                     "target",
                     t,
-                    "a target pressure must be finite and > 0, a target stretch or volume ≥ 1",
+                    "a target pressure or half-gap must be finite and > 0, a target stretch or volume ≥ 1",
                 ));
             }
         } else if s.duration == 0.0 {
@@ -246,12 +148,21 @@ fn check_program(segments: &[Segment]) -> Result<(), GpsError> {
                 "a hold needs a duration > 0",
             ));
         }
+        match s.control {
+            Control::Plates(_) => plates = true,
+            _ if plates => return Err(crate::invalid(
+                "control",
+                f64::NAN,
+                "after a plates segment the plates stay: every later segment moves or holds them",
+            )),
+            _ => {}
+        }
     }
-    if segments[0].target.is_none() {
+    if segments[0].target.is_none() || matches!(segments[0].control, Control::Plates(_)) {
         return Err(crate::invalid(
             "target",
             f64::NAN,
-            "the first segment loads the unloaded tube: give its target",
+            "the first segment inflates the unloaded tube: give its pressure, stretch or volume target",
         ));
     }
     Ok(())
@@ -282,11 +193,20 @@ pub fn integrate(
         lambda_z: 1.0,
         n_s: 0.0,
         n_z: 0.0,
+        rho: None,
+        chi: 0.0,
+        force: 0.0,
     };
     let mut points = vec![p];
     for (k, seg) in segments.iter().enumerate() {
         let from = controlled(&p, seg.control);
         let to = seg.target.unwrap_or(from);
+        // what fixes the pressure in the segment's plates steps, set at its start
+        let supply = match seg.control {
+            Control::Plates(Supply::Pressure) => Some(Fix::Pressure(p.w)),
+            Control::Plates(Supply::Gas) => Some(Fix::Gas(gas_of(&p))),
+            _ => None,
+        };
         let (n, dt) = if seg.duration == 0.0 {
             (1, 0.0)
         } else {
@@ -304,22 +224,42 @@ pub fn integrate(
                 alpha: step.alpha,
                 b: hist.offset(&step),
             };
-            let s = eqs.solve(seg.control, value, [p.lambda_s, p.lambda_z], &at)?;
+            let guess = [p.lambda_s, p.lambda_z];
+            let (s, rho) = match (seg.control, supply) {
+                (Control::Plates(_), Some(fix)) => {
+                    // in contact if the free tube would be wider than the gap
+                    let free = eqs.solve(None, fix, guess, &at);
+                    match free {
+                        Ok(f) if f.ls <= value => (f, Some(value)),
+                        _ => (eqs.solve(Some(value), fix, guess, &at)?, Some(value)),
+                    }
+                }
+                (Control::Pressure, _) => {
+                    (eqs.solve(None, Fix::Pressure(value), guess, &at)?, None)
+                }
+                (Control::Stretch, _) => (eqs.solve(None, Fix::Stretch(value), guess, &at)?, None),
+                (Control::Volume, _) => (eqs.solve(None, Fix::Volume(value), guess, &at)?, None),
+                (Control::Plates(_), None) => unreachable!("a plates segment has its supply"),
+            };
             let r = law
                 .principal(s.ls, s.lz)
                 .map_err(|source| GpsError::Material {
-                    stage: "viscoelastic inflation (eqs. 66 in time)",
+                    stage: "viscoelastic section in time",
                     at: at.clone(),
                     source,
                 })?;
             hist = hist.advanced(&step, [r.grad[0] / s.ls, r.grad[1] / s.lz, 0.0]);
+            let chi = rho.map_or(0.0, |rho| (s.ls - rho).max(0.0));
             p = TimePoint {
                 time,
-                w: s.ns / s.ls,
+                w: s.w,
                 lambda_s: s.ls,
                 lambda_z: s.lz,
                 n_s: s.ns,
                 n_z: s.nz,
+                rho,
+                chi,
+                force: s.w * chi,
             };
             points.push(p);
         }
@@ -374,8 +314,9 @@ pub fn inflation_history(
                     .abs()
                     .max((a.lambda_s - b.lambda_s).abs())
                     .max((a.lambda_z - b.lambda_z).abs())
+                    .max((a.force - b.force).abs())
             })
-            .fold(0.0, f64::max)
+            .fold((loop_area(&coarse) - loop_area(&fine)).abs(), f64::max)
             / (2f64.powi(ORDER) - 1.0);
         n *= 2;
         if est <= tolerance {
@@ -387,4 +328,18 @@ pub fn inflation_history(
         }
         coarse = fine;
     }
+}
+
+/// The work the plates do on the tube, per plate and unit length, over the steps with plates:
+/// ∫ force d(−ρ) in πμHR (trapezoids between consecutive steps; the step where the plates
+/// arrive starts from first contact, ρ = λs, with no force). Over a squeeze and a release back
+/// to first contact it is the force–gap loop's area, the energy the law dissipated.
+pub fn loop_area(points: &[TimePoint]) -> f64 {
+    points
+        .windows(2)
+        .filter_map(|q| {
+            let a = q[0].rho.unwrap_or(q[0].lambda_s);
+            q[1].rho.map(|b| 0.5 * (q[0].force + q[1].force) * (a - b))
+        })
+        .sum()
 }
