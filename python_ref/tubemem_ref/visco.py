@@ -25,38 +25,42 @@ from scipy import integrate, optimize
 from .closed_form import resultants
 
 
-def _section(law, hyp, q, control, value, guess):
-    """(ls, lz, w, ns, nz) of the section with relaxed stresses q = (sum q_s, sum q_z)."""
+def _solve(f, guess, n):
+    sol = optimize.root(f, guess[:n], tol=1e-15)
+    return sol.x
+
+
+def _section(law, hyp, q, fix, value, rho, guess):
+    """(ls, lz, w, ns, nz) of the section with relaxed stresses q = (sum q_s, sum q_z): free
+    (rho None) or between plates at +-rho; fix: "pressure" (w = value), "gas" (w times the
+    enclosed volume per unit reference length over pi R^2 = value), "stretch", "volume"."""
     qs, qz = q
 
     def n(ls, lz):
         n0s, n0z = resultants(ls, lz, law)
         return n0s - ls / lz * qs, n0z - lz / ls * qz
 
-    if control == "pressure":
-        if hyp == "ps":
-            f = lambda x: [n(x[0], 1.0)[0] - value * x[0]]
-            ls = optimize.root(f, [guess[0]], tol=1e-15).x[0]
-            lz = 1.0
+    def eqs(ls, lz):
+        ns, nz = n(ls, lz)
+        if rho is None:
+            w = ns / ls
+            vol = ls * ls * lz
+            axial = ns - 2 * nz
         else:
-            def f(x):
-                ns, nz = n(x[0], x[1])
-                return [ns - value * x[0], ns - 2 * nz]
-            ls, lz = optimize.root(f, guess, tol=1e-15).x
-    elif control == "volume":
-        if hyp == "ps":
-            ls, lz = np.sqrt(value), 1.0
-        else:
-            def f(x):
-                ls_ = np.sqrt(value / x[0])
-                ns, nz = n(ls_, x[0])
-                return [ns - 2 * nz]
-            lz = optimize.root(f, [guess[1]], tol=1e-15).x[0]
-            ls = np.sqrt(value / lz)
+            w = ns / rho
+            vol = rho * (2 * ls - rho) * lz
+            axial = ns * (2 * ls - rho) / (2 * ls) - nz
+        first = {"pressure": lambda: w - value, "gas": lambda: w * vol / value - 1.0,
+                 "stretch": lambda: ls - value, "volume": lambda: ls * ls * lz - value}[fix]()
+        return first, axial
+
+    if hyp == "ps":
+        ls = _solve(lambda x: [eqs(x[0], 1.0)[0]], guess, 1)[0]
+        lz = 1.0
     else:
-        raise ValueError(control)
+        ls, lz = _solve(lambda x: list(eqs(x[0], x[1])), guess, 2)
     ns, nz = n(ls, lz)
-    return ls, lz, ns / ls, ns, nz
+    return ls, lz, ns / (ls if rho is None else rho), ns, nz
 
 
 def _s0(law, ls, lz):
@@ -64,41 +68,78 @@ def _s0(law, ls, lz):
     return n0s * lz / ls, n0z * ls / lz
 
 
-def history(law, prony, hyp, control, to, ramp, hold, times, rtol=1e-12, atol=1e-14):
-    """The states (t, w, ls, lz) at `times` of a ramp of `control` ("pressure" or "volume") from
-    the unloaded tube to `to` over `ramp` (0: a jump), then held for `hold`.
-    prony: [(g, tau), ...]."""
+def program(law, prony, hyp, segments, times, rtol=1e-12, atol=1e-14):
+    """The states (t, w, ls, lz, rho, force) at `times` under `segments`, a list of
+    (control, target, duration): control "pressure", "stretch" or "volume" (the free tube) or
+    "plates-gas" / "plates-pressure" (plates y = +-rho R from first contact, the gas closed or
+    the pressure held at the segment's start); target None holds; duration 0 jumps. Also the
+    plates' work over the program, the integral of force d(-rho) (scipy quad on the dense
+    solution)."""
     gs = np.array([g for g, _ in prony])
     taus = np.array([t for _, t in prony])
-    start = 0.0 if control == "pressure" else 1.0
-    value = lambda t: to if ramp == 0 or t >= ramp else start + (to - start) * t / ramp
-    guess = [1.0, 1.0]
-
-    def state(t, y):
-        q = y.reshape(len(gs), 2).sum(axis=0)
-        s = _section(law, hyp, q, control, value(t), guess)
-        guess[0], guess[1] = s[0], s[1]
-        return s
-
-    def rhs(t, y):
-        ls, lz = state(t, y)[:2]
-        s0 = np.array(_s0(law, ls, lz))
-        yy = y.reshape(len(gs), 2)
-        return ((gs[:, None] * s0[None, :] - yy) / taus[:, None]).ravel()
-
     y = np.zeros(2 * len(gs))
-    out = {}
-    pieces = ([(0.0, ramp)] if ramp > 0 else []) + ([(ramp, ramp + hold)] if hold > 0 else [])
-    if ramp == 0:
-        # the jump: q = 0 (no time to relax), the base law's state at the target
-        guess[:] = [1.2, 1.0]
-    for a, b in pieces:
-        ts = sorted(t for t in times if a <= t <= b)
-        sol = integrate.solve_ivp(rhs, (a, b), y, method="DOP853", rtol=rtol, atol=atol,
-                                  dense_output=True)
-        assert sol.success, sol.message
-        for t in ts:
-            ls, lz, w, _, _ = state(t, sol.sol(t))
-            out[t] = (w, ls, lz)
-        y = sol.y[:, -1]
-    return [(t, *out[t]) for t in sorted(out)]
+    st = {"t": 0.0, "w": 0.0, "ls": 1.0, "lz": 1.0, "rho": None, "chi": 0.0}
+    guess = [1.0, 1.0]
+    out, work = {}, 0.0
+
+    def at(t, y, ctl, value_of, fixval):
+        q = y.reshape(len(gs), 2).sum(axis=0)
+        if ctl.startswith("plates"):
+            rho = value_of(t)
+            fix = "gas" if ctl == "plates-gas" else "pressure"
+            free = _section(law, hyp, q, fix, fixval, None, guess)
+            s = free if free[0] <= rho else _section(law, hyp, q, fix, fixval, rho, guess)
+            guess[0], guess[1] = s[0], s[1]
+            return (*s, rho, max(s[0] - rho, 0.0))
+        s = _section(law, hyp, q, ctl, value_of(t), None, guess)
+        guess[0], guess[1] = s[0], s[1]
+        return (*s, None, 0.0)
+
+    for ctl, target, duration in segments:
+        t0 = st["t"]
+        start = {"pressure": st["w"], "stretch": st["ls"], "volume": st["ls"] ** 2 * st["lz"]}.get(
+            ctl, st["rho"] if st["rho"] is not None else st["ls"])
+        end = start if target is None else target
+        value_of = (lambda t, a=start, b=end, t0=t0, d=duration:
+                    b if d == 0 else a + (b - a) * (t - t0) / d)
+        fixval = None
+        if ctl == "plates-pressure":
+            fixval = st["w"]
+        elif ctl == "plates-gas":
+            r = st["rho"]
+            fixval = (st["w"] * r * (2 * st["ls"] - r) * st["lz"] if st["chi"] > 0
+                      else st["w"] * st["ls"] ** 2 * st["lz"])
+        if duration == 0:
+            ls, lz, w, _, _, rho, chi = at(t0, y, ctl, value_of, fixval)
+            # a jump: no time to relax, q unchanged
+        else:
+            rhs = lambda t, yy: ((gs[:, None] * np.array(_s0(law, *at(t, yy, ctl, value_of, fixval)[:2]))[None, :]
+                                  - yy.reshape(len(gs), 2)) / taus[:, None]).ravel()
+            sol = integrate.solve_ivp(rhs, (t0, t0 + duration), y, method="DOP853", rtol=rtol,
+                                      atol=atol, dense_output=True)
+            assert sol.success, sol.message
+            for t in times:
+                if t0 < t <= t0 + duration:
+                    ls_, lz_, w_, _, _, rho_, chi_ = at(t, sol.sol(t), ctl, value_of, fixval)
+                    out[t] = (w_, ls_, lz_, rho_, w_ * chi_)
+            if ctl.startswith("plates") and start != end:
+                speed = (end - start) / duration
+                f = lambda t: at(t, sol.sol(t), ctl, value_of, fixval)
+                force = lambda t: f(t)[2] * f(t)[6]
+                work += -speed * integrate.quad(force, t0, t0 + duration, epsabs=1e-14, epsrel=1e-12,
+                                                limit=400)[0]
+            y = sol.y[:, -1]
+            ls, lz, w, _, _, rho, chi = at(t0 + duration, y, ctl, value_of, fixval)
+        st = {"t": t0 + duration, "w": w, "ls": ls, "lz": lz, "rho": rho, "chi": chi}
+        if duration == 0 and t0 in times:
+            out[t0] = (w, ls, lz, rho, w * chi)
+    return [(t, *out[t]) for t in sorted(out)], work
+
+
+def history(law, prony, hyp, control, to, ramp, hold, times, rtol=1e-12, atol=1e-14):
+    """The states (t, w, ls, lz) at `times` of a ramp of `control` ("pressure", "stretch" or
+    "volume") from the unloaded tube to `to` over `ramp` (0: a jump), then held for `hold`.
+    prony: [(g, tau), ...]."""
+    segs = [(control, to, ramp)] + ([(control, None, hold)] if hold > 0 else [])
+    rows, _ = program(law, prony, hyp, segs, times, rtol, atol)
+    return [(t, w, ls, lz) for t, w, ls, lz, _, _ in rows]
