@@ -59,6 +59,111 @@ pub struct TestData {
     pub stress: Vec<f64>,
 }
 
+/// One test history (issue #63): times, stretches and nominal stresses of a uniaxial or
+/// equibiaxial test under any loading (a relaxation, a loading–unloading at a rate), fitted by
+/// a QLV Prony law ([`crate::viscoelastic::nominal_history`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HistoryData {
+    /// what the test is called in messages and the per-test residuals (its file)
+    pub name: String,
+    pub mode: Mode,
+    pub time: Vec<f64>,
+    pub stretch: Vec<f64>,
+    pub stress: Vec<f64>,
+}
+
+/// How well the fitted law reproduces one test.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TestResidual {
+    pub name: String,
+    pub points: usize,
+    /// √(Σr²/m) over the test's points, in the stress's units
+    pub rms: f64,
+    /// the largest |P_model − P_data| over the test's largest |P_data|
+    pub max_relative: f64,
+}
+
+/// The data a fit reproduces: stress–stretch points of elastic tests, or histories.
+#[derive(Clone, Copy)]
+enum Data<'a> {
+    Points(&'a [TestData]),
+    Histories(&'a [HistoryData]),
+}
+
+impl Data<'_> {
+    fn count(&self) -> usize {
+        match self {
+            Data::Points(d) => d.iter().map(|t| t.stretch.len()).sum(),
+            Data::Histories(d) => d.iter().map(|t| t.stretch.len()).sum(),
+        }
+    }
+    fn stresses(&self) -> Vec<f64> {
+        match self {
+            Data::Points(d) => d.iter().flat_map(|t| t.stress.iter().copied()).collect(),
+            Data::Histories(d) => d.iter().flat_map(|t| t.stress.iter().copied()).collect(),
+        }
+    }
+    /// (name, points) of each test, in the residuals' order
+    fn tests(&self) -> Vec<(String, usize, f64)> {
+        let top = |s: &[f64]| s.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        match self {
+            Data::Points(d) => d
+                .iter()
+                .map(|t| (t.mode.label().to_string(), t.stretch.len(), top(&t.stress)))
+                .collect(),
+            Data::Histories(d) => d
+                .iter()
+                .map(|t| (t.name.clone(), t.stretch.len(), top(&t.stress)))
+                .collect(),
+        }
+    }
+    /// P_model − P_data at every point, or the first point the law cannot take (its test, its
+    /// stretch and the law's reason).
+    fn residuals(
+        &self,
+        law: &dyn MembraneLaw,
+        prony: Option<&crate::viscoelastic::Prony>,
+    ) -> Result<Vec<f64>, String> {
+        let mut r = vec![];
+        match (self, prony) {
+            (Data::Points(d), _) => {
+                for t in d.iter() {
+                    for (&l, &p) in t.stretch.iter().zip(&t.stress) {
+                        let at = |what: String| {
+                            format!(
+                                "the {} point at stretch {}: {what}",
+                                t.mode.label(),
+                                crate::Num(l)
+                            )
+                        };
+                        let m = nominal_stress(law, t.mode, l).map_err(|e| at(e.to_string()))?;
+                        if !m.is_finite() {
+                            return Err(at(format!("the law's stress is {m}")));
+                        }
+                        r.push(m - p);
+                    }
+                }
+            }
+            (Data::Histories(d), Some(prony)) => {
+                for t in d.iter() {
+                    let eq = t.mode == Mode::Equibiaxial;
+                    let m =
+                        crate::viscoelastic::nominal_history(law, prony, eq, &t.time, &t.stretch)
+                            .map_err(|e| format!("the history {}: {e}", t.name))?;
+                    for (m, p) in m.iter().zip(&t.stress) {
+                        if !m.is_finite() {
+                            return Err(format!("the history {}: the law's stress is {m}", t.name));
+                        }
+                        r.push(m - p);
+                    }
+                }
+            }
+            (Data::Histories(_), None) => return Err("histories need a Prony series".into()),
+        }
+        Ok(r)
+    }
+}
+
 /// Why a fit could not be made (a fit that converges poorly is a result, with warnings).
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
@@ -128,6 +233,12 @@ pub struct FitResult {
     pub free_parameters: usize,
     /// what the user should know: undetermined parameters, a fit that did not converge
     pub warnings: Vec<String>,
+    /// the fitted Prony series of a fit to histories
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prony: Option<Vec<crate::viscoelastic::PronyTerm>>,
+    /// how well each test is reproduced
+    #[serde(default)]
+    pub tests: Vec<TestResidual>,
 }
 
 /// A fit whose largest residual is at most this fraction of the data's largest stress
@@ -229,6 +340,21 @@ fn parameter_paths(v: &Value) -> Vec<(String, Vec<PathStep>)> {
                                 vec![PathStep::Key(k.clone()), PathStep::Index(i)],
                             ));
                         }
+                        // a table in the array (a Prony term): `prony[0].g`
+                        if let Value::Object(o) = y {
+                            for (j, z) in o {
+                                if z.is_number() {
+                                    out.push((
+                                        format!("{k}[{i}].{j}"),
+                                        vec![
+                                            PathStep::Key(k.clone()),
+                                            PathStep::Index(i),
+                                            PathStep::Key(j.clone()),
+                                        ],
+                                    ));
+                                }
+                            }
+                        }
                     }
                 }
                 Value::Object(p) => {
@@ -321,7 +447,7 @@ impl Bound {
 struct Problem<'a> {
     template: Value,
     paths: Vec<Vec<PathStep>>,
-    data: &'a [TestData],
+    data: Data<'a>,
     bounds: Vec<Bound>,
     x: DVector<f64>,
     /// the residual of a refused trial: large and finite
@@ -329,26 +455,28 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
-    fn spec_at(&self, x: &[f64]) -> Option<MaterialSpec> {
+    /// The law's table and, for histories, its Prony series at `x`.
+    fn model_at(&self, x: &[f64]) -> Option<(MaterialSpec, Option<crate::viscoelastic::Prony>)> {
         let mut v = self.template.clone();
         for (p, &val) in self.paths.iter().zip(x) {
             *slot(&mut v, p)? = serde_json::Number::from_f64(val).map(Value::Number)?;
         }
-        serde_json::from_value(v).ok()
+        split_prony(v).ok()
+    }
+    fn spec_at(&self, x: &[f64]) -> Option<MaterialSpec> {
+        self.model_at(x).map(|m| m.0)
+    }
+    fn evaluate(&self, x: &[f64]) -> Result<Vec<f64>, String> {
+        let (spec, prony) = self
+            .model_at(x)
+            .ok_or_else(|| "the parameters are not numbers a law takes".to_string())?;
+        let law = spec
+            .build()
+            .map_err(|e| format!("the parameters make no law: {e}"))?;
+        self.data.residuals(law.as_ref(), prony.as_ref())
     }
     fn residuals_at(&self, x: &[f64]) -> Option<Vec<f64>> {
-        let law = self.spec_at(x)?.build().ok()?;
-        let mut r = vec![];
-        for t in self.data {
-            for (&l, &p) in t.stretch.iter().zip(&t.stress) {
-                let m = nominal_stress(law.as_ref(), t.mode, l).ok()?;
-                if !m.is_finite() {
-                    return None;
-                }
-                r.push(m - p);
-            }
-        }
-        Some(r)
+        self.evaluate(x).ok()
     }
     /// Why [`Self::residuals_at`] has no value at `x`: the parameters, and the first data
     /// point the law cannot take, with the law's own reason.
@@ -359,38 +487,13 @@ impl Problem<'_> {
             .map(|(n, v)| format!("{n} = {}", crate::Num(*v)))
             .collect();
         let at = params.join(", ");
-        let Some(spec) = self.spec_at(x) else {
-            return format!("the parameters ({at}) are not numbers a law takes");
-        };
-        let law = match spec.build() {
-            Ok(l) => l,
-            Err(e) => return format!("the parameters ({at}) make no law: {e}"),
-        };
-        for t in self.data {
-            for &l in &t.stretch {
-                match nominal_stress(law.as_ref(), t.mode, l) {
-                    Err(e) => {
-                        return format!(
-                            "with {at}, the {} point at stretch {}: {e}",
-                            t.mode.label(),
-                            crate::Num(l)
-                        )
-                    }
-                    Ok(m) if !m.is_finite() => {
-                        return format!(
-                            "with {at}, the {} point at stretch {}: the law's stress is {m}",
-                            t.mode.label(),
-                            crate::Num(l)
-                        )
-                    }
-                    Ok(_) => {}
-                }
-            }
+        match self.evaluate(x) {
+            Err(e) => format!("with {at}, {e}"),
+            Ok(_) => format!("with {at}: no point fails (please report this input)"),
         }
-        format!("with {at}: no point fails (please report this input)")
     }
     fn count(&self) -> usize {
-        self.data.iter().map(|t| t.stretch.len()).sum()
+        self.data.count()
     }
     /// Differences of the residuals in each parameter: central, with steps of 1e-6 of the
     /// parameter (of the largest parameter where it is 0); one-sided where the law refuses one
@@ -503,6 +606,56 @@ fn check_data(data: &[TestData], n: usize) -> Result<(), FitError> {
     Ok(())
 }
 
+/// Check histories: each with points, equal lengths, finite values, stretches > 0, times not
+/// decreasing; uniaxial or equibiaxial; more points than parameters overall.
+fn check_histories(data: &[HistoryData], n: usize) -> Result<(), FitError> {
+    if data.is_empty() {
+        return Err(FitError::Data("no test histories".into()));
+    }
+    let mut m = 0;
+    for t in data {
+        let what = &t.name;
+        if t.mode == Mode::PureShear {
+            return Err(FitError::Data(format!(
+                "{what}: a history must be uniaxial or equibiaxial"
+            )));
+        }
+        if t.stretch.len() != t.stress.len() || t.time.len() != t.stress.len() {
+            return Err(FitError::Data(format!(
+                "{what}: {} times, {} stretches and {} stresses",
+                t.time.len(),
+                t.stretch.len(),
+                t.stress.len()
+            )));
+        }
+        if t.stretch.is_empty() {
+            return Err(FitError::Data(format!("{what}: no data points")));
+        }
+        for i in 0..t.time.len() {
+            let (tt, l, p) = (t.time[i], t.stretch[i], t.stress[i]);
+            let row = i + 1;
+            if !(tt.is_finite() && l.is_finite() && l > 0.0 && p.is_finite()) {
+                return Err(FitError::Data(format!(
+                    "{what}, point {row}: time {tt}, stretch {l}, stress {p}: each must be a finite number, the stretch > 0"
+                )));
+            }
+            if i > 0 && tt < t.time[i - 1] {
+                return Err(FitError::Data(format!(
+                    "{what}, point {row}: the time {tt} is before the previous point's {}",
+                    t.time[i - 1]
+                )));
+            }
+        }
+        m += t.stretch.len();
+    }
+    if m <= n {
+        return Err(FitError::Data(format!(
+            "{m} data points for {n} parameters: a fit needs more points than parameters"
+        )));
+    }
+    Ok(())
+}
+
 /// Fit `start`'s numbers to `data` ([`FitOptions::default`]: every number free, unbounded
 /// but by the law's own ranges, [`DEFAULT_STARTS`] starts).
 pub fn fit(start: &MaterialSpec, data: &[TestData]) -> Result<FitResult, FitError> {
@@ -539,11 +692,67 @@ pub fn fit_with(
     data: &[TestData],
     opts: &FitOptions,
 ) -> Result<FitResult, FitError> {
+    let template = serde_json::to_value(start).map_err(|e| {
+        FitError::Data(format!(
+            "the starting law cannot be written as a table: {e}"
+        ))
+    })?;
+    fit_data(template, Data::Points(data), opts)
+}
+
+/// Fit `start`'s numbers and the Prony series `prony` (each term's `g` and `tau`, named
+/// `prony[i].g`, `prony[i].tau`; bounded to (0, 1) and (0, ∞) unless `opts` bounds them) to
+/// test histories, holding `opts.fixed`, as [`fit_with`] (issue #63).
+pub fn fit_histories_with(
+    start: &MaterialSpec,
+    prony: &[crate::viscoelastic::PronyTerm],
+    data: &[HistoryData],
+    opts: &FitOptions,
+) -> Result<FitResult, FitError> {
     let mut template = serde_json::to_value(start).map_err(|e| {
         FitError::Data(format!(
             "the starting law cannot be written as a table: {e}"
         ))
     })?;
+    if let Value::Object(m) = &mut template {
+        m.insert(
+            "prony".into(),
+            serde_json::to_value(prony).map_err(|e| FitError::Data(e.to_string()))?,
+        );
+    }
+    let mut opts = opts.clone();
+    for i in 0..prony.len() {
+        for (key, range) in [("g", (0.0, 1.0)), ("tau", (0.0, f64::INFINITY))] {
+            let name = format!("prony[{i}].{key}");
+            if !opts.fixed.contains_key(&name) {
+                opts.bounds.entry(name).or_insert(range);
+            }
+        }
+    }
+    fit_data(template, Data::Histories(data), &opts)
+}
+
+/// The law's table and the Prony series of a template: its `prony` key, if any, taken out.
+fn split_prony(mut v: Value) -> Result<(MaterialSpec, Option<crate::viscoelastic::Prony>), String> {
+    let prony = v.as_object_mut().and_then(|m| m.remove("prony"));
+    let spec: MaterialSpec = serde_json::from_value(v).map_err(|e| e.to_string())?;
+    let prony = match prony {
+        None => None,
+        Some(p) => {
+            let terms: Vec<crate::viscoelastic::PronyTerm> =
+                serde_json::from_value(p).map_err(|e| e.to_string())?;
+            Some(crate::viscoelastic::Prony::new(terms).map_err(|e| e.to_string())?)
+        }
+    };
+    Ok((spec, prony))
+}
+
+fn fit_data(mut template: Value, data: Data<'_>, opts: &FitOptions) -> Result<FitResult, FitError> {
+    let model = template
+        .get("model")
+        .and_then(|m| m.as_str())
+        .unwrap_or("?")
+        .to_string();
     let named = parameter_paths(&template);
     if named.is_empty() {
         return Err(FitError::NoParameters);
@@ -552,7 +761,7 @@ pub fn fit_with(
     let unknown = |what: &str, n: &str| {
         FitError::Data(format!(
             "{what} `{n}`: the {} law has no parameter `{n}`; its parameters are {}",
-            start.model(),
+            model,
             names.join(", ")
         ))
     };
@@ -587,7 +796,7 @@ pub fn fit_with(
             )));
         }
     }
-    let spec0: MaterialSpec = serde_json::from_value(template.clone())
+    let (spec0, _) = split_prony(template.clone())
         .map_err(|e| FitError::Data(format!("the fixed values do not make a law: {e}")))?;
     spec0.build().map_err(FitError::Start)?;
     let free: Vec<usize> = (0..named.len())
@@ -599,7 +808,10 @@ pub fn fit_with(
         ));
     }
     let n = free.len();
-    check_data(data, n)?;
+    match data {
+        Data::Points(d) => check_data(d, n)?,
+        Data::Histories(d) => check_histories(d, n)?,
+    }
     let mut v = template.clone();
     let x_all: Vec<f64> = named
         .iter()
@@ -623,8 +835,8 @@ pub fn fit_with(
         .map(|(&k, b)| x_all[k].clamp(b.lo, b.hi))
         .collect();
     let scale = data
+        .stresses()
         .iter()
-        .flat_map(|t| t.stress.iter())
         .fold(0.0f64, |a, &p| a.max(p.abs()))
         .max(f64::MIN_POSITIVE);
     let mut problem = Problem {
@@ -791,7 +1003,26 @@ pub fn fit_with(
             p.name
         ));
     }
+    let prony = problem
+        .model_at(&x)
+        .and_then(|m| m.1)
+        .map(|p| p.terms().to_vec());
+    let mut tests = vec![];
+    let mut at = 0;
+    for (name, count, top) in data.tests() {
+        let rt = &r[at..at + count];
+        at += count;
+        tests.push(TestResidual {
+            name,
+            points: count,
+            rms: (rt.iter().map(|v| v * v).sum::<f64>() / count as f64).sqrt(),
+            max_relative: rt.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+                / top.max(f64::MIN_POSITIVE),
+        });
+    }
     Ok(FitResult {
+        prony,
+        tests,
         spec,
         parameters,
         correlation: corr,
@@ -826,11 +1057,7 @@ fn starts_of(problem: &Problem, x0: &[f64], names: &[&str], more: usize) -> Vec<
     // the data-scaled start
     let s = problem.residuals_at(x0).and_then(|r| {
         // r = P_model − P_data, so P_model = r + P_data
-        let p: Vec<f64> = problem
-            .data
-            .iter()
-            .flat_map(|t| t.stress.iter().copied())
-            .collect();
+        let p: Vec<f64> = problem.data.stresses();
         let (pm_pd, pm_pm) = r.iter().zip(&p).fold((0.0, 0.0), |(a, b), (r, pd)| {
             let pm = r + pd;
             (a + pm * pd, b + pm * pm)

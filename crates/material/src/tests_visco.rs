@@ -167,3 +167,135 @@ fn the_step_tangent_matches_finite_differences() {
         }
     }
 }
+
+/// The material point's uniaxial history: a jump to λ held, the stress relaxes exactly as
+/// G(t) times the base law's nominal stress (the width does not change: S₂ = G S⁰₂ = 0 at the
+/// same width), to 1e-12; elastic limits of a slow and a fast ramp: `fit::nominal_stress` of
+/// the base law and of g∞ × it (the long-term law) to 1e-3 and 1e-4 (ramps over 1e5 τ₂ and
+/// 1e-6 τ₁, 400 steps: the residual memory is of order τ/T).
+#[test]
+fn a_uniaxial_history_relaxes_with_g_and_has_both_elastic_limits() {
+    use crate::fit::{nominal_stress, Mode};
+    use crate::viscoelastic::nominal_history;
+    let p = two_terms();
+    let law = AnssariBenamBucchi::new(2.0, 30.0).unwrap();
+    let l = 2.5;
+    let times = [0.0, 0.0, 0.5, 3.0, 20.0, 100.0];
+    let stretch = [1.0, l, l, l, l, l];
+    let s = nominal_history(&law, &p, false, &times, &stretch).unwrap();
+    let elastic = nominal_stress(&law, Mode::Uniaxial, l).unwrap();
+    for (k, &t) in times.iter().enumerate().skip(1) {
+        assert!(
+            (s[k] / (p.relaxation(t) * elastic) - 1.0).abs() < 1e-12,
+            "t = {t}: {} vs {}",
+            s[k],
+            p.relaxation(t) * elastic
+        );
+    }
+    let ramp = |total: f64| {
+        let n = 400;
+        let t: Vec<f64> = (0..=n).map(|i| total * i as f64 / n as f64).collect();
+        let st: Vec<f64> = (0..=n)
+            .map(|i| 1.0 + (l - 1.0) * i as f64 / n as f64)
+            .collect();
+        *nominal_history(&law, &p, false, &t, &st)
+            .unwrap()
+            .last()
+            .unwrap()
+    };
+    let fast = ramp(1e-6);
+    assert!(
+        (fast / elastic - 1.0).abs() < 1e-4,
+        "fast {fast} vs {elastic}"
+    );
+    let slow = ramp(1e6);
+    assert!(
+        (slow / (p.g_infinity() * elastic) - 1.0).abs() < 1e-3,
+        "slow {slow} vs {}",
+        p.g_infinity() * elastic
+    );
+    // equibiaxial: the jump gives the base law's equibiaxial stress
+    let e = nominal_history(&law, &p, true, &[0.0, 0.0], &[1.0, 1.8]).unwrap()[1];
+    let eb = nominal_stress(&law, Mode::Equibiaxial, 1.8).unwrap();
+    assert!((e / eb - 1.0).abs() < 1e-12, "{e} vs {eb}");
+}
+
+/// The history fit (`fit::fit_histories_with`) recovers a known QLV law from its own
+/// noise-free histories: a relaxation (ramp to λ = 3 in 2, held to 60) and a loading–unloading
+/// at a rate (λ 1 → 2.5 → 1 over 20), Gent-free ABB μ = 2, 𝒩 = 30 (fixed) with g = (0.3, 0.2),
+/// τ = (1, 10), from a start off by factors of 2: every parameter to 1e-6 relative (the terms
+/// up to their order)
+/// (exact data: the residual is round-off, the minimum is the truth), the per-test residuals
+/// listed, the fit converged.
+#[test]
+fn a_history_fit_recovers_a_known_viscoelastic_law() {
+    use crate::fit::{fit_histories_with, FitOptions, HistoryData, Mode};
+    use crate::viscoelastic::nominal_history;
+    use crate::MaterialSpec;
+    let truth: MaterialSpec =
+        serde_json::from_str(r#"{"model":"abb","shear_modulus":2.0,"kuhn":30.0}"#).unwrap();
+    let law = truth.build().unwrap();
+    let p = two_terms();
+    let mut data = vec![];
+    let relax_t: Vec<f64> = (0..=120).map(|i| 0.5 * i as f64).collect();
+    let relax_l: Vec<f64> = relax_t
+        .iter()
+        .map(|&t| if t < 2.0 { 1.0 + t } else { 3.0 })
+        .collect();
+    let cyc_t: Vec<f64> = (0..=80).map(|i| 0.25 * i as f64).collect();
+    let cyc_l: Vec<f64> = cyc_t
+        .iter()
+        .map(|&t| {
+            if t <= 10.0 {
+                1.0 + 0.15 * t
+            } else {
+                2.5 - 0.15 * (t - 10.0)
+            }
+        })
+        .collect();
+    for (name, t, l) in [("relaxation", relax_t, relax_l), ("cycle", cyc_t, cyc_l)] {
+        let stress = nominal_history(law.as_ref(), &p, false, &t, &l).unwrap();
+        data.push(HistoryData {
+            name: name.into(),
+            mode: Mode::Uniaxial,
+            time: t,
+            stretch: l,
+            stress,
+        });
+    }
+    let start: MaterialSpec =
+        serde_json::from_str(r#"{"model":"abb","shear_modulus":1.0,"kuhn":30.0}"#).unwrap();
+    let prony0 = [
+        PronyTerm { g: 0.15, tau: 0.5 },
+        PronyTerm { g: 0.4, tau: 20.0 },
+    ];
+    let mut opts = FitOptions::default();
+    opts.fixed.insert("kuhn".into(), 30.0);
+    let r = fit_histories_with(&start, &prony0, &data, &opts).unwrap();
+    assert!(r.converged, "{}", r.stop_reason);
+    let got = |n: &str| r.parameters.iter().find(|q| q.name == n).unwrap().value;
+    assert!((got("shear_modulus") / 2.0 - 1.0).abs() < 1e-6);
+    // the terms are found up to their order: compare them sorted by τ
+    let mut terms: Vec<(f64, f64)> = (0..2)
+        .map(|i| {
+            (
+                got(&format!("prony[{i}].tau")),
+                got(&format!("prony[{i}].g")),
+            )
+        })
+        .collect();
+    terms.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for ((tau, g), (t0, g0)) in terms.iter().zip([(1.0, 0.3), (10.0, 0.2)]) {
+        assert!(
+            (tau / t0 - 1.0).abs() < 1e-6 && (g / g0 - 1.0).abs() < 1e-6,
+            "{terms:?}"
+        );
+    }
+    assert_eq!(r.tests.len(), 2);
+    assert!(
+        r.tests.iter().all(|t| t.max_relative < 1e-8),
+        "{:?}",
+        r.tests
+    );
+    assert_eq!(r.prony.as_ref().map(|p| p.len()), Some(2));
+}

@@ -192,3 +192,68 @@ pub fn step_stress_tangent(
         tangent: base.tangent.map(|row| row.map(|v| step.alpha * v)),
     })
 }
+
+/// A material point's nominal stress P₁ = μ λ₁ S₁ (force per reference area, in the law's
+/// modulus units) along a history of stretches λ₁(tₖ) in a uniaxial test (the width free:
+/// S₂ = 0 at every step, solved by Newton for λ₂) or an equibiaxial one (λ₂ = λ₁), the membrane
+/// in plane stress through the law's incompressibility. The point starts unloaded at t₀; each
+/// interval is one step of [`Prony::step`] (exact for S⁰ linear in time; a zero interval is a
+/// jump). `equibiaxial` false: uniaxial.
+pub fn nominal_history(
+    law: &dyn MembraneLaw,
+    prony: &Prony,
+    equibiaxial: bool,
+    time: &[f64],
+    stretch: &[f64],
+) -> Result<Vec<f64>, MaterialError> {
+    let mu = law.shear_modulus();
+    let mut hist = History::unloaded(prony.terms().len());
+    let mut out = Vec::with_capacity(time.len());
+    let mut l2 = 1.0;
+    let mut t_prev = time.first().copied().unwrap_or(0.0);
+    for (&t, &l1) in time.iter().zip(stretch) {
+        let step = prony.step((t - t_prev).max(0.0));
+        t_prev = t;
+        let b = hist.offset(&step);
+        if equibiaxial {
+            l2 = l1;
+        } else {
+            // S₂ = α grad₂/λ₂ + B₂ = 0 in λ₂, from the last width (or λ₁^−½ at the start)
+            if out.is_empty() {
+                l2 = 1.0 / l1.sqrt();
+            }
+            let mut converged = false;
+            for _ in 0..60 {
+                let p = law.principal(l1, l2)?;
+                let f = step.alpha * p.grad[1] / l2 + b[1];
+                let df = step.alpha * (p.hess[1][1] / l2 - p.grad[1] / (l2 * l2));
+                let mut d = -f / df;
+                if !d.is_finite() {
+                    break;
+                }
+                // keep the width positive
+                while l2 + d <= 0.0 {
+                    d *= 0.5;
+                }
+                l2 += d;
+                if d.abs() <= 1e-14 * l2 {
+                    converged = true;
+                    break;
+                }
+            }
+            if !converged {
+                return Err(MaterialError::InvalidState {
+                    what: "uniaxial width λ₂ (S₂ = 0 not reached)",
+                    value: l2,
+                    requirement: "Newton must converge on the free width at every step",
+                });
+            }
+        }
+        let p = law.principal(l1, l2)?;
+        let s0 = [p.grad[0] / l1, p.grad[1] / l2, 0.0];
+        let s1 = step.alpha * s0[0] + b[0];
+        hist = hist.advanced(&step, s0);
+        out.push(mu * l1 * s1);
+    }
+    Ok(out)
+}
