@@ -34,6 +34,7 @@ pub mod edge_track;
 pub mod export;
 pub mod figures;
 pub mod fit;
+pub mod fit_history;
 mod journal;
 pub mod main_job;
 pub mod model_setup;

@@ -27,6 +27,19 @@ pub struct FitArgs {
     /// Pure-shear (planar tension) test: CSV as --uniaxial.
     #[arg(long)]
     pub pure_shear: Option<PathBuf>,
+    /// A uniaxial test history (repeatable): CSV with a header naming `time` (or `time_s`, in
+    /// seconds), `stretch` and `nominal_stress_UNIT` (or `force`, proportional to it, unit
+    /// unknown). With histories the law is viscoelastic: the base law and a Prony series are
+    /// fitted together.
+    #[arg(long, value_name = "CSV")]
+    pub history: Vec<PathBuf>,
+    /// The Prony series' start for --history, as g:τ pairs (τ in seconds), e.g. 0.3:1,0.2:30.
+    #[arg(long)]
+    pub prony: Option<String>,
+    /// Without --prony: this many Prony terms, their τ spread by decades over the data's
+    /// time scales.
+    #[arg(long, default_value_t = 3)]
+    pub prony_terms: usize,
     /// The stresses' unit where the headers name none: Pa, kPa, MPa, GPa or psi. With a unit
     /// the fit works in Pa and prints the table for a case in SI.
     #[arg(long, value_name = "UNIT")]
@@ -52,7 +65,7 @@ pub struct FitArgs {
 }
 
 /// `NAME=VALUE` of --fix.
-fn fixed(s: &str) -> Result<(String, f64)> {
+pub(crate) fn fixed(s: &str) -> Result<(String, f64)> {
     let (n, v) = s
         .split_once('=')
         .with_context(|| format!("--fix {s}: give NAME=VALUE, e.g. --fix c30=0"))?;
@@ -66,7 +79,7 @@ fn fixed(s: &str) -> Result<(String, f64)> {
 }
 
 /// `NAME=LOW:HIGH` of --bound.
-fn bounded(s: &str) -> Result<(String, (f64, f64))> {
+pub(crate) fn bounded(s: &str) -> Result<(String, (f64, f64))> {
     let parse = |t: &str| -> Option<f64> {
         match t.trim() {
             "-inf" => Some(f64::NEG_INFINITY),
@@ -87,6 +100,12 @@ fn bounded(s: &str) -> Result<(String, (f64, f64))> {
 }
 
 pub fn run(a: FitArgs) -> Result<()> {
+    if !a.history.is_empty() {
+        return crate::fit_history_cmd::run(a);
+    }
+    if a.prony.is_some() {
+        bail!("--prony is the start of a viscoelastic fit: give --history files");
+    }
     let unit: Option<StressUnit> = match &a.stress_unit {
         None => None,
         Some(u) => Some(

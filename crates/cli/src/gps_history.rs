@@ -324,15 +324,14 @@ pub fn run(a: HistoryArgs) -> Result<()> {
                 .unwrap_or_default()
         )?;
         if let Some(rho) = last.rho {
-            let si = units
-                .is_si()
-                .then(|| {
-                    format!(
-                        " ({:.6e} N/m)",
-                        units.from_core(Dimension::ForcePerLength, last.force)
-                    )
-                })
-                .unwrap_or_default();
+            let si = if units.is_si() {
+                format!(
+                    " ({:.6e} N/m)",
+                    units.from_core(Dimension::ForcePerLength, last.force)
+                )
+            } else {
+                String::new()
+            };
             crate::say!(
                 "  plates at ρ = {rho:.6} R: χ = {:.9}, force ϖχ = {:.9} πμH per unit length{si}",
                 last.chi,
@@ -341,22 +340,21 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         }
         if release_from.is_some() {
             let area = loop_area(&h.points);
-            let si = units
-                .is_si()
-                .then(|| {
-                    format!(
-                        " ({:.6e} J/m)",
-                        units.from_core(Dimension::Force, std::f64::consts::PI * area)
-                    )
-                })
-                .unwrap_or_default();
+            let si = if units.is_si() {
+                format!(
+                    " ({:.6e} J/m)",
+                    units.from_core(Dimension::Force, std::f64::consts::PI * area)
+                )
+            } else {
+                String::new()
+            };
             crate::say!(
                 "  force–gap loop: the plates did {area:.6e} πμHR{si} of work per plate and unit length over the cycle (dissipated)"
             )?;
         }
         if units.is_si() {
             crate::say!(
-                "  pressure {} Pa",
+                "  pressure {:.6e} Pa",
                 units.from_core(Dimension::Pressure, last.w)
             )?;
         }
