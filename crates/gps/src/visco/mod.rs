@@ -3,7 +3,7 @@
 //! (Sec. 3.2). Every point of the section has the same stretch history (N_s is uniform around
 //! the section at every instant, frictionless plates or none), so the section stays uniform and
 //! eqs. (66) (free) or (76)–(77) (between plates) hold at every instant with the hereditary
-//! stress of the step ([`step`]).
+//! stress of the step (the private module `step`).
 //!
 //! A load program is a list of segments, each ramping its control linearly in time to a target
 //! (or holding it) over a duration (0: a jump, taken with Δt = 0, the instantaneous response):
