@@ -1,4 +1,4 @@
-"""`tubemem gps history` (the recursive QLV update with step doubling to a Richardson estimate
+"""`tubemem gps history` (the recursive QLV update with step doubling to an error estimate
 of 1e-10) against the independent DAE integration of tubemem_ref.visco (scipy DOP853 in the
 relaxed stresses, rtol 1e-12). Bound 1e-8 relative, the issue's: the Rust side's own error is
 at most 1e-10 by its estimate, the scipy side's changes by less than 1e-9 from rtol 1e-10 to
@@ -73,7 +73,7 @@ CYCLES = [
 @pytest.mark.parametrize("supply,hyp", CYCLES)
 def test_squeeze_hold_release_matches_the_independent_dae(tubemem_exe, tmp_path, supply, hyp):
     """States to 1e-8 as the free histories (measured at most 1.1e-10); the loop's area to 1e-6
-    relative: Rust's Richardson estimate bounds its error by 1e-10 absolute, 1.7e-7 of the
+    relative: Rust's error estimate bounds its error by 1e-10 absolute, 1.7e-7 of the
     smallest area here (6.1e-4); measured 1.8e-8 to 7.0e-8."""
     import subprocess
 

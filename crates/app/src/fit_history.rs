@@ -241,14 +241,18 @@ pub fn save_history_figure(
         .map_err(|e| FitError::Figure(Box::new(e)))
 }
 
-/// The fitted Prony series as a case file's `[material.viscoelastic]` table (τ in seconds).
+/// The fitted Prony series as `tubemem gps history --prony` takes it (τ in seconds), and as
+/// the `[material.viscoelastic]` table the FE's case files are to take (issue #63; `tubemem
+/// run` does not read it yet, which the comment says).
 pub fn prony_table(terms: &[PronyTerm]) -> String {
+    let pairs: Vec<String> = terms.iter().map(|t| format!("{:?}:{:?}", t.g, t.tau)).collect();
     let items: Vec<String> = terms
         .iter()
         .map(|t| format!("{{ g = {:?}, tau = {:?} }}", t.g, t.tau))
         .collect();
     format!(
-        "[material.viscoelastic]   # tau in seconds\nprony = [{}]\n",
+        "# the Prony series (tau in seconds): `tubemem gps history --prony {}`\n# the FE in time (issue #63) is to read it as below; `tubemem run` does not yet\n# [material.viscoelastic]\n# prony = [{}]\n",
+        pairs.join(","),
         items.join(", ")
     )
 }

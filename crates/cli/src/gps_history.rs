@@ -87,9 +87,13 @@ pub struct HistoryArgs {
     #[arg(long)]
     release: bool,
     /// The largest error in ϖ, λs, λz and the force the time steps may leave (their
-    /// Richardson estimate).
+    /// estimate, the difference between the last two step counts).
     #[arg(long, default_value_t = 1e-10)]
     tolerance: f64,
+    /// Instead of --tolerance: exactly this many equal steps per segment, no error estimate
+    /// (for measuring the integration's order).
+    #[arg(long)]
+    steps: Option<usize>,
     /// Write every step to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -216,14 +220,16 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         })
         .map_err(|e| anyhow::anyhow!(e.chain()))?;
     }
-    let h = inflation_history(
-        law.as_ref(),
-        &prony,
-        hyp,
-        &program,
-        16,
-        a.tolerance,
-    )
+    let h = match a.steps {
+        Some(n) => tubemem_gps::visco::integrate(law.as_ref(), &prony, hyp, &program, n).map(
+            |points| tubemem_gps::visco::TimeHistory {
+                points,
+                steps_per_segment: n,
+                error_estimate: f64::NAN,
+            },
+        ),
+        None => inflation_history(law.as_ref(), &prony, hyp, &program, 16, a.tolerance),
+    }
     .map_err(|e| {
         let e = anyhow::anyhow!(e).context("the viscoelastic inflation");
         // under a pressure the likely cause is the pressure maximum: name it and its
@@ -290,7 +296,11 @@ pub fn run(a: HistoryArgs) -> Result<()> {
     add_si(&mut v, &units);
     if let Some(map) = v.as_object_mut() {
         map.insert("steps_per_segment".into(), h.steps_per_segment.into());
-        map.insert("error_estimate".into(), h.error_estimate.into());
+        // fixed steps (--steps): no estimate (null, not NaN)
+        map.insert(
+            "error_estimate".into(),
+            Some(h.error_estimate).filter(|e| e.is_finite()).into(),
+        );
         map.insert("g_infinity".into(), prony.g_infinity().into());
         if let Some(area) = release_from.map(|_| loop_area(&h.points)) {
             map.insert("loop_area".into(), area.into());
@@ -308,7 +318,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         crate::say!("{v}")?;
     } else {
         crate::say!(
-            "{} viscoelastic tube ({} Prony terms, g∞ = {}): at t = {} (the Prony series' time unit) ϖ = {:.9}, λs = {:.9}, λz = {:.9} ({} steps per segment, time-step error ≤ {:.1e}){}",
+            "{} viscoelastic tube ({} Prony terms, g∞ = {}): at t = {} (the Prony series' time unit) ϖ = {:.9}, λs = {:.9}, λz = {:.9} ({} steps per segment, {}){}",
             a.hypothesis_label(),
             prony.terms().len(),
             prony.g_infinity(),
@@ -317,7 +327,11 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             last.lambda_s,
             last.lambda_z,
             h.steps_per_segment,
-            h.error_estimate,
+            if h.error_estimate.is_finite() {
+                format!("time-step error ≤ {:.1e}", h.error_estimate)
+            } else {
+                "fixed steps: no error estimate".to_string()
+            },
             a.csv
                 .as_ref()
                 .map(|c| format!("; wrote {} states to {}", h.points.len(), c.display()))

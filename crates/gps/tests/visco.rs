@@ -128,7 +128,7 @@ fn relaxation_at_fixed_volume_follows_the_relaxation_function() {
 
 /// A ramped creep (ϖ 0 → 0.3 over one τ₁, held 20 τ₁): the error against a 2^14-step run falls
 /// as Δt² (observed order within 0.1 of 2 between 32, 64 and 128 steps per segment), and
-/// `inflation_history`'s Richardson estimate is honest: the true error of the history it
+/// `inflation_history`'s estimate is honest: the true error of the history it
 /// returns is below 2 × its estimate and at most the tolerance asked, 1e-9.
 #[test]
 fn the_history_converges_at_second_order_and_its_estimate_is_honest() {
