@@ -506,7 +506,16 @@ pub fn run(cmd: GpsCommand) -> Result<()> {
             ("pressure", "--pressure"),
             ("points", "--points"),
         ],
-        GpsCommand::Limits(_) | GpsCommand::History(_) => &[],
+        GpsCommand::History(_) => &[
+            ("ramp", "--ramp"),
+            ("hold", "--hold"),
+            ("squeeze_time", "--squeeze-time"),
+            ("plates_hold", "--plates-hold"),
+            ("target", "--to"),
+            ("steps", "--steps"),
+            ("tolerance", "--tolerance"),
+        ],
+        GpsCommand::Limits(_) => &[],
     };
     run_command(cmd).map_err(|e| flagged(e, names))
 }

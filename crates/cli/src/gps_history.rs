@@ -8,7 +8,8 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use tubemem_app::units::Dimension;
-use tubemem_gps::visco::{inflation_history, loop_area, Control, Segment, Supply};
+use tubemem_gps::visco::cycle::{run_cycle, Cycle, PlatesLeg, Steps};
+use tubemem_gps::visco::{Control, Supply};
 use tubemem_material::viscoelastic::{Prony, PronyTerm};
 
 /// The header of `gps history --csv` (dimensionless columns; SI ones follow with --radius).
@@ -140,73 +141,30 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         Control::Pressure => units.to_core(Dimension::Pressure, a.to),
         _ => a.to,
     };
-    for (flag, v) in [
-        ("--ramp", a.ramp),
-        ("--hold", a.hold),
-        ("--squeeze-time", a.squeeze_time),
-        ("--plates-hold", a.plates_hold),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            bail!("{flag} = {v}: a duration must be finite and ≥ 0");
-        }
-    }
-    let hyp = a.hypothesis.into();
-    let mut program = vec![Segment {
-        control,
-        target: Some(to),
-        duration: a.ramp,
-    }];
-    if a.hold > 0.0 {
-        program.push(Segment {
-            control,
-            target: None,
-            duration: a.hold,
-        });
-    }
     if a.plates_to.is_none() && (a.release || a.squeeze_time > 0.0 || a.plates_hold > 0.0) {
         bail!("--squeeze-time, --plates-hold and --release move plates: give --plates-to ρ");
     }
-    let mut release_from = None;
-    if let Some(rho) = a.plates_to {
-        let supply = match a.supply {
-            PlateSupply::Gas => Supply::Gas,
-            PlateSupply::Pressure => Supply::Pressure,
-        };
-        let plates = Control::Plates(supply);
-        // where the plates first touch: the inflated λs (to the history's tolerance)
-        let first = inflation_history(law.as_ref(), &prony, hyp, &program, 16, a.tolerance)
-            .map_err(|e| {
-                anyhow::anyhow!(e).context("the viscoelastic inflation before the plates")
-            })?;
-        let touch = first
-            .points
-            .last()
-            .expect("a history has its start")
-            .lambda_s;
-        if !(rho.is_finite() && rho > 0.0 && rho < touch) {
-            bail!("--plates-to {rho}: the plates close from first contact at ρ = {touch:.6} (the inflated λs): give 0 < ρ < {touch:.6}");
-        }
-        program.push(Segment {
-            control: plates,
-            target: Some(rho),
-            duration: a.squeeze_time,
-        });
-        if a.plates_hold > 0.0 {
-            program.push(Segment {
-                control: plates,
-                target: None,
-                duration: a.plates_hold,
-            });
-        }
-        if a.release {
-            release_from = Some(program.len());
-            program.push(Segment {
-                control: plates,
-                target: Some(touch),
-                duration: a.squeeze_time,
-            });
-        }
-    }
+    let hyp = a.hypothesis.into();
+    let cycle = Cycle {
+        control,
+        to,
+        ramp: a.ramp,
+        hold: a.hold,
+        plates: a.plates_to.map(|rho| PlatesLeg {
+            supply: match a.supply {
+                PlateSupply::Gas => Supply::Gas,
+                PlateSupply::Pressure => Supply::Pressure,
+            },
+            to: rho,
+            travel: a.squeeze_time,
+            hold: a.plates_hold,
+            release: a.release,
+        }),
+    };
+    let steps = match a.steps {
+        Some(n) => Steps::Fixed(n),
+        None => Steps::Tolerance(a.tolerance),
+    };
     if let Some(csv) = &a.csv {
         let law_file = a
             .material
@@ -220,16 +178,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         })
         .map_err(|e| anyhow::anyhow!(e.chain()))?;
     }
-    let h = match a.steps {
-        Some(n) => tubemem_gps::visco::integrate(law.as_ref(), &prony, hyp, &program, n).map(
-            |points| tubemem_gps::visco::TimeHistory {
-                points,
-                steps_per_segment: n,
-                error_estimate: f64::NAN,
-            },
-        ),
-        None => inflation_history(law.as_ref(), &prony, hyp, &program, 16, a.tolerance),
-    }
+    let result = run_cycle(law.as_ref(), &prony, hyp, &cycle, steps)
     .map_err(|e| {
         let e = anyhow::anyhow!(e).context("the viscoelastic inflation");
         // under a pressure the likely cause is the pressure maximum: name it and its
@@ -251,6 +200,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             None => e,
         }
     })?;
+    let h = &result.history;
     let last = *h.points.last().expect("a history has its start");
     if let Some(csv) = &a.csv {
         let si = units.is_si();
@@ -302,7 +252,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             Some(h.error_estimate).filter(|e| e.is_finite()).into(),
         );
         map.insert("g_infinity".into(), prony.g_infinity().into());
-        if let Some(area) = release_from.map(|_| loop_area(&h.points)) {
+        if let Some(area) = result.loop_area {
             map.insert("loop_area".into(), area.into());
             if units.is_si() {
                 map.insert(
@@ -352,8 +302,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
                 last.force
             )?;
         }
-        if release_from.is_some() {
-            let area = loop_area(&h.points);
+        if let Some(area) = result.loop_area {
             let si = if units.is_si() {
                 format!(
                     " ({:.6e} J/m)",

@@ -20,6 +20,10 @@ pub enum GpsError {
         #[source]
         source: MaterialError,
     },
+    /// Plates asked to close to a half-gap not inside the tube they start from (a viscoelastic
+    /// cycle's plates start where they touch the inflated tube, ρ = λs).
+    #[error("the plates close from first contact at ρ = {touch:.6} (the inflated λs) to ρ = {}: give 0 < ρ < {touch:.6}", tubemem_material::Num(*rho))]
+    PlatesOutside { rho: f64, touch: f64 },
     /// A set of walls that cannot hold the section (open, empty, too short a perimeter).
     #[error("{message}")]
     Walls { message: String },

@@ -19,6 +19,7 @@
 //! whole difference, which bounds the finer history's error for any order of at least 1
 //! (the Richardson estimate |y_n − y_2n|/(2^p − 1) would assume p).
 
+pub mod cycle;
 mod step;
 
 use crate::{GpsError, Hypothesis};
