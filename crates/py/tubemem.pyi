@@ -2,7 +2,7 @@
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Callable, Iterator, Literal, Mapping, Optional, Union
+from typing import Any, Callable, Iterator, Literal, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -79,6 +79,27 @@ def gps_section_at_pressure(
     """The GPS cross-section at half-gap rho under a given pressure w (eq. 76, no gas law)."""
 
 def gps_limits(material: MaterialLike = None, hypothesis: str = "gps") -> dict[str, Any]: ...
+def gps_history(
+    prony: Sequence[tuple[float, float]],
+    control: str,
+    to: float,
+    ramp: float = 0.0,
+    hold: float = 0.0,
+    material: MaterialLike = None,
+    hypothesis: str = "gps",
+    *,
+    plates_to: float | None = None,
+    squeeze_time: float = 0.0,
+    plates_hold: float = 0.0,
+    release: bool = False,
+    supply: str = "gas",
+    tolerance: float = 1e-10,
+    steps: int | None = None,
+) -> dict[str, Any]:
+    """The GPS section in time with a QLV Prony law (issue #63): a ramp and hold of the
+    pressure, stretch or volume, then plates closing, held and released. Keys: history,
+    plates (Tables), touch, loop_area, error_estimate, steps_per_segment, g_infinity."""
+
 def resultants(l1: float, l2: float, material: MaterialLike = None) -> tuple[float, float]:
     """Cauchy resultants (N1, N2)/(μH) at principal stretches (eq. 18)."""
 

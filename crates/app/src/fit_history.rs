@@ -245,7 +245,10 @@ pub fn save_history_figure(
 /// the `[material.viscoelastic]` table the FE's case files are to take (issue #63; `tubemem
 /// run` does not read it yet, which the comment says).
 pub fn prony_table(terms: &[PronyTerm]) -> String {
-    let pairs: Vec<String> = terms.iter().map(|t| format!("{:?}:{:?}", t.g, t.tau)).collect();
+    let pairs: Vec<String> = terms
+        .iter()
+        .map(|t| format!("{:?}:{:?}", t.g, t.tau))
+        .collect();
     let items: Vec<String> = terms
         .iter()
         .map(|t| format!("{{ g = {:?}, tau = {:?} }}", t.g, t.tau))

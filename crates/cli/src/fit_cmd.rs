@@ -65,7 +65,7 @@ pub struct FitArgs {
 }
 
 /// `NAME=VALUE` of --fix.
-pub(crate) fn fixed(s: &str) -> Result<(String, f64)> {
+fn fixed(s: &str) -> Result<(String, f64)> {
     let (n, v) = s
         .split_once('=')
         .with_context(|| format!("--fix {s}: give NAME=VALUE, e.g. --fix c30=0"))?;
@@ -79,7 +79,7 @@ pub(crate) fn fixed(s: &str) -> Result<(String, f64)> {
 }
 
 /// `NAME=LOW:HIGH` of --bound.
-pub(crate) fn bounded(s: &str) -> Result<(String, (f64, f64))> {
+fn bounded(s: &str) -> Result<(String, (f64, f64))> {
     let parse = |t: &str| -> Option<f64> {
         match t.trim() {
             "-inf" => Some(f64::NEG_INFINITY),
@@ -101,7 +101,26 @@ pub(crate) fn bounded(s: &str) -> Result<(String, (f64, f64))> {
 
 pub fn run(a: FitArgs) -> Result<()> {
     if !a.history.is_empty() {
-        return crate::fit_history_cmd::run(a);
+        if a.uniaxial.is_some() || a.equibiaxial.is_some() || a.pure_shear.is_some() {
+            bail!("--history fits a viscoelastic law to histories; --uniaxial, --equibiaxial and --pure-shear fit an elastic law to curves: give one kind");
+        }
+        if a.stress_unit.is_some() {
+            bail!("--stress-unit: a history names its stress's unit in its header (`nominal_stress_kpa`), or gives a `force` of unknown unit");
+        }
+        return crate::fit_history_cmd::run(crate::fit_history_cmd::HistoryFit {
+            law: &a.law,
+            history: &a.history,
+            prony: a.prony.as_deref(),
+            prony_terms: a.prony_terms,
+            opts: FitOptions {
+                fixed: a.fix.iter().map(|s| fixed(s)).collect::<Result<_>>()?,
+                bounds: a.bound.iter().map(|s| bounded(s)).collect::<Result<_>>()?,
+                starts: a.starts,
+            },
+            plot: a.plot.as_deref(),
+            overwrite: a.overwrite,
+            json: a.json,
+        });
     }
     if a.prony.is_some() {
         bail!("--prony is the start of a viscoelastic fit: give --history files");

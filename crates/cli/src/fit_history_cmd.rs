@@ -1,20 +1,28 @@
 //! `tubemem fit --history …`: a viscoelastic (QLV Prony) law from test histories (issue #63).
 
-use crate::fit_cmd::FitArgs;
 use anyhow::{bail, Result};
+use std::path::{Path, PathBuf};
 use tubemem_app::fit::default_start;
 use tubemem_app::fit_history::{
     default_prony, prony_table, read_history_file, run_fit_histories, save_history_figure,
 };
 use tubemem_material::fit::{FitOptions, Mode, TestData};
 
-pub fn run(a: FitArgs) -> Result<()> {
-    if a.uniaxial.is_some() || a.equibiaxial.is_some() || a.pure_shear.is_some() {
-        bail!("--history fits a viscoelastic law to histories; --uniaxial, --equibiaxial and --pure-shear fit an elastic law to curves: give one kind");
-    }
-    if a.stress_unit.is_some() {
-        bail!("--stress-unit: a history names its stress's unit in its header (`nominal_stress_kpa`), or gives a `force` of unknown unit");
-    }
+/// What `tubemem fit --history` was given (`fit_cmd` checks the rest of its flags).
+pub struct HistoryFit<'a> {
+    /// a model name, a material table or a TOML file (as `--law`)
+    pub law: &'a str,
+    pub history: &'a [PathBuf],
+    /// `--prony` g:τ pairs
+    pub prony: Option<&'a str>,
+    pub prony_terms: usize,
+    pub opts: FitOptions,
+    pub plot: Option<&'a Path>,
+    pub overwrite: bool,
+    pub json: bool,
+}
+
+pub fn run(a: HistoryFit) -> Result<()> {
     if !(1..=tubemem_material::viscoelastic::MAX_TERMS).contains(&a.prony_terms) {
         bail!(
             "--prony-terms {}: give 1 to {}",
@@ -23,7 +31,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         );
     }
     // the figure's files checked before anything is read
-    if let Some(stem) = &a.plot {
+    if let Some(stem) = a.plot {
         let inputs: Vec<&std::path::Path> = a.history.iter().map(|p| p.as_path()).collect();
         let ours = |t: &str| t.starts_with("<svg") && t.contains("Prony terms to");
         let svg_ours = std::fs::read_to_string(stem.with_extension("svg")).is_ok_and(|t| ours(&t));
@@ -51,7 +59,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     let data: Vec<_> = files.into_iter().map(|f| f.data).collect();
     let table = a.law.contains('=') || a.law.ends_with(".toml");
     let start = if table {
-        crate::material_args::law_of(&a.law)?
+        crate::material_args::law_of(a.law)?
     } else {
         // the elastic start from each history's loading points (stretch and stress until the
         // largest stretch): the instantaneous law's scale
@@ -72,30 +80,17 @@ pub fn run(a: FitArgs) -> Result<()> {
             .collect();
         default_start(a.law.trim(), &loading)?
     };
-    let prony0 = match &a.prony {
+    let prony0 = match a.prony {
         Some(p) => crate::gps_history::parse_prony(p)?.terms().to_vec(),
         None => default_prony(&data, a.prony_terms),
     };
-    let opts = FitOptions {
-        fixed: a
-            .fix
-            .iter()
-            .map(|s| crate::fit_cmd::fixed(s))
-            .collect::<Result<_>>()?,
-        bounds: a
-            .bound
-            .iter()
-            .map(|s| crate::fit_cmd::bounded(s))
-            .collect::<Result<_>>()?,
-        starts: a.starts,
-    };
-    let result = run_fit_histories(&start, &prony0, &data, &opts)?;
+    let result = run_fit_histories(&start, &prony0, &data, &a.opts)?;
     let unit_name = if proportional {
         "(force)"
     } else {
         unit.unwrap_or("(data)")
     };
-    if let Some(stem) = &a.plot {
+    if let Some(stem) = a.plot {
         let y = if proportional {
             "force (proportional to the nominal stress; unit not stated)".to_string()
         } else {

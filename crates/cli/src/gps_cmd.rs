@@ -1,7 +1,7 @@
 //! `tubemem gps …` and the default job.
-use crate::material_args::{add_si, MaterialArgs, UnitArgs};
+use crate::material_args::{add_si, Hyp, MaterialArgs, UnitArgs};
 use anyhow::{bail, Result};
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use serde::Serialize;
 use std::path::PathBuf;
 use tubemem_app::curves::{
@@ -50,23 +50,6 @@ const CONFINE_HEADER: &str = "scale,w,lambda_s,lambda_z,n_s,n_z,r,area,regime";
 
 /// The title of `gps confine --figure`.
 const SECTION_TITLE: &str = "Confined cross-section (GPS closed form, eqs. 55–60)";
-
-#[derive(Copy, Clone, Debug, ValueEnum)]
-pub enum Hyp {
-    /// generalized plane strain (λz from the end-cap balance)
-    Gps,
-    /// plane strain (λz = 1)
-    Ps,
-}
-
-impl From<Hyp> for Hypothesis {
-    fn from(h: Hyp) -> Self {
-        match h {
-            Hyp::Gps => Hypothesis::Gps,
-            Hyp::Ps => Hypothesis::Ps,
-        }
-    }
-}
 
 #[derive(Subcommand, Debug)]
 pub enum GpsCommand {

@@ -52,7 +52,7 @@ pub struct HistoryArgs {
     #[command(flatten)]
     units: UnitArgs,
     #[arg(long, value_enum, default_value = "gps")]
-    hypothesis: crate::gps_cmd::Hyp,
+    hypothesis: crate::material_args::Hyp,
     /// The Prony series as g:τ pairs separated by commas, e.g. 0.3:1,0.2:10 (τ in the time
     /// unit of --ramp and --hold; g∞ = 1 − Σ g > 0; the base law's modulus is the
     /// instantaneous one)

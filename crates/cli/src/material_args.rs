@@ -196,3 +196,21 @@ impl OptionalMaterialArgs {
         }
     }
 }
+
+/// `--hypothesis` of the `gps` commands.
+#[derive(Copy, Clone, Debug, ValueEnum)]
+pub enum Hyp {
+    /// generalized plane strain (λz from the end-cap balance)
+    Gps,
+    /// plane strain (λz = 1)
+    Ps,
+}
+
+impl From<Hyp> for tubemem_gps::Hypothesis {
+    fn from(h: Hyp) -> Self {
+        match h {
+            Hyp::Gps => tubemem_gps::Hypothesis::Gps,
+            Hyp::Ps => tubemem_gps::Hypothesis::Ps,
+        }
+    }
+}

@@ -24,7 +24,8 @@ pub(crate) fn gps_err(e: GpsError) -> PyErr {
         | GpsError::Walls { .. }
         | GpsError::Unstable { .. }
         | GpsError::Snaps { .. }
-        | GpsError::NoContact { .. } => PyValueError::new_err(msg),
+        | GpsError::NoContact { .. }
+        | GpsError::PlatesOutside { .. } => PyValueError::new_err(msg),
         // a material parameter out of range, or a stretch asked for beyond the locking limit,
         // is bad input
         GpsError::Material {

@@ -18,6 +18,7 @@ mod case;
 mod convert;
 mod errors;
 mod gps;
+mod gps_history;
 mod material;
 mod outcome;
 mod progress;
@@ -38,7 +39,8 @@ use pyo3::prelude::*;
 ///
 /// Closed form: gps_inflate, gps_flatten (numbers → dict; numpy arrays → Table),
 /// gps_inflation_curve, gps_flattening_curve (→ Table), gps_section_at_pressure, gps_limits,
-/// gps_between_plates, gps_critical_pressure (the regulated squeeze, issue #62),
+/// gps_between_plates, gps_critical_pressure (the regulated squeeze, issue #62), gps_history
+/// (a viscoelastic law in time, issue #63),
 /// resultants. A Table is named numpy columns: t["w"], t.columns, t.to_pandas().
 /// FE runs: run (a case as path, TOML text or dict → Run: steps and profiles as Tables),
 /// run_case, run_case_text (→ the summary dict), default_case; progress= a callable, "tqdm" or
@@ -63,6 +65,7 @@ fn tubemem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gps::gps_section_at_pressure, m)?)?;
     m.add_function(wrap_pyfunction!(gps::gps_limits, m)?)?;
     m.add_function(wrap_pyfunction!(gps::resultants, m)?)?;
+    m.add_function(wrap_pyfunction!(gps_history::gps_history, m)?)?;
     m.add_function(wrap_pyfunction!(run::run_case, m)?)?;
     m.add_function(wrap_pyfunction!(run::run_case_text, m)?)?;
     m.add_function(wrap_pyfunction!(run::default_case, m)?)?;

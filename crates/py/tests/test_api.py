@@ -912,3 +912,40 @@ def test_atlas_errors_name_the_key(tmp_path):
     with pytest.raises(ValueError, match="length"):
         tubemem.atlas(bad, tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+def test_gps_history_matches_the_independent_dae_and_refuses_bad_input():
+    """Issue #63: a squeeze-hold-release cycle from Python against tubemem_ref.visco (scipy
+    DOP853 on the relaxed stresses; the bound 1e-8 of python_ref/tests/test_visco_vs_rust.py,
+    the loop's area 1e-6); the free and plate steps in separate Tables (no NaN for a gap
+    before the plates come); bad input is a ValueError naming the key."""
+    from tubemem_ref import visco
+
+    prony = [(0.3, 1.0), (0.2, 10.0)]
+    r = tubemem.gps_history(prony, "stretch", 1.3, hold=200.0, material=ABB30, plates_to=1.0,
+                            squeeze_time=3.0, plates_hold=5.0, release=True)
+    assert r["error_estimate"] <= 1e-10 and r["touch"] == pytest.approx(1.3, abs=1e-12)
+    free, plates = r["history"], r["plates"]
+    assert "rho" not in free.columns and not np.isnan(plates["rho"]).any()
+    times = [201.125, 203.0, 205.5, 209.5]
+    ref, work = visco.program(("abb", 30.0), prony, "gps", [
+        ("stretch", 1.3, 0.0), ("stretch", None, 200.0), ("plates-gas", 1.0, 3.0),
+        ("plates-gas", None, 5.0), ("plates-gas", 1.3, 3.0)], times)
+    t = np.asarray(plates["time"])
+    for tt, w, ls, lz, rho, force in ref:
+        i = int(np.argmin(abs(t - tt)))
+        assert abs(t[i] - tt) < 1e-12 * tt
+        for key, v in [("w", w), ("lambda_s", ls), ("lambda_z", lz), ("force", force)]:
+            assert abs(plates[key][i] / v - 1) < 1e-8, (tt, key)
+    assert abs(r["loop_area"] / work - 1) < 1e-6
+    # a creep without plates: the plates Table is None, and g_infinity is reported
+    c = tubemem.gps_history(prony, "pressure", 0.3, ramp=1.0, hold=20.0, material=ABB30)
+    assert c["plates"] is None and c["loop_area"] is None and c["g_infinity"] == pytest.approx(0.5)
+    for kwargs, words in [
+        (dict(prony=[(0.6, 1.0), (0.5, 2.0)], control="pressure", to=0.3), "g∞"),
+        (dict(prony=prony, control="plates", to=0.3), "control"),
+        (dict(prony=prony, control="stretch", to=1.3, plates_to=1.5), "first contact"),
+        (dict(prony=prony, control="stretch", to=1.3, squeeze_time=2.0), "plates_to"),
+    ]:
+        with pytest.raises(ValueError, match=words):
+            tubemem.gps_history(material=ABB30, **kwargs)
