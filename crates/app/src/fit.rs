@@ -108,6 +108,46 @@ fn excerpt(line: &str) -> String {
     }
 }
 
+/// A data file's lines as the fits read them: the header (its index from 0, its text and its
+/// lower-case column names) and the data rows (index, text); blank and `#` lines skipped.
+pub(crate) struct CsvLines {
+    pub header_line: usize,
+    pub header: String,
+    pub names: Vec<String>,
+    pub rows: Vec<(usize, String)>,
+}
+
+/// Read `path` (at most [`tubemem_mesh::io::MAX_TEXT_INPUT_BYTES`]) into [`CsvLines`].
+pub(crate) fn csv_lines(path: &Path) -> Result<CsvLines, FitError> {
+    let text = tubemem_mesh::io::read_text_limited(path, tubemem_mesh::io::MAX_TEXT_INPUT_BYTES)
+        .map_err(|source| FitError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let mut rows = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .map(|(k, l)| (k, l.to_string()));
+    let Some((h, header)) = rows.next() else {
+        return Err(FitError::Data {
+            path: path.to_path_buf(),
+            line: 1,
+            message: "the file has no header and no data".into(),
+        });
+    };
+    let names = header
+        .split(',')
+        .map(|c| c.trim().to_ascii_lowercase())
+        .collect();
+    Ok(CsvLines {
+        header_line: h,
+        header,
+        names,
+        rows: rows.collect(),
+    })
+}
+
 /// Read a test's CSV file: a header naming a `stretch` and a stress column (with its unit),
 /// then rows. `unit` states the stress unit where the header names none (`--stress-unit`).
 pub fn read_test_file(
@@ -115,27 +155,17 @@ pub fn read_test_file(
     mode: Mode,
     unit: Option<StressUnit>,
 ) -> Result<TestFile, FitError> {
-    let text = tubemem_mesh::io::read_text_limited(path, tubemem_mesh::io::MAX_TEXT_INPUT_BYTES)
-        .map_err(|source| FitError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+    let CsvLines {
+        header_line: h,
+        header,
+        names,
+        rows,
+    } = csv_lines(path)?;
     let err = |line: usize, message: String| FitError::Data {
         path: path.to_path_buf(),
         line,
         message,
     };
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some((h, header)) = rows.next() else {
-        return Err(err(1, "the file has no header and no data".into()));
-    };
-    let names: Vec<String> = header
-        .split(',')
-        .map(|c| c.trim().to_ascii_lowercase())
-        .collect();
     let stretch_col = names
         .iter()
         .position(|c| c.starts_with("stretch") || c.starts_with("lambda"));
@@ -147,7 +177,7 @@ pub fn read_test_file(
             h + 1,
             format!(
                 "the header `{}` must name a `stretch` column and a `nominal_stress` (or `stress`) column, with the stress's unit as a suffix, e.g. `stretch,nominal_stress_mpa` (a file without a header is refused: its first row would be taken for one)",
-                excerpt(header)
+                excerpt(&header)
             ),
         ));
     };
@@ -173,7 +203,7 @@ pub fn read_test_file(
                 k + 1,
                 format!(
                     "`{}` has {} fields and the header {}{}",
-                    excerpt(line),
+                    excerpt(&line),
                     f.len(),
                     names.len(),
                     if f.len() > names.len() {

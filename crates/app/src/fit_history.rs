@@ -9,7 +9,7 @@
 //! mean anything physical).
 
 use crate::figures::{save, Figure, FigureOptions, Markers, Series, Stroke};
-use crate::fit::{unit_of_column, FitError, StressUnit};
+use crate::fit::{csv_lines, unit_of_column, CsvLines, FitError, StressUnit};
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
 use tubemem_material::fit::{fit_histories_with, FitOptions, FitResult, HistoryData, Mode};
@@ -28,27 +28,17 @@ pub struct HistoryFile {
 
 /// Read a history's CSV (see the module docs); its name is the file's stem.
 pub fn read_history_file(path: &Path, mode: Mode) -> Result<HistoryFile, FitError> {
-    let text = tubemem_mesh::io::read_text_limited(path, tubemem_mesh::io::MAX_TEXT_INPUT_BYTES)
-        .map_err(|source| FitError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+    let CsvLines {
+        header_line: h,
+        header,
+        names,
+        rows,
+    } = csv_lines(path)?;
     let err = |line: usize, message: String| FitError::Data {
         path: path.to_path_buf(),
         line,
         message,
     };
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some((h, header)) = rows.next() else {
-        return Err(err(1, "the file has no header and no data".into()));
-    };
-    let names: Vec<String> = header
-        .split(',')
-        .map(|c| c.trim().to_ascii_lowercase())
-        .collect();
     let find = |p: &dyn Fn(&str) -> bool| names.iter().position(|c| p(c));
     let time_col = find(&|c| c == "time" || c == "time_s");
     let stretch_col = find(&|c| c.starts_with("stretch") || c.starts_with("lambda"));

@@ -216,31 +216,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             100.0 * result.max_relative_residual,
             result.stop_reason
         )?;
-        for p in &result.parameters {
-            let se = match (p.fixed, p.std_error) {
-                (true, _) => "fixed".to_string(),
-                (_, Some(e)) => format!("± {e:.2e}"),
-                (_, None) => "± —".to_string(),
-            };
-            let u = if tubemem_material::fit::is_modulus(&p.name) {
-                unit_name
-            } else {
-                ""
-            };
-            crate::say!(
-                "  {:<20} {:>14.6e} {u:<8} {se}{}",
-                p.name,
-                p.value,
-                match (&p.at_bound, p.determined) {
-                    (Some(b), _) => format!("   at its {b} bound"),
-                    (None, false) => format!(
-                        "   not determined by the data (rank {} of {})",
-                        result.rank, result.free_parameters
-                    ),
-                    _ => String::new(),
-                }
-            )?;
-        }
+        crate::fit_print::parameter_lines(&result, unit_name)?;
         for w in &result.warnings {
             crate::say!("warning: {w}")?;
         }

@@ -122,30 +122,7 @@ pub fn run(a: HistoryFit) -> Result<()> {
             100.0 * result.max_relative_residual,
             result.stop_reason
         )?;
-        for p in &result.parameters {
-            let se = match (p.fixed, p.std_error) {
-                (true, _) => "fixed".to_string(),
-                (_, Some(e)) => format!("± {e:.2e}"),
-                (_, None) => "± —".to_string(),
-            };
-            let u = if tubemem_material::fit::is_modulus(&p.name) {
-                unit_name
-            } else if p.name.ends_with(".tau") {
-                "s"
-            } else {
-                ""
-            };
-            crate::say!(
-                "  {:<20} {:>14.6e} {u:<8} {se}{}",
-                p.name,
-                p.value,
-                match (&p.at_bound, p.determined) {
-                    (Some(b), _) => format!("   at its {b} bound"),
-                    (None, false) => "   not determined by the data".to_string(),
-                    _ => String::new(),
-                }
-            )?;
-        }
+        crate::fit_print::parameter_lines(&result, unit_name)?;
         crate::say!("per history (rms residual in {unit_name}, largest residual over the history's largest stress):")?;
         for t in &result.tests {
             crate::say!(

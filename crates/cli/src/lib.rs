@@ -6,6 +6,7 @@ pub mod atlas_cmd;
 pub mod console;
 pub mod fit_cmd;
 pub mod fit_history_cmd;
+pub mod fit_print;
 pub mod gps_cmd;
 pub mod gps_history;
 pub mod material_args;
