@@ -15,6 +15,7 @@ const PAGES: &[&str] = &[
     "tubemem-gps-flatten",
     "tubemem-gps-confine",
     "tubemem-gps-limits",
+    "tubemem-gps-history",
     "tubemem-run",
     "tubemem-fit",
     "tubemem-verify",
