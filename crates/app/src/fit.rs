@@ -111,10 +111,22 @@ fn excerpt(line: &str) -> String {
 /// A data file's lines as the fits read them: the header (its index from 0, its text and its
 /// lower-case column names) and the data rows (index, text); blank and `#` lines skipped.
 pub(crate) struct CsvLines {
+    pub path: PathBuf,
     pub header_line: usize,
     pub header: String,
     pub names: Vec<String>,
     pub rows: Vec<(usize, String)>,
+}
+
+impl CsvLines {
+    /// The file's content refused at `line` (counted from 1).
+    pub fn err(&self, line: usize, message: String) -> FitError {
+        FitError::Data {
+            path: self.path.clone(),
+            line,
+            message,
+        }
+    }
 }
 
 /// Read `path` (at most [`tubemem_mesh::io::MAX_TEXT_INPUT_BYTES`]) into [`CsvLines`].
@@ -141,6 +153,7 @@ pub(crate) fn csv_lines(path: &Path) -> Result<CsvLines, FitError> {
         .map(|c| c.trim().to_ascii_lowercase())
         .collect();
     Ok(CsvLines {
+        path: path.to_path_buf(),
         header_line: h,
         header,
         names,
@@ -155,17 +168,9 @@ pub fn read_test_file(
     mode: Mode,
     unit: Option<StressUnit>,
 ) -> Result<TestFile, FitError> {
-    let CsvLines {
-        header_line: h,
-        header,
-        names,
-        rows,
-    } = csv_lines(path)?;
-    let err = |line: usize, message: String| FitError::Data {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let lines = csv_lines(path)?;
+    let err = |line: usize, message: String| lines.err(line, message);
+    let (h, header, names) = (lines.header_line, &lines.header, &lines.names);
     let stretch_col = names
         .iter()
         .position(|c| c.starts_with("stretch") || c.starts_with("lambda"));
@@ -177,7 +182,7 @@ pub fn read_test_file(
             h + 1,
             format!(
                 "the header `{}` must name a `stretch` column and a `nominal_stress` (or `stress`) column, with the stress's unit as a suffix, e.g. `stretch,nominal_stress_mpa` (a file without a header is refused: its first row would be taken for one)",
-                excerpt(&header)
+                excerpt(header)
             ),
         ));
     };
@@ -196,14 +201,14 @@ pub fn read_test_file(
     };
     let factor = unit.map_or(1.0, |u| u.pascals);
     let (mut stretch, mut stress) = (vec![], vec![]);
-    for (k, line) in rows {
+    for (k, line) in &lines.rows {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != names.len() {
             return Err(err(
                 k + 1,
                 format!(
                     "`{}` has {} fields and the header {}{}",
-                    excerpt(&line),
+                    excerpt(line),
                     f.len(),
                     names.len(),
                     if f.len() > names.len() {
@@ -405,7 +410,14 @@ pub fn fit_figure(result: &FitResult, data: &[TestData], unit: Option<StressUnit
         series,
     );
     fig.markers = markers;
-    fig.notes = result
+    fig.notes = parameter_notes(result);
+    fig
+}
+
+/// A figure's note per fitted parameter: its value, standard error, and whether it is fixed,
+/// at a bound or not determined.
+pub(crate) fn parameter_notes(result: &FitResult) -> Vec<String> {
+    result
         .parameters
         .iter()
         .map(|p| {
@@ -425,8 +437,7 @@ pub fn fit_figure(result: &FitResult, data: &[TestData], unit: Option<StressUnit
                 }
             )
         })
-        .collect();
-    fig
+        .collect()
 }
 
 /// Write the fit's figure as `stem`.svg and/or .png.

@@ -9,7 +9,7 @@
 //! mean anything physical).
 
 use crate::figures::{save, Figure, FigureOptions, Markers, Series, Stroke};
-use crate::fit::{csv_lines, unit_of_column, CsvLines, FitError, StressUnit};
+use crate::fit::{csv_lines, unit_of_column, FitError, StressUnit};
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
 use tubemem_material::fit::{fit_histories_with, FitOptions, FitResult, HistoryData, Mode};
@@ -28,17 +28,9 @@ pub struct HistoryFile {
 
 /// Read a history's CSV (see the module docs); its name is the file's stem.
 pub fn read_history_file(path: &Path, mode: Mode) -> Result<HistoryFile, FitError> {
-    let CsvLines {
-        header_line: h,
-        header,
-        names,
-        rows,
-    } = csv_lines(path)?;
-    let err = |line: usize, message: String| FitError::Data {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
+    let lines = csv_lines(path)?;
+    let err = |line: usize, message: String| lines.err(line, message);
+    let (h, header, names) = (lines.header_line, &lines.header, &lines.names);
     let find = |p: &dyn Fn(&str) -> bool| names.iter().position(|c| p(c));
     let time_col = find(&|c| c == "time" || c == "time_s");
     let stretch_col = find(&|c| c.starts_with("stretch") || c.starts_with("lambda"));
@@ -55,7 +47,7 @@ pub fn read_history_file(path: &Path, mode: Mode) -> Result<HistoryFile, FitErro
     let unit = stress_col.and_then(|c| unit_of_column(&names[c]));
     let factor = unit.map_or(1.0, |u| u.pascals);
     let (mut time, mut stretch, mut stress) = (vec![], vec![], vec![]);
-    for (k, line) in rows {
+    for (k, line) in &lines.rows {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
         if f.len() != names.len() {
             return Err(err(
@@ -204,18 +196,7 @@ pub fn history_figure(result: &FitResult, data: &[HistoryData], y_label: &str) -
         series,
     );
     fig.markers = markers;
-    fig.notes = result
-        .parameters
-        .iter()
-        .map(|p| {
-            format!(
-                "{} = {:.5e}{}",
-                p.name,
-                p.value,
-                p.std_error.map_or(String::new(), |e| format!(" ± {e:.2e}"))
-            )
-        })
-        .collect();
+    fig.notes = crate::fit::parameter_notes(result);
     fig
 }
 

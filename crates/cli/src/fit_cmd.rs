@@ -148,17 +148,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             .flatten()
             .map(|p| p.as_path())
             .collect();
-        let ours = |t: &str| t.starts_with("<svg") && t.contains("Fit of the");
-        // a PNG's writer cannot be told from its bytes: it is this command's where the SVG
-        // written beside it is
-        let svg_ours = std::fs::read_to_string(stem.with_extension("svg")).is_ok_and(|t| ours(&t));
-        for ext in ["svg", "png"] {
-            let path = stem.with_extension(ext);
-            tubemem_app::output_file::check("--plot", &path, &inputs, |t| {
-                a.overwrite || ours(t) || (ext == "png" && svg_ours)
-            })
-            .map_err(|e| anyhow::anyhow!(tubemem_app::error_chain(&e)))?;
-        }
+        crate::fit_print::check_plot(stem, &inputs, "Fit of the", a.overwrite)?;
     }
     let mut files = vec![];
     for (path, mode) in [

@@ -32,16 +32,14 @@ pub fn run(a: HistoryFit) -> Result<()> {
     }
     // the figure's files checked before anything is read
     if let Some(stem) = a.plot {
-        let inputs: Vec<&std::path::Path> = a.history.iter().map(|p| p.as_path()).collect();
-        let ours = |t: &str| t.starts_with("<svg") && t.contains("Prony terms to");
-        let svg_ours = std::fs::read_to_string(stem.with_extension("svg")).is_ok_and(|t| ours(&t));
-        for ext in ["svg", "png"] {
-            let path = stem.with_extension(ext);
-            tubemem_app::output_file::check("--plot", &path, &inputs, |t| {
-                a.overwrite || ours(t) || (ext == "png" && svg_ours)
-            })
-            .map_err(|e| anyhow::anyhow!(tubemem_app::error_chain(&e)))?;
-        }
+        let law_file = Some(PathBuf::from(a.law)).filter(|p| p.is_file());
+        let inputs: Vec<&Path> = a
+            .history
+            .iter()
+            .chain(&law_file)
+            .map(|p| p.as_path())
+            .collect();
+        crate::fit_print::check_plot(stem, &inputs, "Prony terms to", a.overwrite)?;
     }
     let files = a
         .history

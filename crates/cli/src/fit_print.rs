@@ -1,4 +1,5 @@
-//! The parameter lines `tubemem fit` prints, for the elastic fit and the history fit alike.
+//! What `tubemem fit` writes and prints, for the elastic fit and the history fit alike: the
+//! figure's files checked before anything is read, and the parameter lines.
 
 use tubemem_material::fit::FitResult;
 
@@ -31,6 +32,28 @@ pub fn parameter_lines(result: &FitResult, unit_name: &str) -> std::io::Result<(
                 _ => String::new(),
             }
         )?;
+    }
+    Ok(())
+}
+
+/// The `--plot` files `stem`.svg and .png checked before anything is read: not an input, and an
+/// existing file only where it is a figure of this command (an SVG whose text holds `title`;
+/// a PNG's writer cannot be told from its bytes: it is ours where the SVG beside it is), or
+/// with `overwrite`.
+pub fn check_plot(
+    stem: &std::path::Path,
+    inputs: &[&std::path::Path],
+    title: &str,
+    overwrite: bool,
+) -> anyhow::Result<()> {
+    let ours = |t: &str| t.starts_with("<svg") && t.contains(title);
+    let svg_ours = std::fs::read_to_string(stem.with_extension("svg")).is_ok_and(|t| ours(&t));
+    for ext in ["svg", "png"] {
+        let path = stem.with_extension(ext);
+        tubemem_app::output_file::check("--plot", &path, inputs, |t| {
+            overwrite || ours(t) || (ext == "png" && svg_ours)
+        })
+        .map_err(|e| anyhow::anyhow!(tubemem_app::error_chain(&e)))?;
     }
     Ok(())
 }

@@ -201,7 +201,7 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         }
     })?;
     let h = &result.history;
-    let last = *h.points.last().expect("a history has its start");
+    let last = h.end();
     if let Some(csv) = &a.csv {
         let si = units.is_si();
         let header = if si {

@@ -2758,6 +2758,65 @@ fn a_viscoelastic_history_and_its_si_twin_agree_and_bad_input_is_named() {
     }
     assert!((f(&si, "pressure_pa") / 3000.0 - 1.0).abs() < 1e-12);
     assert!(d.get("pressure_pa").is_none());
+    // a squeeze–release cycle and its SI twin: the same force and loop (1e-12), the force in
+    // N/m = πμH·force (πμH = π · 50 N/m) and the loop's work in J/m = πμHR·area (πμHR = π ·
+    // 0.25 N), to rounding (1e-14)
+    let cycle = [
+        "gps",
+        "history",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--prony",
+        "0.3:1,0.2:10",
+        "--control",
+        "stretch",
+        "--to",
+        "1.3",
+        "--hold",
+        "50",
+        "--plates-to",
+        "1.0",
+        "--squeeze-time",
+        "3",
+        "--plates-hold",
+        "2",
+        "--tolerance",
+        "1e-8",
+        "--json",
+    ];
+    let dc = json(&with(&cycle, &[]));
+    let sc = json(&with(
+        &cycle,
+        &[
+            "--radius",
+            "0.005",
+            "--thickness",
+            "0.0005",
+            "--shear-modulus",
+            "1e5",
+        ],
+    ));
+    let pi = std::f64::consts::PI;
+    assert!(f(&dc, "force") > 0.0 && (f(&sc, "force") / f(&dc, "force") - 1.0).abs() < 1e-12);
+    assert!((f(&sc, "force_n_per_m") / (pi * 50.0 * f(&sc, "force")) - 1.0).abs() < 1e-14);
+    let dr = json(&with(&cycle, &["--release"]));
+    let sr = json(&with(
+        &cycle,
+        &[
+            "--release",
+            "--radius",
+            "0.005",
+            "--thickness",
+            "0.0005",
+            "--shear-modulus",
+            "1e5",
+        ],
+    ));
+    assert!((f(&sr, "loop_area") / f(&dr, "loop_area") - 1.0).abs() < 1e-12);
+    assert!((f(&sr, "loop_area_j_per_m") / (pi * 0.25 * f(&sr, "loop_area")) - 1.0).abs() < 1e-14);
+    assert!(dr.get("loop_area_j_per_m").is_none());
     assert!(f(&d, "error_estimate") <= 1e-9 && f(&d, "g_infinity") == 0.5);
     let refused = |args: Vec<&str>, words: &[&str]| {
         let o = tubemem(&args);

@@ -122,11 +122,7 @@ pub fn run_cycle(
     }
     // where the plates first touch: the inflated λs (to the same steps)
     let first = history(law, prony, hyp, &program, steps)?;
-    let touch = first
-        .points
-        .last()
-        .expect("a history has its start")
-        .lambda_s;
+    let touch = first.end().lambda_s;
     if !(p.to.is_finite() && p.to > 0.0 && p.to < touch) {
         return Err(GpsError::PlatesOutside { rho: p.to, touch });
     }

@@ -23,7 +23,7 @@ pub mod cycle;
 mod step;
 
 use crate::{GpsError, Hypothesis};
-use step::{Fix, StepEquations};
+use step::{Fix, PlateFix, Section, StepEquations};
 use tubemem_material::viscoelastic::{History, Prony};
 use tubemem_material::{MembraneLaw, Num};
 
@@ -91,6 +91,26 @@ pub struct TimeHistory {
     pub error_estimate: f64,
 }
 
+impl TimeHistory {
+    /// The last state (the unloaded tube for a history without steps).
+    pub fn end(&self) -> TimePoint {
+        self.points.last().copied().unwrap_or(UNLOADED)
+    }
+}
+
+/// The unloaded tube every history starts from.
+pub const UNLOADED: TimePoint = TimePoint {
+    time: 0.0,
+    w: 0.0,
+    lambda_s: 1.0,
+    lambda_z: 1.0,
+    n_s: 0.0,
+    n_z: 0.0,
+    rho: None,
+    chi: 0.0,
+    force: 0.0,
+};
+
 /// The update's order in Δt on a smooth history (`tubemem_material::viscoelastic`; measured
 /// by the tests).
 pub const ORDER: i32 = 2;
@@ -110,6 +130,13 @@ fn controlled(p: &TimePoint, c: Control) -> f64 {
 
 /// M = ϖ × the enclosed volume per unit reference length over πR² of a state: ϖ ρ(2λs − ρ)λz
 /// in contact, ϖ λs² λz free (λz = 1 under PS, as the state has it).
+/// What a segment's steps solve for: the free tube under its control's value, or the tube
+/// between plates at the step's ρ under a pressure or gas fixed at the segment's start.
+enum Drive {
+    Free(fn(f64) -> Fix),
+    Plates(PlateFix),
+}
+
 fn gas_of(p: &TimePoint) -> f64 {
     if p.chi > 0.0 {
         let rho = p.rho.unwrap_or(p.lambda_s);
@@ -193,26 +220,19 @@ pub fn integrate(
         ));
     }
     let mut hist = History::unloaded(prony.terms().len());
-    let mut p = TimePoint {
-        time: 0.0,
-        w: 0.0,
-        lambda_s: 1.0,
-        lambda_z: 1.0,
-        n_s: 0.0,
-        n_z: 0.0,
-        rho: None,
-        chi: 0.0,
-        force: 0.0,
-    };
+    let mut p = UNLOADED;
     let mut points = vec![p];
     for (k, seg) in segments.iter().enumerate() {
         let from = controlled(&p, seg.control);
         let to = seg.target.unwrap_or(from);
-        // what fixes the pressure in the segment's plates steps, set at its start
-        let supply = match seg.control {
-            Control::Plates(Supply::Pressure) => Some(Fix::Pressure(p.w)),
-            Control::Plates(Supply::Gas) => Some(Fix::Gas(gas_of(&p))),
-            _ => None,
+        // the free tube's control, or what fixes the pressure between the plates (set at the
+        // segment's start)
+        let drive = match seg.control {
+            Control::Pressure => Drive::Free(Fix::Pressure),
+            Control::Stretch => Drive::Free(Fix::Stretch),
+            Control::Volume => Drive::Free(Fix::Volume),
+            Control::Plates(Supply::Pressure) => Drive::Plates(PlateFix::Pressure(p.w)),
+            Control::Plates(Supply::Gas) => Drive::Plates(PlateFix::Gas(gas_of(&p))),
         };
         let (n, dt) = if seg.duration == 0.0 {
             (1, 0.0)
@@ -232,21 +252,22 @@ pub fn integrate(
                 b: hist.offset(&step),
             };
             let guess = [p.lambda_s, p.lambda_z];
-            let (s, rho) = match (seg.control, supply) {
-                (Control::Plates(_), Some(fix)) => {
+            let (s, rho) = match drive {
+                Drive::Free(fix) => (eqs.solve(Section::Free(fix(value)), guess, &at)?, None),
+                Drive::Plates(fix) => {
                     // in contact if the free tube would be wider than the gap
-                    let free = eqs.solve(None, fix, guess, &at);
-                    match free {
+                    let free = match fix {
+                        PlateFix::Pressure(w) => Fix::Pressure(w),
+                        PlateFix::Gas(m) => Fix::Gas(m),
+                    };
+                    match eqs.solve(Section::Free(free), guess, &at) {
                         Ok(f) if f.ls <= value => (f, Some(value)),
-                        _ => (eqs.solve(Some(value), fix, guess, &at)?, Some(value)),
+                        _ => (
+                            eqs.solve(Section::Plates(value, fix), guess, &at)?,
+                            Some(value),
+                        ),
                     }
                 }
-                (Control::Pressure, _) => {
-                    (eqs.solve(None, Fix::Pressure(value), guess, &at)?, None)
-                }
-                (Control::Stretch, _) => (eqs.solve(None, Fix::Stretch(value), guess, &at)?, None),
-                (Control::Volume, _) => (eqs.solve(None, Fix::Volume(value), guess, &at)?, None),
-                (Control::Plates(_), None) => unreachable!("a plates segment has its supply"),
             };
             let r = law
                 .principal(s.ls, s.lz)

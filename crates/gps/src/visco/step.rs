@@ -25,6 +25,23 @@ pub(crate) enum Fix {
     Volume(f64),
 }
 
+/// What fixes the pressure between plates (the plates fix ρ, so never λs or v).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum PlateFix {
+    /// ϖ given
+    Pressure(f64),
+    /// the gas closed: ϖ ρ (2λs − ρ) λz = M
+    Gas(f64),
+}
+
+/// Where a step's section is: free under a [`Fix`], or between plates at ±ρ under a
+/// [`PlateFix`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Section {
+    Free(Fix),
+    Plates(f64, PlateFix),
+}
+
 /// The solved step.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Solved {
@@ -89,7 +106,7 @@ impl StepEquations<'_> {
     fn plates_gps(
         &self,
         rho: f64,
-        fix: Fix,
+        fix: PlateFix,
         x: [f64; 2],
     ) -> Result<([f64; 2], Jac), MaterialError> {
         let [ls, lz] = x;
@@ -102,48 +119,49 @@ impl StepEquations<'_> {
             [j[0][0] * q + ns * dq - j[1][0], j[0][1] * q - j[1][1]],
         );
         let (f, d) = match fix {
-            Fix::Pressure(w) => (ns - w * rho, [j[0][0], j[0][1]]),
-            Fix::Gas(m) => (
+            PlateFix::Pressure(w) => (ns - w * rho, [j[0][0], j[0][1]]),
+            PlateFix::Gas(m) => (
                 lz * ns * t / m - 1.0,
                 [
                     lz * (j[0][0] * t + 2.0 * ns) / m,
                     (ns * t + lz * j[0][1] * t) / m,
                 ],
             ),
-            Fix::Stretch(_) | Fix::Volume(_) => unreachable!("plates fix ρ, not λs or v"),
         };
         Ok(([f, axial.0], [d, axial.1]))
     }
 
-    /// Solve the step, free (`rho` None) or between plates at ±ρ, from the guess (λs, λz).
-    pub fn solve(
-        &self,
-        rho: Option<f64>,
-        fix: Fix,
-        guess: [f64; 2],
-        at: &str,
-    ) -> Result<Solved, GpsError> {
+    /// Solve the step's `section` from the guess (λs, λz).
+    pub fn solve(&self, section: Section, guess: [f64; 2], at: &str) -> Result<Solved, GpsError> {
+        let rho = match section {
+            Section::Free(_) => None,
+            Section::Plates(rho, _) => Some(rho),
+        };
         let ftol = 1e-13;
         let fail = |f: newton::Failure| f.into_error(STAGE, at);
         let (ls, lz) = match self.hyp {
             Hypothesis::Gps => {
-                let x = match rho {
-                    None => newton::system2(|x| self.free_gps(fix, x), guess, ftol),
-                    Some(rho) => newton::system2(|x| self.plates_gps(rho, fix, x), guess, ftol),
+                let x = match section {
+                    Section::Free(fix) => newton::system2(|x| self.free_gps(fix, x), guess, ftol),
+                    Section::Plates(rho, fix) => {
+                        newton::system2(|x| self.plates_gps(rho, fix, x), guess, ftol)
+                    }
                 }
                 .map_err(fail)?;
                 (x[0], x[1])
             }
             // PS: λz = 1, the first equation alone in λs
             Hypothesis::Ps => {
-                let ls = match fix {
-                    Fix::Stretch(v) => v,
-                    Fix::Volume(v) => v.sqrt(),
+                let ls = match section {
+                    Section::Free(Fix::Stretch(v)) => v,
+                    Section::Free(Fix::Volume(v)) => v.sqrt(),
                     _ => newton::scalar(
                         |ls| {
-                            let (f, j) = match rho {
-                                None => self.free_gps(fix, [ls, 1.0])?,
-                                Some(rho) => self.plates_gps(rho, fix, [ls, 1.0])?,
+                            let (f, j) = match section {
+                                Section::Free(fix) => self.free_gps(fix, [ls, 1.0])?,
+                                Section::Plates(rho, fix) => {
+                                    self.plates_gps(rho, fix, [ls, 1.0])?
+                                }
                             };
                             Ok((f[0], j[0][0]))
                         },
