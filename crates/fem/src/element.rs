@@ -10,12 +10,36 @@
 
 use crate::geometry::{RefElement, Vec3};
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector};
-use tubemem_material::{MaterialError, MembraneLaw};
+use tubemem_material::{MaterialError, MembraneLaw, StressTangent};
 pub use tubemem_mesh::volume::{Matrix12, Vector12};
 
 /// The right Cauchy–Green components (C11, C22, C12) of the gradient columns f_1, f_2.
 pub fn cauchy_green(f: &[Vec3; 2]) -> [f64; 3] {
     [f[0].dot(&f[0]), f[1].dot(&f[1]), f[0].dot(&f[1])]
+}
+
+/// One time step of a hereditary law at an element's Gauss points
+/// ([`crate::memory`]): the base law's stress and tangent scaled by `alpha`, plus a stress
+/// `offsets[g]` (Voigt 11, 22, 12) frozen over the step. Within the step the point is
+/// hyperelastic with the energy α W(C) + ½ B:(C − I), so the residual is its gradient and the
+/// tangent its Hessian.
+#[derive(Clone, Copy, Debug)]
+pub struct Hereditary<'a> {
+    pub alpha: f64,
+    pub offsets: &'a [[f64; 3]],
+}
+
+impl Hereditary<'_> {
+    /// The step's stress, tangent and energy at Gauss point `g` from the base law's at `c`.
+    pub fn apply(&self, g: usize, c: [f64; 3], base: StressTangent) -> StressTangent {
+        let b = self.offsets[g];
+        StressTangent {
+            w: self.alpha * base.w
+                + 0.5 * (b[0] * (c[0] - 1.0) + b[1] * (c[1] - 1.0) + 2.0 * b[2] * c[2]),
+            s: std::array::from_fn(|k| self.alpha * base.s[k] + b[k]),
+            tangent: base.tangent.map(|row| row.map(|v| self.alpha * v)),
+        }
+    }
 }
 
 /// Add the energy (per μH), residual r and, if asked, stiffness K of one element.
@@ -25,13 +49,31 @@ pub fn membrane_kernel<const N: usize, const D: usize>(
     re: &RefElement<N>,
     xe: &[Vec3; N],
     r: &mut SVector<f64, D>,
+    k: Option<&mut SMatrix<f64, D, D>>,
+) -> Result<f64, (usize, MaterialError)> {
+    membrane_kernel_in_step(law, None, re, xe, r, k)
+}
+
+/// [`membrane_kernel`] within a time step of a hereditary law (`hereditary`; `None`: the law
+/// alone).
+pub fn membrane_kernel_in_step<const N: usize, const D: usize>(
+    law: &dyn MembraneLaw,
+    hereditary: Option<Hereditary<'_>>,
+    re: &RefElement<N>,
+    xe: &[Vec3; N],
+    r: &mut SVector<f64, D>,
     mut k: Option<&mut SMatrix<f64, D, D>>,
 ) -> Result<f64, (usize, MaterialError)> {
     const { assert!(D == 3 * N) };
     let mut energy = 0.0;
     for (g, gp) in re.gauss.iter().enumerate() {
         let f = re.gradient(g, xe);
-        let st = law.stress_tangent(cauchy_green(&f)).map_err(|e| (g, e))?;
+        let c = cauchy_green(&f);
+        let st = law.stress_tangent(c).map_err(|e| (g, e))?;
+        let st = match hereditary {
+            Some(h) => h.apply(g, c, st),
+            None => st,
+        };
         let w = gp.w;
         energy += w * st.w;
         let s = Matrix2::new(st.s[0], st.s[2], st.s[2], st.s[1]);
@@ -110,8 +152,22 @@ pub fn point_state<const N: usize>(
 
 /// [`point_state`] from the gradient columns f_1, f_2.
 pub fn point_state_of(law: &dyn MembraneLaw, f: &[Vec3; 2]) -> Result<PointState, MaterialError> {
+    point_state_in_step(law, None, f)
+}
+
+/// [`point_state_of`] at Gauss point `g` of a time step of a hereditary law (`hereditary`:
+/// the step and the point; `None`: the law alone).
+pub fn point_state_in_step(
+    law: &dyn MembraneLaw,
+    hereditary: Option<(Hereditary<'_>, usize)>,
+    f: &[Vec3; 2],
+) -> Result<PointState, MaterialError> {
     let c = cauchy_green(f);
     let st = law.stress_tangent(c)?;
+    let st = match hereditary {
+        Some((h, g)) => h.apply(g, c, st),
+        None => st,
+    };
     let (tr, det) = (c[0] + c[1], c[0] * c[1] - c[2] * c[2]);
     let disc = (0.25 * tr * tr - det).max(0.0).sqrt();
     let (l1, l2) = ((0.5 * tr + disc).sqrt(), (0.5 * tr - disc).max(0.0).sqrt());

@@ -41,6 +41,7 @@ pub mod heap;
 pub mod krylov;
 pub mod linsolve;
 pub mod manufactured;
+pub mod memory;
 pub mod model;
 pub mod newton;
 pub mod ordering;

@@ -16,7 +16,7 @@
 //! ϖ    = the reduced pressure,  volume = total enclosed volume (all symmetry copies)
 //! ```
 use crate::contact::{Contact, ContactPoints};
-use crate::element::point_state_of;
+use crate::element::{point_state_in_step, PointState};
 use crate::geometry::{RefElement, Vec3};
 use crate::model::{Elements, Model, State};
 use crate::with_elements;
@@ -200,6 +200,18 @@ impl Ring {
     }
 }
 
+/// The state of Gauss point `g` of element `e` with gradient columns `f`: the law's, or a
+/// viscoelastic law's at its committed history ([`crate::memory::Memory::committed_at`]).
+fn point_state_committed(
+    model: &Model,
+    e: usize,
+    g: usize,
+    f: &[Vec3; 2],
+) -> Result<PointState, tubemem_material::MaterialError> {
+    let committed = model.memory().map(|m| (m.committed_at(e), g));
+    point_state_in_step(model.law(), committed, f)
+}
+
 /// Mid-span values: [`ring_state`] at Z = 0.
 pub fn midspan(model: &Model, state: &State) -> Result<MidSpan, FemError> {
     ring_state(model, state, &Ring::midspan(model))
@@ -237,7 +249,7 @@ fn projected_resultants(
     let mut out = vec![[0.0; 3]; samples.len()];
     for (g, (o, sp)) in out.iter_mut().zip(samples).enumerate() {
         let f = sp.f;
-        let ps = point_state_of(model.law(), &f).map_err(|source| FemError::Material {
+        let ps = point_state_committed(model, e, g, &f).map_err(|source| FemError::Material {
             element: e,
             gauss_point: g,
             source,
@@ -363,12 +375,13 @@ pub fn cell_values(model: &Model, state: &State) -> Result<Vec<CellValues>, FemE
             let share = 1.0 / samples.len() as f64;
             let mut c = CellValues::default();
             for (g, sp) in samples.iter().enumerate() {
-                let ps =
-                    point_state_of(model.law(), &sp.f).map_err(|source| FemError::Material {
+                let ps = point_state_committed(model, e, g, &sp.f).map_err(|source| {
+                    FemError::Material {
                         element: e,
                         gauss_point: g,
                         source,
-                    })?;
+                    }
+                })?;
                 let xr = sp.x_ref;
                 let [e1, e2] = sp.frame;
                 let normal = e1.cross(&e2);

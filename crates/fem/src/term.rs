@@ -1,7 +1,7 @@
 //! Force terms: what one element adds to the energy, the internal force and the stiffness.
 //!
 //! The assembly ([`crate::model::Model::assemble`]) sums, element by element, the built-in
-//! terms — the hyperelastic membrane ([`MembraneTerm`]) and, when the load has planes, the
+//! terms — the membrane ([`MembraneTerm`]) and, when the load has planes, the
 //! frictionless contact ([`ContactTerm`]) — and then every term added to the model with
 //! [`Model::add_term`](crate::model::Model::add_term). The enclosed volume (the gas) is not a
 //! term: the loading multiplies it by the pressure, a Lagrange multiplier or Boyle's law
@@ -23,8 +23,9 @@
 //! `crates/fem/tests/term.rs` does for an elastic foundation.
 
 use crate::contact::Contact;
-use crate::element::membrane_kernel;
+use crate::element::membrane_kernel_in_step;
 use crate::geometry::{RefElement, Vec3};
+use crate::memory::Memory;
 use crate::FemError;
 use nalgebra::{SMatrix, SVector};
 use tubemem_material::MembraneLaw;
@@ -119,10 +120,12 @@ impl<T: ElementTerm> Term for T {
     }
 }
 
-/// The hyperelastic membrane of a law ([`crate::element::membrane_kernel`]): a law's failure
-/// at a Gauss point is [`FemError::Material`] with the element and the point.
+/// The membrane of a law ([`crate::element::membrane_kernel`]), hyperelastic or, with a
+/// [`Memory`], in the current time step of a viscoelastic law: a law's failure at a Gauss point
+/// is [`FemError::Material`] with the element and the point.
 pub struct MembraneTerm<'a> {
     pub law: &'a dyn MembraneLaw,
+    pub memory: Option<&'a Memory>,
 }
 
 impl ElementTerm for MembraneTerm<'_> {
@@ -135,7 +138,8 @@ impl ElementTerm for MembraneTerm<'_> {
         r: &mut SVector<f64, D>,
         k: Option<&mut SMatrix<f64, D, D>>,
     ) -> Result<f64, FemError> {
-        membrane_kernel(self.law, el.reference, el.x, r, k).map_err(|(gp, source)| {
+        let step = self.memory.map(|m| m.at(el.index));
+        membrane_kernel_in_step(self.law, step, el.reference, el.x, r, k).map_err(|(gp, source)| {
             FemError::Material {
                 element: el.index,
                 gauss_point: gp,

@@ -114,6 +114,41 @@ fn membrane_tangents_match_finite_differences() {
     }
 }
 
+/// Within a viscoelastic time step each Gauss point's energy is α W(C) + ½ B:(C − I)
+/// ([`crate::element::Hereditary`]): the kernel's residual is its gradient and its tangent the
+/// Hessian, for random α in (0.1, 1) and random offsets B per point (central differences,
+/// [`check_element_fd`]'s bounds).
+#[test]
+fn membrane_tangents_in_a_viscoelastic_step_match_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    for _ in 0..20 {
+        let x0 = random_quad(&mut rng);
+        let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
+        let x = deform(&x0, &mut rng);
+        let offsets: Vec<[f64; 3]> = (0..re.gauss.len())
+            .map(|_| std::array::from_fn(|_| rng.random_range(-0.5..0.5)))
+            .collect();
+        let step = crate::element::Hereditary {
+            alpha: rng.random_range(0.1..1.0),
+            offsets: &offsets,
+        };
+        check_element_fd(&x, 1e-6, "viscoelastic step", |x| {
+            let (mut r, mut k) = (SVector::<f64, 12>::zeros(), SMatrix::zeros());
+            let e = crate::element::membrane_kernel_in_step(
+                &law,
+                Some(step),
+                &re,
+                x,
+                &mut r,
+                Some(&mut k),
+            )
+            .unwrap();
+            (e, r, k)
+        });
+    }
+}
+
 /// The volume as an "energy" for [`check_element_fd`]: (V, ∂V/∂x, ∂²V/∂x²).
 pub(crate) fn volume_eval<const N: usize, const D: usize>(
     x: &[Vec3; N],

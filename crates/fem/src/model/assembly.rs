@@ -193,6 +193,7 @@ impl Model {
     ) -> Result<Assembled, FemError> {
         let membrane = MembraneTerm {
             law: self.law.as_ref(),
+            memory: self.memory.as_ref(),
         };
         let contact = contact.map(|contact| ContactTerm {
             contact,

@@ -76,6 +76,9 @@ pub struct Model {
     interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     mesh: Mesh,
     law: Box<dyn MembraneLaw>,
+    /// the Gauss points' histories of a viscoelastic law and the time step solved
+    /// ([`crate::memory`]; `None`: the law is elastic)
+    memory: Option<crate::memory::Memory>,
     /// force terms added to the membrane and the contact ([`Model::add_term`])
     terms: Vec<Box<dyn Term>>,
     /// a load magnitude applied by the added terms ([`Model::set_load_scale`]; 0: none)
@@ -137,6 +140,7 @@ impl Model {
             interrupt: None,
             mesh,
             law,
+            memory: None,
             terms: Vec::new(),
             load_scale: 0.0,
             elements,
@@ -242,6 +246,50 @@ impl Model {
 
     pub fn law(&self) -> &dyn MembraneLaw {
         self.law.as_ref()
+    }
+
+    /// Make the law viscoelastic with the relaxation `prony` ([`crate::memory`]): the law
+    /// given at construction becomes the base law (its μ the instantaneous modulus), every
+    /// Gauss point starts unloaded and the current step is a jump (Δt = 0).
+    pub fn set_viscoelastic(&mut self, prony: tubemem_material::viscoelastic::Prony) {
+        self.memory = Some(crate::memory::Memory::new(prony, &self.elements));
+    }
+
+    /// The Gauss points' histories of a viscoelastic law (`None`: elastic).
+    pub fn memory(&self) -> Option<&crate::memory::Memory> {
+        self.memory.as_ref()
+    }
+
+    /// Solve the next time step over `dt` ≥ 0 (0: a jump) from the committed histories; an
+    /// elastic model ignores time (Ok).
+    pub fn set_time_step(&mut self, dt: f64) -> Result<(), FemError> {
+        match &mut self.memory {
+            Some(m) => m.set_step(dt),
+            None => Ok(()),
+        }
+    }
+
+    /// Accept `state` as the converged end of the current time step: every Gauss point's
+    /// history advances ([`crate::memory::Memory::commit`]). Nothing to do for an elastic
+    /// model.
+    pub fn commit_time_step(&mut self, state: &State) -> Result<(), FemError> {
+        match &mut self.memory {
+            Some(m) => m.commit(self.law.as_ref(), &self.elements, &state.x),
+            None => Ok(()),
+        }
+    }
+
+    /// Replace the Gauss points' histories (a checkpoint's; [`crate::memory::Memory::set_histories`]).
+    pub fn set_histories(
+        &mut self,
+        histories: Vec<tubemem_material::viscoelastic::History>,
+    ) -> Result<(), FemError> {
+        match &mut self.memory {
+            Some(m) => m.set_histories(histories),
+            None => Err(FemError::Setup {
+                reason: "material histories given to an elastic model".into(),
+            }),
+        }
     }
 
     /// Add a force term ([`crate::term`]): every assembly from now on sums it, element by

@@ -18,6 +18,12 @@ impl Model {
         contact: Option<&Contact>,
         states: &mut [&mut State],
     ) -> Result<(), FemError> {
+        if self.memory.is_some() {
+            // the Gauss points' histories are tensors in frames of the reference surface
+            return Err(FemError::Remap {
+                reason: "a viscoelastic law's material histories live on the reference mesh, which cannot move".into(),
+            });
+        }
         let points = contact.map(|c| c.points);
         let count = self.mesh.nodes.len();
         if nodes.len() != count {
