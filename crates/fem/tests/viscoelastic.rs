@@ -210,3 +210,192 @@ fn the_fe_in_time_converges_at_the_updates_second_order() {
         "spread {spread:e} vs temporal {temporal:e}"
     );
 }
+
+/// One row of a squeeze–hold–release cycle: the FE's mid-span and the GPS DAE driven by the
+/// FE's own time steps, plate position and pressure.
+#[derive(Clone, Copy, Debug)]
+struct CycleRow {
+    time: f64,
+    rho: f64,
+    w: f64,
+    force: f64,
+    dae_force: f64,
+    lambda_s: f64,
+    dae_lambda_s: f64,
+}
+
+/// The cycle: ϖ jumped to `w`, held 200 (20 τ₂) in `n` steps, then the gas closed in and two
+/// plates moved from first contact (the mid-span λs) to ±`rho` over `t`, held there for `t`
+/// and moved back over `t`, `n` steps each. The DAE ([`Stepper`]) takes each of the FE's steps
+/// with the FE's Δt, ρ and ϖ (the closed gas of the whole tube, caps included, sets ϖ in the
+/// FE; the DAE is compared at that pressure, as the elastic closed-gas squeeze is). A step
+/// that Newton cannot take is split into halves, each committed; the nodes on the plates
+/// move with them before each solve (the predictor: a release after a hold otherwise starts
+/// with every contact point separated by more than λ/κ and no plate force at all).
+fn cycle(around: usize, length: f64, w: f64, rho: f64, t: f64, n: usize) -> Vec<CycleRow> {
+    use tubemem_fem::contact::{penalty_for, Contact, ContactPoints, Enforcement};
+    use tubemem_fem::model::Loading;
+    use tubemem_fem::post::midspan_contact;
+    use tubemem_gps::visco::{StepLoad, Stepper};
+    let (law, p) = (abb(), prony());
+    let mut dae = Stepper::new(&law, &p, Hypothesis::Gps);
+    let mut model = tube(around, length, true);
+    let mut state = model.reference_state();
+    jump_to(&mut model, &mut state, w, 4);
+    dae.advance(0.0, StepLoad::Pressure(w)).unwrap();
+    for _ in 0..n {
+        step(&mut model, &mut state, w, 200.0 / n as f64);
+        dae.advance(200.0 / n as f64, StepLoad::Pressure(w))
+            .unwrap();
+    }
+    let m = midspan(&model, &state).unwrap();
+    let rho0 = m.lambda_s;
+    let penalty = penalty_for(w, m.lambda_s * m.lambda_z, 1e-6);
+    let pv = state.p * model.total_volume(&state.x);
+    let plates = |r: f64| {
+        Contact::plates(r, penalty)
+            .with_enforcement(Enforcement::augmented())
+            .with_points(ContactPoints::Nodal)
+    };
+    let targets = (1..=n)
+        .map(|k| rho0 + (rho - rho0) * k as f64 / n as f64)
+        .chain(std::iter::repeat_n(rho, n))
+        .chain((1..=n).map(|k| rho + (rho0 - rho) * k as f64 / n as f64));
+    let dt = t / n as f64;
+    let mut at = rho0;
+    let mut rows = Vec::new();
+    for target in targets {
+        let mut parts = 1;
+        loop {
+            let (mut trial, memory) = (state.clone(), model.memory().cloned().unwrap());
+            let ok = (1..=parts).all(|k| {
+                let r0 = at + (target - at) * (k - 1) as f64 / parts as f64;
+                let r = at + (target - at) * k as f64 / parts as f64;
+                for q in trial.x.iter_mut() {
+                    if q[1].abs() > r0 - 1e-6 {
+                        q[1] += (r - r0) * q[1].signum();
+                    }
+                }
+                model.set_time_step(dt / parts as f64).unwrap();
+                let load = Load::with_contact(Loading::Gas { pv }, plates(r));
+                model.solve(&mut trial, &load).is_ok() && model.commit_time_step(&trial).is_ok()
+            });
+            if ok {
+                state = trial;
+                break;
+            }
+            model.restore_memory(memory).unwrap();
+            parts *= 2;
+            assert!(parts <= 64, "the step to ρ = {target} does not converge");
+        }
+        at = target;
+        let d = dae
+            .advance(
+                dt,
+                StepLoad::PlatesAtPressure {
+                    rho: target,
+                    w: state.p,
+                },
+            )
+            .unwrap();
+        let m = midspan(&model, &state).unwrap();
+        let force = midspan_contact(&model, &state, &plates(target)).map_or(0.0, |c| c.force);
+        rows.push(CycleRow {
+            time: d.time,
+            rho: target,
+            w: state.p,
+            force,
+            dae_force: d.force,
+            lambda_s: m.lambda_s,
+            dae_lambda_s: d.lambda_s,
+        });
+    }
+    rows
+}
+
+/// The plates' work per plate and unit length over the rows (trapezoids of force × d(−ρ)),
+/// the force–gap loop's area over a cycle back to first contact: FE's and the DAE's.
+fn loop_areas(rows: &[CycleRow], rho0: f64) -> (f64, f64) {
+    let mut last = (rho0, 0.0, 0.0);
+    let mut areas = (0.0, 0.0);
+    for r in rows {
+        areas.0 += 0.5 * (last.1 + r.force) * (last.0 - r.rho);
+        areas.1 += 0.5 * (last.2 + r.dae_force) * (last.0 - r.rho);
+        last = (r.rho, r.force, r.dae_force);
+    }
+    areas
+}
+
+/// A squeeze–hold–release cycle of the paper's tube with the gas closed (ABB 30, two Prony
+/// terms; ϖ = 0.3 held 20 τ₂, then plates from first contact to ρ = 1 over 3 τ₁, held 3 τ₁,
+/// back over 3 τ₁; 9-node, L/R = 20): the mid-span force against the GPS DAE taken through
+/// the FE's own steps at the FE's pressure and ρ, at 32 and 64 around, and the loop's area.
+///
+/// Measured (this test, 2026-12-08, 8 steps per leg): the largest |F − F_DAE| over the peak
+/// force is 4.95e-3 at 32 around and 1.20e-3 at 64 (order 2.0), |λs/λs_DAE − 1| 1.77e-4 and
+/// 4.76e-5, oscillating as the contact edge crosses the elements; 16 steps per leg and
+/// L/R = 40 gave 5.5e-3 and 1.4e-3 to 1.5e-3 (the ignored `measure_cycle`), so the error is
+/// neither the time steps' (the DAE takes the FE's) nor the ends'. It is the untracked contact
+/// edge's: the 1e-4 at 64 around needs the edge tracked, which a viscoelastic model
+/// does not yet allow (its histories live on the reference mesh). The loop's area agrees to
+/// 3.8e-3 and 6.8e-3: it is about 4 % of the squeeze's work, so the legs' edge errors reach it
+/// amplified about 25 times and do not cancel monotonically. Bounds: twice the measured
+/// errors, and the force and λs errors at least halve from 32 to 64 around.
+#[test]
+fn a_squeeze_hold_release_cycle_follows_the_gps_dae_at_the_fes_pressure() {
+    let mut worst = Vec::new();
+    for around in [32, 64] {
+        let rows = cycle(around, 20.0, 0.3, 1.0, 3.0, 8);
+        let peak = rows.iter().fold(0.0_f64, |m, r| m.max(r.force));
+        let (mut force, mut ls) = (0.0_f64, 0.0_f64);
+        for r in &rows {
+            force = force.max((r.force - r.dae_force).abs() / peak);
+            ls = ls.max((r.lambda_s / r.dae_lambda_s - 1.0).abs());
+        }
+        let rho0 = rows.last().unwrap().rho;
+        let (fe, dae) = loop_areas(&rows, rho0);
+        eprintln!(
+            "{around} around: |ΔF|/F_max {force:.2e}, |λs/λs_DAE − 1| {ls:.2e}; loop area FE {fe:.4e} DAE {dae:.4e} ({:+.2e}); ϖ {:.6} to {:.6}",
+            fe / dae - 1.0,
+            rows[0].w,
+            rows.iter().fold(0.0_f64, |m, r| m.max(r.w))
+        );
+        // the law dissipates: the plates do positive work over the cycle
+        assert!(dae > 0.0 && fe > 0.0, "loop areas {fe} {dae}");
+        worst.push((force, ls, (fe / dae - 1.0).abs()));
+    }
+    let [(f32_, l32, a32), (f64_, l64, a64)] = [worst[0], worst[1]];
+    assert!(f32_ < 1e-2 && l32 < 3.6e-4, "32 around: {f32_:e} {l32:e}");
+    assert!(f64_ < 2.4e-3 && l64 < 9.6e-5, "64 around: {f64_:e} {l64:e}");
+    assert!(
+        f64_ < 0.5 * f32_ && l64 < 0.5 * l32,
+        "refinement: {worst:?}"
+    );
+    assert!(a32 < 7.6e-3 && a64 < 1.4e-2, "loop areas: {a32:e} {a64:e}");
+}
+
+/// The refinement and length study behind the bounds above (16 steps per leg; L/R = 20 and
+/// 40; about 2.5 min): `cargo test --release -p tubemem-fem --test viscoelastic measure_cycle
+/// -- --ignored --nocapture`. It prints; the test above holds the bounds.
+#[test]
+#[ignore]
+fn measure_cycle() {
+    for (around, length) in [(32, 20.0), (64, 20.0), (32, 40.0), (64, 40.0)] {
+        let rows = cycle(around, length, 0.3, 1.0, 3.0, 16);
+        let peak = rows.iter().fold(0.0_f64, |m, r| m.max(r.force));
+        let mut worst = (0.0_f64, 0.0_f64);
+        for r in &rows {
+            let e = (r.force - r.dae_force) / peak;
+            let es = r.lambda_s / r.dae_lambda_s - 1.0;
+            worst = (worst.0.max(e.abs()), worst.1.max(es.abs()));
+            eprintln!(
+                "{around} {length}: t {:.3} rho {:.5} w {:.6} F {:.7} dae {:.7} dF/Fmax {e:+.2e} dls {es:+.2e}",
+                r.time, r.rho, r.w, r.force, r.dae_force
+            );
+        }
+        eprintln!(
+            "{around} around L/R {length}: worst |dF|/Fmax {:e}, |dls| {:e}",
+            worst.0, worst.1
+        );
+    }
+}

@@ -279,6 +279,21 @@ impl Model {
         }
     }
 
+    /// Put back a viscoelastic law's memory taken earlier ([`Model::memory`], cloned): a
+    /// time step that failed after some of its substeps were committed starts again from
+    /// there. It must be this model's (the same Gauss points).
+    pub fn restore_memory(&mut self, memory: crate::memory::Memory) -> Result<(), FemError> {
+        match &self.memory {
+            Some(m) if m.len() == memory.len() => {
+                self.memory = Some(memory);
+                Ok(())
+            }
+            _ => Err(FemError::Setup {
+                reason: "the memory restored is not this model's".into(),
+            }),
+        }
+    }
+
     /// Replace the Gauss points' histories (a checkpoint's; [`crate::memory::Memory::set_histories`]).
     pub fn set_histories(
         &mut self,

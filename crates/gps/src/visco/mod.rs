@@ -21,10 +21,11 @@
 
 pub mod cycle;
 mod step;
+mod stepper;
 
 use crate::{GpsError, Hypothesis};
-use step::{Fix, PlateFix, Section, StepEquations};
-use tubemem_material::viscoelastic::{History, Prony};
+pub use stepper::{StepLoad, Stepper};
+use tubemem_material::viscoelastic::Prony;
 use tubemem_material::{MembraneLaw, Num};
 
 /// How the gas is supplied while the plates move.
@@ -128,24 +129,6 @@ fn controlled(p: &TimePoint, c: Control) -> f64 {
     }
 }
 
-/// M = ϖ × the enclosed volume per unit reference length over πR² of a state: ϖ ρ(2λs − ρ)λz
-/// in contact, ϖ λs² λz free (λz = 1 under PS, as the state has it).
-/// What a segment's steps solve for: the free tube under its control's value, or the tube
-/// between plates at the step's ρ under a pressure or gas fixed at the segment's start.
-enum Drive {
-    Free(fn(f64) -> Fix),
-    Plates(PlateFix),
-}
-
-fn gas_of(p: &TimePoint) -> f64 {
-    if p.chi > 0.0 {
-        let rho = p.rho.unwrap_or(p.lambda_s);
-        p.w * rho * (2.0 * p.lambda_s - rho) * p.lambda_z
-    } else {
-        p.w * p.lambda_s * p.lambda_s * p.lambda_z
-    }
-}
-
 fn check_program(segments: &[Segment]) -> Result<(), GpsError> {
     if segments.is_empty() {
         return Err(crate::invalid(
@@ -219,77 +202,33 @@ pub fn integrate(
             "steps per segment must be 1 to 2^20",
         ));
     }
-    let mut hist = History::unloaded(prony.terms().len());
-    let mut p = UNLOADED;
-    let mut points = vec![p];
+    let mut stepper = Stepper::new(law, prony, hyp);
+    let mut points = vec![stepper.state()];
     for (k, seg) in segments.iter().enumerate() {
+        let p = stepper.state();
         let from = controlled(&p, seg.control);
         let to = seg.target.unwrap_or(from);
-        // the free tube's control, or what fixes the pressure between the plates (set at the
-        // segment's start)
-        let drive = match seg.control {
-            Control::Pressure => Drive::Free(Fix::Pressure),
-            Control::Stretch => Drive::Free(Fix::Stretch),
-            Control::Volume => Drive::Free(Fix::Volume),
-            Control::Plates(Supply::Pressure) => Drive::Plates(PlateFix::Pressure(p.w)),
-            Control::Plates(Supply::Gas) => Drive::Plates(PlateFix::Gas(gas_of(&p))),
-        };
+        // the gas closed at the segment's start, and the pressure held there
+        let (m, held) = (stepper.gas(), p.w);
         let (n, dt) = if seg.duration == 0.0 {
             (1, 0.0)
         } else {
             (steps, seg.duration / steps as f64)
         };
-        let step = prony.step(dt);
-        let t0 = p.time;
         for i in 1..=n {
             let value = from + (to - from) * i as f64 / n as f64;
-            let time = t0 + dt * i as f64;
-            let at = format!("segment {}, t = {}", k + 1, Num(time));
-            let eqs = StepEquations {
-                law,
-                hyp,
-                alpha: step.alpha,
-                b: hist.offset(&step),
+            let load = match seg.control {
+                Control::Pressure => StepLoad::Pressure(value),
+                Control::Stretch => StepLoad::Stretch(value),
+                Control::Volume => StepLoad::Volume(value),
+                Control::Plates(Supply::Pressure) => StepLoad::PlatesAtPressure {
+                    rho: value,
+                    w: held,
+                },
+                Control::Plates(Supply::Gas) => StepLoad::PlatesWithGas { rho: value, m },
             };
-            let guess = [p.lambda_s, p.lambda_z];
-            let (s, rho) = match drive {
-                Drive::Free(fix) => (eqs.solve(Section::Free(fix(value)), guess, &at)?, None),
-                Drive::Plates(fix) => {
-                    // in contact if the free tube would be wider than the gap
-                    let free = match fix {
-                        PlateFix::Pressure(w) => Fix::Pressure(w),
-                        PlateFix::Gas(m) => Fix::Gas(m),
-                    };
-                    match eqs.solve(Section::Free(free), guess, &at) {
-                        Ok(f) if f.ls <= value => (f, Some(value)),
-                        _ => (
-                            eqs.solve(Section::Plates(value, fix), guess, &at)?,
-                            Some(value),
-                        ),
-                    }
-                }
-            };
-            let r = law
-                .principal(s.ls, s.lz)
-                .map_err(|source| GpsError::Material {
-                    stage: "viscoelastic section in time",
-                    at: at.clone(),
-                    source,
-                })?;
-            hist = hist.advanced(&step, [r.grad[0] / s.ls, r.grad[1] / s.lz, 0.0]);
-            let chi = rho.map_or(0.0, |rho| (s.ls - rho).max(0.0));
-            p = TimePoint {
-                time,
-                w: s.w,
-                lambda_s: s.ls,
-                lambda_z: s.lz,
-                n_s: s.ns,
-                n_z: s.nz,
-                rho,
-                chi,
-                force: s.w * chi,
-            };
-            points.push(p);
+            let point = stepper.advance_in(dt, load, &format!("segment {}, ", k + 1))?;
+            points.push(point);
         }
     }
     Ok(points)
