@@ -211,3 +211,167 @@ fn base_stresses<const N: usize>(
         .collect::<Result<Vec<_>, _>>()?;
     Ok(per_element.into_iter().flatten().collect())
 }
+
+/// (cos φ, sin φ) of the reference hoop direction t = (−Y, X, 0)/|·| in a Gauss point's frame
+/// (e1, e2): t = cos φ e1 + sin φ e2 (on a surface of revolution t is tangent). At the axis
+/// (a cap's pole), where t is undefined, e1.
+fn hoop_in_frame(frame: &[Vec3; 2], x_ref: &Vec3) -> (f64, f64) {
+    let t = Vec3::new(-x_ref[1], x_ref[0], 0.0);
+    if t.norm_squared() < 1e-20 {
+        return (1.0, 0.0);
+    }
+    let (c, s) = (t.dot(&frame[0]), t.dot(&frame[1]));
+    let n = c.hypot(s);
+    (c / n, s / n)
+}
+
+/// Voigt (11, 22, 12) components in the frame (e1, e2) to the (hoop, meridian) basis
+/// t = c e1 + s e2, m = −s e1 + c e2, and back.
+fn to_hoop([a, b, d]: [f64; 3], (c, s): (f64, f64)) -> [f64; 3] {
+    [
+        c * c * a + s * s * b + 2.0 * c * s * d,
+        s * s * a + c * c * b - 2.0 * c * s * d,
+        c * s * (b - a) + (c * c - s * s) * d,
+    ]
+}
+
+fn from_hoop([tt, mm, tm]: [f64; 3], (c, s): (f64, f64)) -> [f64; 3] {
+    [
+        c * c * tt + s * s * mm - 2.0 * c * s * tm,
+        s * s * tt + c * c * mm + 2.0 * c * s * tm,
+        c * s * (tt - mm) + (c * c - s * s) * tm,
+    ]
+}
+
+/// Every Gauss point's history as (hoop, meridian) components, each tensor of the history
+/// (S⁰, then h₁ …) in turn: `(1 + terms)` tensors per point, element major.
+fn hoop_components<const N: usize>(
+    elements: &[RefElement<N>],
+    nodes: &[[f64; 3]],
+    histories: &[History],
+) -> Vec<Vec<[f64; 3]>> {
+    let mut k = 0;
+    let mut out = Vec::with_capacity(histories.len());
+    for re in elements {
+        let x0: [Vec3; N] = re.gather(nodes);
+        for gp in re.gauss.iter() {
+            let basis = hoop_in_frame(&gp.frame, &gp.position(&x0));
+            let h = &histories[k];
+            out.push(
+                std::iter::once(h.s0)
+                    .chain(h.h.iter().copied())
+                    .map(|v| to_hoop(v, basis))
+                    .collect(),
+            );
+            k += 1;
+        }
+    }
+    out
+}
+
+/// The lumped projection of Gauss-point values to the nodes: node a takes
+/// Σ w_g N_a(g) v_g / Σ w_g N_a(g) over the Gauss points of its elements (a uniform field is
+/// kept exactly).
+fn to_nodes<const N: usize>(
+    elements: &[RefElement<N>],
+    count: usize,
+    values: &[Vec<[f64; 3]>],
+) -> Vec<Vec<[f64; 3]>> {
+    let width = values.first().map_or(0, Vec::len);
+    let mut num = vec![vec![[0.0; 3]; width]; count];
+    let mut den = vec![0.0; count];
+    let mut k = 0;
+    for re in elements {
+        for gp in re.gauss.iter() {
+            for (a, &n) in re.nodes.iter().enumerate() {
+                let c = gp.w * gp.n[a];
+                den[n] += c;
+                for (acc, v) in num[n].iter_mut().zip(&values[k]) {
+                    for i in 0..3 {
+                        acc[i] += c * v[i];
+                    }
+                }
+            }
+            k += 1;
+        }
+    }
+    for (v, d) in num.iter_mut().zip(&den) {
+        if *d != 0.0 {
+            v.iter_mut().flatten().for_each(|x| *x /= d);
+        }
+    }
+    num
+}
+
+/// The nodal values `nodal` at the Gauss points of `elements`, back in each point's frame as
+/// histories.
+fn from_nodes<const N: usize>(
+    elements: &[RefElement<N>],
+    nodes: &[[f64; 3]],
+    nodal: &[Vec<[f64; 3]>],
+) -> Vec<History> {
+    let width = nodal.first().map_or(0, Vec::len);
+    let mut out = Vec::new();
+    for re in elements {
+        let x0: [Vec3; N] = re.gather(nodes);
+        for gp in re.gauss.iter() {
+            let basis = hoop_in_frame(&gp.frame, &gp.position(&x0));
+            let mut v = vec![[0.0; 3]; width];
+            for (a, &n) in re.nodes.iter().enumerate() {
+                for (acc, x) in v.iter_mut().zip(&nodal[n]) {
+                    for i in 0..3 {
+                        acc[i] += gp.n[a] * x[i];
+                    }
+                }
+            }
+            let mut tensors = v.into_iter().map(|t| from_hoop(t, basis));
+            let s0 = tensors.next().unwrap_or([0.0; 3]);
+            out.push(History {
+                s0,
+                h: tensors.collect(),
+            });
+        }
+    }
+    out
+}
+
+impl Memory {
+    /// Carry the histories to the same mesh with its reference nodes moved (`old_nodes` to
+    /// `new_nodes`, `transfer` giving each new node's old neighbours, as the positions are
+    /// carried: [`crate::model::Model::move_reference`]). Each tensor of a history is taken in
+    /// the (hoop, meridian) basis of its point, projected to the nodes (lumped), carried by
+    /// the transfer's weights, interpolated at the new Gauss points and turned into their
+    /// frames. Where the history is the same at every point of a ring in that basis — the
+    /// whole section of a GPS state, free or between frictionless planes, whose points all
+    /// share one stretch history — this is exact to rounding; near the caps it is the
+    /// interpolation's error of a smooth field, far from the mid-span.
+    pub(crate) fn carry(
+        &mut self,
+        old: &Elements,
+        old_nodes: &[[f64; 3]],
+        new: &Elements,
+        new_nodes: &[[f64; 3]],
+        transfer: &tubemem_mesh::hoop::Transfer,
+    ) -> Result<(), FemError> {
+        let count = old_nodes.len();
+        let nodal = crate::with_elements!(old, v => {
+            let values = hoop_components(v, old_nodes, &self.histories);
+            to_nodes(v, count, &values)
+        });
+        let moved: Vec<Vec<[f64; 3]>> = (0..count)
+            .map(|n| {
+                let mut acc = vec![[0.0; 3]; nodal[n].len()];
+                for &(b, c) in transfer.weights(n) {
+                    for (a, x) in acc.iter_mut().zip(&nodal[b]) {
+                        for i in 0..3 {
+                            a[i] += c * x[i];
+                        }
+                    }
+                }
+                acc
+            })
+            .collect();
+        let histories = crate::with_elements!(new, v => from_nodes(v, new_nodes, &moved));
+        self.set_histories(histories)
+    }
+}

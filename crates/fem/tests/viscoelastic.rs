@@ -222,6 +222,9 @@ struct CycleRow {
     dae_force: f64,
     lambda_s: f64,
     dae_lambda_s: f64,
+    /// whether the mesh's node lines were on the step's contact edge (tracked, and the flat
+    /// at least half an element wide)
+    on_edge: bool,
 }
 
 /// The cycle: ϖ jumped to `w`, held 200 (20 τ₂) in `n` steps, then the gas closed in and two
@@ -233,6 +236,50 @@ struct CycleRow {
 /// move with them before each solve (the predictor: a release after a hold otherwise starts
 /// with every contact point separated by more than λ/κ and no plate force at all).
 fn cycle(around: usize, length: f64, w: f64, rho: f64, t: f64, n: usize) -> Vec<CycleRow> {
+    cycle_with(around, length, w, rho, t, n, false)
+}
+
+/// The reference nodes of [`tube`] with the hoop node lines on the plates' contact edges at
+/// the reference angle πχ/(2λs) from the plates' symmetry line (none: uniform).
+fn fitted_nodes(around: usize, length: f64, chi: f64, lambda_s: f64) -> Vec<[f64; 3]> {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let along = (length * around as f64 / 8.0) as usize;
+    let a = PI * chi / (2.0 * lambda_s);
+    let map = (chi > 0.0).then(|| {
+        tubemem_mesh::hoop::HoopMap::fitted(
+            around,
+            &[FRAC_PI_2 - a, FRAC_PI_2 + a, 1.5 * PI - a, 1.5 * PI + a],
+        )
+        .unwrap()
+    });
+    tubemem_mesh::tube::capped_tube_fitted_of(
+        ElementKind::Quad9,
+        1.0,
+        length,
+        around,
+        along,
+        around / 8,
+        Symmetry::Eighth,
+        map.as_ref(),
+    )
+    .unwrap()
+    .nodes
+}
+
+/// [`cycle`], with the contact edge tracked when `track`: before each step the hoop node lines
+/// are put on the edge of the DAE's section at the step's ρ under the last pressure, and
+/// after it on the edge under the converged pressure (solved again if the edge moved by more
+/// than 0.005 of an element, the app's `TRACK_TOLERANCE`); the histories follow the moved
+/// mesh (`Model::move_reference`).
+fn cycle_with(
+    around: usize,
+    length: f64,
+    w: f64,
+    rho: f64,
+    t: f64,
+    n: usize,
+    track: bool,
+) -> Vec<CycleRow> {
     use tubemem_fem::contact::{penalty_for, Contact, ContactPoints, Enforcement};
     use tubemem_fem::model::Loading;
     use tubemem_fem::post::midspan_contact;
@@ -264,9 +311,56 @@ fn cycle(around: usize, length: f64, w: f64, rho: f64, t: f64, n: usize) -> Vec<
     let dt = t / n as f64;
     let mut at = rho0;
     let mut rows = Vec::new();
+    let element = std::f64::consts::PI / around as f64 * 2.0;
+    let mut fitted = 0.0_f64;
     for target in targets {
-        let mut parts = 1;
-        loop {
+        if track {
+            // the edge angle of the DAE's section at (ρ, ϖ), a prediction from the last state
+            let edge = |w: f64| {
+                let d = dae
+                    .clone()
+                    .advance(dt, StepLoad::PlatesAtPressure { rho: target, w })
+                    .unwrap();
+                (
+                    d.chi,
+                    d.lambda_s,
+                    std::f64::consts::PI * d.chi / (2.0 * d.lambda_s),
+                )
+            };
+            let mut refit = |model: &mut Model, state: &mut State, r: f64| -> bool {
+                let (chi, ls, a) = edge(state.p);
+                // a flat narrower than half an element stays on the mesh it is on (fitting it
+                // would squeeze the element at the symmetry line to the flat's width)
+                if a < 0.5 * element || (a - fitted).abs() <= 0.005 * element {
+                    return false;
+                }
+                let nodes = fitted_nodes(around, length, chi, ls);
+                let transfer = tubemem_mesh::hoop::Transfer::between(model.mesh(), &nodes).unwrap();
+                model
+                    .move_reference(nodes, &transfer, Some(&plates(r)), &mut [state])
+                    .unwrap();
+                fitted = a;
+                true
+            };
+            refit(&mut model, &mut state, at);
+            for q in state.x.iter_mut() {
+                if q[1].abs() > at - 1e-6 {
+                    q[1] += (target - at) * q[1].signum();
+                }
+            }
+            model.set_time_step(dt).unwrap();
+            let load = Load::with_contact(Loading::Gas { pv }, plates(target));
+            if let Err(e) = model.solve(&mut state, &load) {
+                panic!("tracked step from ρ = {at} to {target} (edge fitted at {fitted}): {e:?}");
+            }
+            // on the converged pressure's edge
+            while refit(&mut model, &mut state, target) {
+                model.solve(&mut state, &load).unwrap();
+            }
+            model.commit_time_step(&state).unwrap();
+        }
+        let mut parts = if track { 0 } else { 1 };
+        while parts > 0 {
             let (mut trial, memory) = (state.clone(), model.memory().cloned().unwrap());
             let ok = (1..=parts).all(|k| {
                 let r0 = at + (target - at) * (k - 1) as f64 / parts as f64;
@@ -308,6 +402,7 @@ fn cycle(around: usize, length: f64, w: f64, rho: f64, t: f64, n: usize) -> Vec<
             dae_force: d.force,
             lambda_s: m.lambda_s,
             dae_lambda_s: d.lambda_s,
+            on_edge: track && std::f64::consts::PI * d.chi / (2.0 * d.lambda_s) >= 0.5 * element,
         });
     }
     rows
@@ -336,8 +431,8 @@ fn loop_areas(rows: &[CycleRow], rho0: f64) -> (f64, f64) {
 /// 4.76e-5, oscillating as the contact edge crosses the elements; 16 steps per leg and
 /// L/R = 40 gave 5.5e-3 and 1.4e-3 to 1.5e-3 (the ignored `measure_cycle`), so the error is
 /// neither the time steps' (the DAE takes the FE's) nor the ends'. It is the untracked contact
-/// edge's: the issue's 1e-4 at 64 around needs the edge tracked, which a viscoelastic model
-/// does not yet allow (its histories live on the reference mesh). The loop's area agrees to
+/// edge's: with the edge tracked the same cycle meets the issue's 1e-4
+/// ([`with_the_contact_edge_tracked_the_cycle_meets_the_issues_1e_4`]). The loop's area agrees to
 /// 3.8e-3 and 6.8e-3: it is about 4 % of the squeeze's work, so the legs' edge errors reach it
 /// amplified about 25 times and do not cancel monotonically. Bounds: twice the measured
 /// errors, and the force and λs errors at least halve from 32 to 64 around.
@@ -374,14 +469,68 @@ fn a_squeeze_hold_release_cycle_follows_the_gps_dae_at_the_fes_pressure() {
     assert!(a32 < 7.6e-3 && a64 < 1.4e-2, "loop areas: {a32:e} {a64:e}");
 }
 
-/// The refinement and length study behind the bounds above (16 steps per leg; L/R = 20 and
-/// 40; about 2.5 min): `cargo test --release -p tubemem-fem --test viscoelastic measure_cycle
-/// -- --ignored --nocapture`. It prints; the test above holds the bounds.
+/// The cycle of [`a_squeeze_hold_release_cycle_follows_the_gps_dae_at_the_fes_pressure`] at
+/// 64 around with the contact edge tracked (`cycle_with`): the issue's bound, the force
+/// within 1e-4 of the DAE's (over the peak force) at every step whose flat spans at least half
+/// an element, and λs within 1e-5 there. Measured (this test, 2026-12-08): at most 8.4e-6
+/// and 1.6e-6 on those 21 of the 24 plates steps. The last step is back at first contact (no
+/// flat, both forces 0). The other two, the first contact step and
+/// the release's last step in contact, have a flat narrower than half an element, which the
+/// tracker leaves on the mesh it is on (fitting it moves the node line next to the plates'
+/// symmetry line onto the edge and squeezes that element to the flat's width: Newton then
+/// fails from the carried state); they have the untracked error, measured 2.8e-4 and 1.8e-4,
+/// bound 6e-4 (twice the larger). The loop's area (trapezoids over the same steps, FE and
+/// DAE): FE/DAE − 1 = −2.43e-3, bound 5e-3 (twice); the narrow flats' force errors reach it
+/// amplified, the area being about 4 % of the squeeze's work.
+#[test]
+fn with_the_contact_edge_tracked_the_cycle_meets_the_issues_1e_4() {
+    let rows = cycle_with(64, 20.0, 0.3, 1.0, 3.0, 8, true);
+    let peak = rows.iter().fold(0.0_f64, |m, r| m.max(r.force));
+    let (mut on, mut off, mut ls) = (0.0_f64, 0.0_f64, 0.0_f64);
+    for r in &rows {
+        let e = (r.force - r.dae_force).abs() / peak;
+        if r.on_edge {
+            on = on.max(e);
+            ls = ls.max((r.lambda_s / r.dae_lambda_s - 1.0).abs());
+        } else {
+            off = off.max(e);
+        }
+    }
+    let tracked = rows.iter().filter(|r| r.on_edge).count();
+    let (fe, dae) = loop_areas(&rows, rows.last().unwrap().rho);
+    eprintln!(
+        "tracked steps {tracked} of {}: |ΔF|/F_max {on:.2e}, |λs/λs_DAE − 1| {ls:.2e}; narrow flats {off:.2e}; loop area FE {fe:.5e} DAE {dae:.5e} ({:+.2e})",
+        rows.len(),
+        fe / dae - 1.0
+    );
+    // all but the two narrow flats and the last step, back at first contact (no flat, both
+    // forces 0)
+    assert!(
+        tracked >= rows.len() - 3,
+        "{tracked} of {} tracked",
+        rows.len()
+    );
+    assert!(on < 1e-4 && ls < 1e-5, "tracked: {on:e} {ls:e}");
+    assert!(off < 6e-4, "narrow flats: {off:e}");
+    assert!((fe / dae - 1.0).abs() < 5e-3, "loop area {fe} vs {dae}");
+}
+
+/// The refinement and length study behind the bounds above (32 and 64 around, L/R = 20 and
+/// 40; 16 steps per leg, `STEPS=n` to change; untracked, `TRACK=1` to track the contact edge;
+/// about 2.5 min): `cargo test --release -p tubemem-fem --test viscoelastic measure_cycle --
+/// --ignored --nocapture`. It prints; the tests above hold the bounds.
 #[test]
 #[ignore]
 fn measure_cycle() {
     for (around, length) in [(32, 20.0), (64, 20.0), (32, 40.0), (64, 40.0)] {
-        let rows = cycle(around, length, 0.3, 1.0, 3.0, 16);
+        let track = std::env::var("TRACK").is_ok();
+        let steps: usize = std::env::var("STEPS").map_or(16, |s| s.parse().unwrap());
+        let rows = cycle_with(around, length, 0.3, 1.0, 3.0, steps, track);
+        let (fe, dae) = loop_areas(&rows, rows.last().unwrap().rho);
+        eprintln!(
+            "loop area FE {fe:.5e} DAE {dae:.5e} ({:+.2e})",
+            fe / dae - 1.0
+        );
         let peak = rows.iter().fold(0.0_f64, |m, r| m.max(r.force));
         let mut worst = (0.0_f64, 0.0_f64);
         for r in &rows {
@@ -398,4 +547,77 @@ fn measure_cycle() {
             worst.0, worst.1
         );
     }
+}
+
+/// Each Gauss point's (cos φ, sin φ) of the reference hoop direction in its frame, element
+/// major.
+fn hoop_bases(model: &Model) -> Vec<(f64, f64)> {
+    let nodes = &model.mesh().nodes;
+    let mut out = Vec::new();
+    tubemem_fem::with_elements!(model.elements(), els => {
+        for re in els.iter() {
+            let x0 = re.gather(nodes);
+            for gp in re.gauss.iter() {
+                let p = gp.position(&x0);
+                let t = nalgebra::Vector3::new(-p[1], p[0], 0.0).normalize();
+                // t is tangent to the exact surface, nearly to the element's: its direction in
+                // the tangent plane
+                let (c, s) = (t.dot(&gp.frame[0]), t.dot(&gp.frame[1]));
+                out.push((c / c.hypot(s), s / c.hypot(s)));
+            }
+        }
+    });
+    out
+}
+
+/// Moving the reference nodes along their hoops (a contact-edge refit) carries the Gauss
+/// points' histories (`Memory::carry`) exactly where a history is the same at every point in
+/// the (hoop, meridian) basis, as every point of a GPS section's is: a field set so on the
+/// whole tube (S⁰ and two terms, no shear) is found again at every moved point, to 1e-12 of
+/// its largest component (rounding).
+#[test]
+fn histories_carried_to_a_refitted_mesh_keep_a_uniform_section() {
+    use tubemem_material::viscoelastic::History;
+    let mut model = tube(16, 20.0, true);
+    let mut state = model.reference_state();
+    let hoop = [[0.4, 0.2, 0.0], [0.1, 0.05, 0.0], [0.03, 0.01, 0.0]];
+    let frame = |[tt, mm, tm]: [f64; 3], (c, s): (f64, f64)| {
+        [
+            c * c * tt + s * s * mm - 2.0 * c * s * tm,
+            s * s * tt + c * c * mm + 2.0 * c * s * tm,
+            c * s * (tt - mm) + (c * c - s * s) * tm,
+        ]
+    };
+    let set: Vec<History> = hoop_bases(&model)
+        .into_iter()
+        .map(|b| History {
+            s0: frame(hoop[0], b),
+            h: vec![frame(hoop[1], b), frame(hoop[2], b)],
+        })
+        .collect();
+    model.set_histories(set).unwrap();
+    let nodes = fitted_nodes(16, 20.0, 0.2, 1.25);
+    let transfer = tubemem_mesh::hoop::Transfer::between(model.mesh(), &nodes).unwrap();
+    let moved = nodes
+        .iter()
+        .zip(&model.mesh().nodes)
+        .filter(|(a, b)| a != b)
+        .count();
+    model
+        .move_reference(nodes, &transfer, None, &mut [&mut state])
+        .unwrap();
+    let memory = model.memory().unwrap();
+    let mut worst = 0.0_f64;
+    for (h, b) in memory.histories().iter().zip(hoop_bases(&model)) {
+        let want = [frame(hoop[0], b), frame(hoop[1], b), frame(hoop[2], b)];
+        let got = [h.s0, h.h[0], h.h[1]];
+        for (w, g) in want.iter().zip(&got) {
+            for k in 0..3 {
+                worst = worst.max((w[k] - g[k]).abs());
+            }
+        }
+    }
+    eprintln!("{moved} nodes moved; largest change of a carried history {worst:e}");
+    assert!(moved > 0);
+    assert!(worst < 1e-12 * 0.4, "{worst:e}");
 }

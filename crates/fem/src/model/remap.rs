@@ -10,7 +10,8 @@ impl Model {
     /// planes' traction per reference area at each node (the elements' values at a shared node
     /// averaged with their weights ∫N_a dA0, then transferred), with no last gap. The dofs,
     /// the pattern and the symbolic factorization stay (the topology is the same). Gauss-point
-    /// multipliers have no nodal field to transfer: an error.
+    /// multipliers have no nodal field to transfer: an error. A viscoelastic law's Gauss-point
+    /// histories are carried too ([`crate::memory::Memory::carry`]).
     pub fn move_reference(
         &mut self,
         nodes: Vec<[f64; 3]>,
@@ -18,12 +19,6 @@ impl Model {
         contact: Option<&Contact>,
         states: &mut [&mut State],
     ) -> Result<(), FemError> {
-        if self.memory.is_some() {
-            // the Gauss points' histories are tensors in frames of the reference surface
-            return Err(FemError::Remap {
-                reason: "a viscoelastic law's material histories live on the reference mesh, which cannot move".into(),
-            });
-        }
         let points = contact.map(|c| c.points);
         let count = self.mesh.nodes.len();
         if nodes.len() != count {
@@ -152,6 +147,16 @@ impl Model {
                     }
                 }
             }
+        }
+        // a viscoelastic law's histories follow ([`crate::memory::Memory::carry`])
+        if let Some(m) = &mut self.memory {
+            m.carry(
+                &self.elements,
+                &self.mesh.nodes,
+                &new_elements,
+                &mesh.nodes,
+                transfer,
+            )?;
         }
         self.mesh = mesh;
         self.elements = new_elements;

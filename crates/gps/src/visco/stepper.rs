@@ -28,7 +28,8 @@ pub enum StepLoad {
 }
 
 /// The section's state and its material history, advanced step by step from the unloaded
-/// tube.
+/// tube (a clone advances on its own: a prediction).
+#[derive(Clone)]
 pub struct Stepper<'a> {
     law: &'a dyn MembraneLaw,
     prony: &'a Prony,
