@@ -26,7 +26,6 @@
 //! be taken in several load steps of zero length, as an elastic inflation is.
 
 use crate::geometry::{RefElement, Vec3};
-use crate::model::Elements;
 use crate::FemError;
 use rayon::prelude::*;
 use tubemem_material::viscoelastic::{History, Prony, Step};
@@ -50,12 +49,12 @@ pub struct Memory {
 
 impl Memory {
     /// Every Gauss point of `elements` unloaded, and a jump (Δt = 0) as the current step.
-    pub fn new(prony: Prony, elements: &Elements) -> Self {
+    pub fn new<const N: usize>(prony: Prony, elements: &[RefElement<N>]) -> Self {
         let mut first = Vec::with_capacity(elements.len() + 1);
         let mut total = 0;
-        for e in 0..elements.len() {
+        for re in elements {
             first.push(total);
-            total += crate::with_elements!(elements, v => v[e].gauss.len());
+            total += re.gauss.len();
         }
         first.push(total);
         let terms = prony.terms().len();
@@ -165,14 +164,15 @@ impl Memory {
     }
 
     /// The converged end of the current step: every point's history advanced with the base
-    /// law's stress at the positions `x`; the next step is again of the same length.
-    pub fn commit(
+    /// law's stress at the positions `x` (`elements` the model's, whose points these
+    /// histories are); the next step is again of the same length.
+    pub fn commit<const N: usize>(
         &mut self,
         law: &dyn MembraneLaw,
-        elements: &Elements,
+        elements: &[RefElement<N>],
         x: &[[f64; 3]],
     ) -> Result<(), FemError> {
-        let base = crate::with_elements!(elements, v => base_stresses(law, v, x))?;
+        let base = base_stresses(law, elements, x)?;
         let step = &self.step;
         self.histories = self
             .histories
@@ -345,19 +345,17 @@ impl Memory {
     /// whole section of a GPS state, free or between frictionless planes, whose points all
     /// share one stretch history — this is exact to rounding; near the caps it is the
     /// interpolation's error of a smooth field, far from the mid-span.
-    pub(crate) fn carry(
+    pub fn carry<const N: usize>(
         &mut self,
-        old: &Elements,
+        old: &[RefElement<N>],
         old_nodes: &[[f64; 3]],
-        new: &Elements,
+        new: &[RefElement<N>],
         new_nodes: &[[f64; 3]],
         transfer: &tubemem_mesh::hoop::Transfer,
     ) -> Result<(), FemError> {
         let count = old_nodes.len();
-        let nodal = crate::with_elements!(old, v => {
-            let values = hoop_components(v, old_nodes, &self.histories);
-            to_nodes(v, count, &values)
-        });
+        let values = hoop_components(old, old_nodes, &self.histories);
+        let nodal = to_nodes(old, count, &values);
         let moved: Vec<Vec<[f64; 3]>> = (0..count)
             .map(|n| {
                 let mut acc = vec![[0.0; 3]; nodal[n].len()];
@@ -371,7 +369,6 @@ impl Memory {
                 acc
             })
             .collect();
-        let histories = crate::with_elements!(new, v => from_nodes(v, new_nodes, &moved));
-        self.set_histories(histories)
+        self.set_histories(from_nodes(new, new_nodes, &moved))
     }
 }

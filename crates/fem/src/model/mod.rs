@@ -252,7 +252,9 @@ impl Model {
     /// given at construction becomes the base law (its μ the instantaneous modulus), every
     /// Gauss point starts unloaded and the current step is a jump (Δt = 0).
     pub fn set_viscoelastic(&mut self, prony: tubemem_material::viscoelastic::Prony) {
-        self.memory = Some(crate::memory::Memory::new(prony, &self.elements));
+        self.memory = Some(crate::with_elements!(&self.elements, v => {
+            crate::memory::Memory::new(prony, v)
+        }));
     }
 
     /// The Gauss points' histories of a viscoelastic law (`None`: elastic).
@@ -274,7 +276,10 @@ impl Model {
     /// model.
     pub fn commit_time_step(&mut self, state: &State) -> Result<(), FemError> {
         match &mut self.memory {
-            Some(m) => m.commit(self.law.as_ref(), &self.elements, &state.x),
+            Some(m) => {
+                let law = self.law.as_ref();
+                crate::with_elements!(&self.elements, v => m.commit(law, v, &state.x))
+            }
             None => Ok(()),
         }
     }

@@ -150,13 +150,20 @@ impl Model {
         }
         // a viscoelastic law's histories follow ([`crate::memory::Memory::carry`])
         if let Some(m) = &mut self.memory {
-            m.carry(
-                &self.elements,
-                &self.mesh.nodes,
-                &new_elements,
-                &mesh.nodes,
-                transfer,
-            )?;
+            let (old_nodes, new_nodes) = (&self.mesh.nodes, &mesh.nodes);
+            match (&self.elements, &new_elements) {
+                (Elements::Quad4(a), Elements::Quad4(b)) => {
+                    m.carry(a, old_nodes, b, new_nodes, transfer)?
+                }
+                (Elements::Quad9(a), Elements::Quad9(b)) => {
+                    m.carry(a, old_nodes, b, new_nodes, transfer)?
+                }
+                _ => {
+                    return Err(FemError::Remap {
+                        reason: "the moved mesh has another element kind".into(),
+                    })
+                }
+            }
         }
         self.mesh = mesh;
         self.elements = new_elements;
