@@ -121,32 +121,36 @@ fn membrane_tangents_match_finite_differences() {
 #[test]
 fn membrane_tangents_in_a_viscoelastic_step_match_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(13);
-    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
     for _ in 0..20 {
         let x0 = random_quad(&mut rng);
         let re = RefElement::new(0, [0, 1, 2, 3], &x0).unwrap();
         let x = deform(&x0, &mut rng);
-        let offsets: Vec<[f64; 3]> = (0..re.gauss.len())
-            .map(|_| std::array::from_fn(|_| rng.random_range(-0.5..0.5)))
-            .collect();
-        let step = crate::element::Hereditary {
-            alpha: rng.random_range(0.1..1.0),
-            offsets: &offsets,
-        };
-        check_element_fd(&x, 1e-6, "viscoelastic step", |x| {
-            let (mut r, mut k) = (SVector::<f64, 12>::zeros(), SMatrix::zeros());
-            let e = crate::element::membrane_kernel_in_step(
-                &law,
-                Some(step),
-                &re,
-                x,
-                &mut r,
-                Some(&mut k),
-            )
-            .unwrap();
-            (e, r, k)
-        });
+        check_viscoelastic_step::<4, 12>(&re, &x, &mut rng);
     }
+}
+
+/// [`check_element_fd`] on the membrane kernel within a viscoelastic step of random α in
+/// (0.1, 1) and random offsets B in (−0.5, 0.5) per point (ABB 30).
+pub(crate) fn check_viscoelastic_step<const N: usize, const D: usize>(
+    re: &RefElement<N>,
+    x: &[Vec3; N],
+    rng: &mut ChaCha8Rng,
+) {
+    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
+    let offsets: Vec<[f64; 3]> = (0..re.gauss.len())
+        .map(|_| std::array::from_fn(|_| rng.random_range(-0.5..0.5)))
+        .collect();
+    let step = crate::element::Hereditary {
+        alpha: rng.random_range(0.1..1.0),
+        offsets: &offsets,
+    };
+    check_element_fd(x, 1e-6, "viscoelastic step", |x| {
+        let (mut r, mut k) = (SVector::<f64, D>::zeros(), SMatrix::zeros());
+        let e =
+            crate::element::membrane_kernel_in_step(&law, Some(step), re, x, &mut r, Some(&mut k))
+                .unwrap();
+        (e, r, k)
+    });
 }
 
 /// The volume as an "energy" for [`check_element_fd`]: (V, ∂V/∂x, ∂²V/∂x²).

@@ -81,31 +81,11 @@ fn quad9_membrane_tangents_match_finite_differences() {
 #[test]
 fn quad9_membrane_tangents_in_a_viscoelastic_step_match_finite_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(92);
-    let law = AnssariBenamBucchi::new(1.0, 30.0).unwrap();
     for _ in 0..10 {
         let x0 = random_quad9(&mut rng, false);
         let re = RefElement::new(0, nodes9(), &x0).unwrap();
         let x = deform9(&x0, &mut rng);
-        let offsets: Vec<[f64; 3]> = (0..re.gauss.len())
-            .map(|_| std::array::from_fn(|_| rng.random_range(-0.5..0.5)))
-            .collect();
-        let step = crate::element::Hereditary {
-            alpha: rng.random_range(0.1..1.0),
-            offsets: &offsets,
-        };
-        check_element_fd(&x, 1e-6, "viscoelastic step", |x| {
-            let (mut r, mut k) = (SVector::<f64, 27>::zeros(), SMatrix::zeros());
-            let e = crate::element::membrane_kernel_in_step(
-                &law,
-                Some(step),
-                &re,
-                x,
-                &mut r,
-                Some(&mut k),
-            )
-            .unwrap();
-            (e, r, k)
-        });
+        crate::tests::check_viscoelastic_step::<9, 27>(&re, &x, &mut rng);
     }
 }
 
