@@ -98,7 +98,14 @@ pub struct HistoryArgs {
     /// Write every step to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
-    /// Replace an existing --csv file that this command did not write.
+    /// With --plates-to and --release: draw the force–gap loop as STEM.svg and STEM.png.
+    #[arg(long, value_name = "STEM")]
+    plot: Option<PathBuf>,
+    /// With --plot: also draw the same cycle with these plates' travel times (comma
+    /// separated, e.g. 0.3,3,30), one loop per speed.
+    #[arg(long, value_delimiter = ',')]
+    travel_times: Vec<f64>,
+    /// Replace an existing --csv or --plot file that this command did not write.
     #[arg(long)]
     overwrite: bool,
     /// Print one JSON object (the end state, the steps and the error estimate).
@@ -144,6 +151,19 @@ pub fn run(a: HistoryArgs) -> Result<()> {
     if a.plates_to.is_none() && (a.release || a.squeeze_time > 0.0 || a.plates_hold > 0.0) {
         bail!("--squeeze-time, --plates-hold and --release move plates: give --plates-to ρ");
     }
+    if a.plot.is_some() && !(a.plates_to.is_some() && a.release) {
+        bail!("--plot draws the force–gap loop: give --plates-to ρ and --release");
+    }
+    if !a.travel_times.is_empty() && a.plot.is_none() {
+        bail!("--travel-times adds loops to the figure: give --plot STEM");
+    }
+    if let Some(t) = a
+        .travel_times
+        .iter()
+        .find(|t| !(t.is_finite() && **t >= 0.0))
+    {
+        bail!("--travel-times: {t} is not a travel time (finite and ≥ 0)");
+    }
     let hyp = a.hypothesis.into();
     let cycle = Cycle {
         control,
@@ -165,18 +185,26 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         Some(n) => Steps::Fixed(n),
         None => Steps::Tolerance(a.tolerance),
     };
+    let law_file = a
+        .material
+        .law
+        .as_ref()
+        .map(PathBuf::from)
+        .filter(|p| p.is_file());
+    let inputs: Vec<&std::path::Path> = law_file.iter().map(|p| p.as_path()).collect();
     if let Some(csv) = &a.csv {
-        let law_file = a
-            .material
-            .law
-            .as_ref()
-            .map(PathBuf::from)
-            .filter(|p| p.is_file());
-        let inputs: Vec<&std::path::Path> = law_file.iter().map(|p| p.as_path()).collect();
         tubemem_app::output_file::check("--csv", csv, &inputs, |text| {
             a.overwrite || text.starts_with(HISTORY_HEADER)
         })
         .map_err(|e| anyhow::anyhow!(e.chain()))?;
+    }
+    if let Some(stem) = &a.plot {
+        crate::fit_print::check_plot(
+            stem,
+            &inputs,
+            tubemem_app::figures::LOOPS_TITLE,
+            a.overwrite,
+        )?;
     }
     let result = run_cycle(law.as_ref(), &prony, hyp, &cycle, steps)
     .map_err(|e| {
@@ -200,6 +228,9 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             None => e,
         }
     })?;
+    if let Some(stem) = &a.plot {
+        plot_loops(&a, law.as_ref(), &prony, &cycle, steps, &result, stem)?;
+    }
     let h = &result.history;
     let last = h.end();
     if let Some(csv) = &a.csv {
@@ -320,6 +351,55 @@ pub fn run(a: HistoryArgs) -> Result<()> {
                 "  pressure {:.6e} Pa",
                 units.from_core(Dimension::Pressure, last.w)
             )?;
+        }
+    }
+    Ok(())
+}
+
+/// `--plot`: the run's loop and one per `--travel-times` (the same cycle, other travel times).
+fn plot_loops(
+    a: &HistoryArgs,
+    law: &dyn tubemem_material::MembraneLaw,
+    prony: &Prony,
+    cycle: &Cycle,
+    steps: Steps,
+    result: &tubemem_gps::visco::cycle::CycleResult,
+    stem: &std::path::Path,
+) -> Result<()> {
+    let mut results = vec![(cycle.plates.map_or(0.0, |p| p.travel), result.clone())];
+    for &t in &a.travel_times {
+        let mut c = *cycle;
+        if let Some(p) = &mut c.plates {
+            p.travel = t;
+        }
+        let r = run_cycle(law, prony, a.hypothesis.into(), &c, steps)
+            .with_context(|| format!("the cycle with the plates' travel time {t}"))?;
+        results.push((t, r));
+    }
+    results.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let loops: Vec<_> = results
+        .iter()
+        .map(|(t, r)| tubemem_app::figures::Loop {
+            travel: *t,
+            touch: r.touch.unwrap_or(f64::NAN),
+            points: &r.history.points,
+        })
+        .collect();
+    let terms: Vec<String> = prony
+        .terms()
+        .iter()
+        .map(|p| format!("{}:{}", p.g, p.tau))
+        .collect();
+    let fig = tubemem_app::figures::loops_figure(
+        &format!("{} ({})", law.name(), a.hypothesis_label()),
+        &terms.join(","),
+        &loops,
+    );
+    let files = tubemem_app::figures::save(&fig, stem, &Default::default())
+        .map_err(|e| anyhow::anyhow!(tubemem_app::error_chain(&e)))?;
+    if !a.json {
+        for f in files {
+            crate::say!("wrote {}", f.display())?;
         }
     }
     Ok(())

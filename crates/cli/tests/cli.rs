@@ -2884,6 +2884,93 @@ fn a_viscoelastic_history_and_its_si_twin_agree_and_bad_input_is_named() {
     );
 }
 
+/// Issue #63: `gps history --plot` draws the force–gap loop of the run and one per
+/// `--travel-times`, sorted by speed (the tube relaxed 20 τ₂ at λs = 1.3 first: squeezed
+/// right after a jump it creeps outward during the cycle and ends wider than where the plates
+/// touched, with a negative "loop"); misuse is refused before anything runs, and a file at the
+/// figure's path that tubemem did not write is kept.
+#[test]
+fn a_viscoelastic_cycle_draws_its_force_gap_loops() {
+    let d = tmp("visco-loops");
+    let stem = d.join("loops");
+    let base = [
+        "gps",
+        "history",
+        "--material",
+        "abb",
+        "--kuhn",
+        "30",
+        "--prony",
+        "0.3:1,0.2:10",
+        "--control",
+        "stretch",
+        "--to",
+        "1.3",
+        "--hold",
+        "200",
+        "--plates-to",
+        "0.9",
+        "--squeeze-time",
+        "1",
+        "--steps",
+        "64",
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter()
+            .chain(extra)
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>()
+    };
+    let args = with(&[
+        "--release",
+        "--plot",
+        stem.to_str().unwrap(),
+        "--travel-times",
+        "3,0.3",
+        "--json",
+    ]);
+    let v = json(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(num(&v, "loop_area") > 0.0, "{v}");
+    let svg = std::fs::read_to_string(d.join("loops.svg")).unwrap();
+    assert!(d.join("loops.png").is_file());
+    assert!(svg.contains("Force–gap loops of a viscoelastic tube"));
+    // the legend's travel times, in order
+    let times: Vec<&str> = svg
+        .match_indices("travel time T = ")
+        .map(|(i, m)| {
+            let rest = &svg[i + m.len()..];
+            &rest[..rest
+                .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+                .unwrap_or(rest.len())]
+        })
+        .collect();
+    assert_eq!(times, ["0.3", "1", "3"], "one loop per speed, sorted");
+    // again: its own figure is replaced
+    json(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    // a file it did not write is kept
+    let foreign = d.join("mine");
+    std::fs::write(foreign.with_extension("svg"), "my drawing").unwrap();
+    let args = with(&["--release", "--plot", foreign.to_str().unwrap()]);
+    assert_clean_failure(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        "--plot",
+    );
+    assert_eq!(
+        std::fs::read_to_string(foreign.with_extension("svg")).unwrap(),
+        "my drawing"
+    );
+    let args = with(&["--plot", stem.to_str().unwrap()]);
+    assert_clean_failure(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        "give --plates-to ρ and --release",
+    );
+    let args = with(&["--release", "--travel-times", "3"]);
+    assert_clean_failure(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        "--travel-times adds loops to the figure: give --plot STEM",
+    );
+}
+
 /// Issue #63: `tubemem fit --history`. Two histories made from a known QLV law (neo-Hookean,
 /// μ = 50 kPa, g = (0.3, 0.2), τ = (0.7 s, 25 s); a relaxation and a loading–unloading, the
 /// stress in kPa) are fitted back from a start off by factors of 2 to 1e-6 relative (exact

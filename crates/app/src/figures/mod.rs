@@ -23,12 +23,15 @@
 //! | [`overlay`] | the FE points of runs |
 //! | [`paper`] | Figs. 5-7 and λz against λs ([`write_all`]) |
 //! | [`mode`] | a critical mode along the tube |
+//! | [`loops`] | the force–gap loops of a viscoelastic tube at several plate speeds |
 
+pub mod loops;
 pub mod mode;
 pub mod overlay;
 pub mod paper;
 pub mod render;
 
+pub use loops::{loops_figure, Loop, LOOPS_TITLE};
 pub use mode::mode_figure;
 pub use overlay::{law_label, same_law, Overlay, SqueezePoint, PAPER_LAW};
 pub use paper::write_all;
