@@ -165,3 +165,95 @@ pub(crate) fn model_of(
     model.set_iteration_log(case.output.iterations);
     Ok(model)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tubemem_fem::linsolve::{Layout, SparseLdlt, SPLIT_MIN_UNKNOWNS};
+    use tubemem_fem::ordering::Ordering;
+
+    /// Our own numeric layer (the tree split's halves, each a multifrontal LDLᵀ over faer's
+    /// symbolic analysis and dense kernels) against faer's own factorization of the whole, on
+    /// the pattern of every shipped case (cases/*.toml, edge fits left out: a fit moves nodes,
+    /// not the pattern). The values: a regular matrix of known inertia on the pattern — ±2 on
+    /// the diagonal (every 7th negative), off-diagonal entries of at most 0.01 in magnitude
+    /// (at most 74 a row on the 9-node tube: Gershgorin puts every eigenvalue within 0.74 of
+    /// ±2, so the condition number is below 2.2 and the negative count is the negative
+    /// diagonals'). Both factors must find that count, and their solutions of one right-hand
+    /// side must agree, and satisfy the matrix, to 1e-12 (a condition of 2.2 times round-off,
+    /// with three orders of margin).
+    #[test]
+    fn the_tree_split_agrees_with_faers_factor_on_every_shipped_pattern() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases");
+        let mut paths: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        paths.sort();
+        assert!(paths.len() >= 19, "{} shipped cases", paths.len());
+        for path in &paths {
+            let name = path.file_name().unwrap().to_string_lossy();
+            let mut case = Case::parse(&std::fs::read_to_string(path).unwrap()).unwrap();
+            case.mesh.fit_contact_edge = false;
+            let (mesh, _) = mesh_of(&case, &mut |_| {
+                unreachable!("no locating run without a fit")
+            })
+            .unwrap();
+            let model = model_of(&case, mesh, None).unwrap();
+            let pairs = model.pattern_pairs();
+            let n = model.dofs().len();
+            let d = |i: usize| if i % 7 == 3 { -2.0 } else { 2.0 };
+            let mut seen = std::collections::HashSet::new();
+            let values: Vec<f64> = pairs
+                .iter()
+                .map(|&(r, c)| match (seen.insert((r, c)), r == c) {
+                    (false, _) => 0.0,
+                    (true, true) => d(r),
+                    (true, false) => 0.01 * (((r * 31 + c * 17) % 11) as f64 / 5.0 - 1.0),
+                })
+                .collect();
+            let negative = (0..n).filter(|&i| d(i) < 0.0).count();
+            let mut whole =
+                SparseLdlt::with_options(n, &pairs, Layout::Auto, Ordering::NestedDissection)
+                    .unwrap();
+            if n < SPLIT_MIN_UNKNOWNS {
+                assert_eq!(whole.split_separator(), None, "{name}: faer's whole factor");
+            }
+            let mut split = SparseLdlt::split_of(n, &pairs)
+                .unwrap()
+                .unwrap_or_else(|| panic!("{name}: METIS found no split"));
+            assert_eq!(whole.factorize(&values).unwrap(), negative, "{name}");
+            assert_eq!(split.factorize(&values).unwrap(), negative, "{name}");
+            let b: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+            let (mut x, mut y) = (b.clone(), b.clone());
+            whole.solve(&mut x);
+            split.solve(&mut y);
+            let mut ax = vec![0.0; n];
+            for (&(r, c), v) in pairs.iter().zip(&values) {
+                ax[r] += v * y[c];
+                if r != c {
+                    ax[c] += v * y[r];
+                }
+            }
+            let apart = x
+                .iter()
+                .zip(&y)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            let residual = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            eprintln!(
+                "{name}: {n} unknowns, separator {}; split − whole {apart:.1e}, residual {residual:.1e}",
+                split.split_separator().unwrap_or(0)
+            );
+            assert!(
+                apart < 1e-12 && residual < 1e-12,
+                "{name}: {apart:e} {residual:e}"
+            );
+        }
+    }
+}

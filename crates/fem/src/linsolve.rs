@@ -288,6 +288,22 @@ impl SparseLdlt {
         })
     }
 
+    /// The tree split of the pattern `pairs` on `n` unknowns whatever its size (runs use it from
+    /// [`SPLIT_MIN_UNKNOWNS`] up): the halves' multifrontal LDLᵀ, our own numeric layer, on any
+    /// pattern, to check it against faer's own factorization of the whole
+    /// ([`SparseLdlt::with_options`] with nested dissection) on small patterns too. `None`
+    /// where METIS leaves a half empty.
+    pub fn split_of(n: usize, pairs: &[(usize, usize)]) -> Result<Option<Self>, FemError> {
+        Ok(TreeSplit::new(n, pairs)?.map(|t| Self {
+            n,
+            entries: pairs.len(),
+            factor: Factor::Split(Box::new(t)),
+            factorized: false,
+            par: Par::Seq,
+            ordering: Ordering::NestedDissection,
+        }))
+    }
+
     /// The threads of the numeric factorization of a whole factor, inside its supernodes: 1
     /// sequential (the default), n on n threads of the current rayon pool (0: all of them).
     /// faer parallelizes inside each supernode's dense kernels (the supernodes are eliminated in

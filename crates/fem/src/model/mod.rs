@@ -170,6 +170,17 @@ impl Model {
         Ok(())
     }
 
+    /// The (row, col) of every value the assembly gives the factorization, row ≥ col, in the
+    /// order the values come (duplicates included): the pattern's pairs, built again (runs do
+    /// not keep them: 16 bytes a value).
+    pub fn pattern_pairs(&self) -> Vec<(usize, usize)> {
+        Pattern::new(
+            &self.dofs,
+            (0..self.elements.len()).map(|e| self.elements.nodes(e)),
+        )
+        .1
+    }
+
     /// The fill-reducing ordering asked for ([`Model::with_ordering`]).
     pub fn ordering(&self) -> crate::ordering::Ordering {
         self.ordering
