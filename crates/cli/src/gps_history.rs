@@ -143,83 +143,118 @@ pub fn run(a: HistoryArgs) -> Result<()> {
     let law = a.material.build()?;
     let units = a.units.units(law.as_ref())?;
     let prony = parse_prony(&a.prony)?;
-    let control: Control = a.control.into();
-    let to = match control {
-        Control::Pressure => units.to_core(Dimension::Pressure, a.to),
-        _ => a.to,
-    };
-    if a.plates_to.is_none() && (a.release || a.squeeze_time > 0.0 || a.plates_hold > 0.0) {
-        bail!("--squeeze-time, --plates-hold and --release move plates: give --plates-to ρ");
-    }
-    if a.plot.is_some() && !(a.plates_to.is_some() && a.release) {
-        bail!("--plot draws the force–gap loop: give --plates-to ρ and --release");
-    }
-    if !a.travel_times.is_empty() && a.plot.is_none() {
-        bail!("--travel-times adds loops to the figure: give --plot STEM");
-    }
-    if let Some(t) = a
-        .travel_times
-        .iter()
-        .find(|t| !(t.is_finite() && **t >= 0.0))
-    {
-        bail!("--travel-times: {t} is not a travel time (finite and ≥ 0)");
-    }
-    let hyp = a.hypothesis.into();
-    let cycle = Cycle {
-        control,
-        to,
-        ramp: a.ramp,
-        hold: a.hold,
-        plates: a.plates_to.map(|rho| PlatesLeg {
-            supply: match a.supply {
-                PlateSupply::Gas => Supply::Gas,
-                PlateSupply::Pressure => Supply::Pressure,
-            },
-            to: rho,
-            travel: a.squeeze_time,
-            hold: a.plates_hold,
-            release: a.release,
-        }),
-    };
+    let cycle = a.cycle(&units)?;
     let steps = match a.steps {
         Some(n) => Steps::Fixed(n),
         None => Steps::Tolerance(a.tolerance),
     };
-    let law_file = a
-        .material
-        .law
-        .as_ref()
-        .map(PathBuf::from)
-        .filter(|p| p.is_file());
-    let inputs: Vec<&std::path::Path> = law_file.iter().map(|p| p.as_path()).collect();
-    if let Some(csv) = &a.csv {
-        tubemem_app::output_file::check("--csv", csv, &inputs, |text| {
-            a.overwrite || text.starts_with(HISTORY_HEADER)
-        })
-        .map_err(|e| anyhow::anyhow!(e.chain()))?;
-    }
+    a.check_outputs()?;
+    let result = run_cycle(law.as_ref(), &prony, a.hypothesis.into(), &cycle, steps)
+        .map_err(|e| a.explain(e, law.as_ref(), &prony, cycle.to))?;
     if let Some(stem) = &a.plot {
-        crate::fit_print::check_plot(
-            stem,
-            &inputs,
-            tubemem_app::figures::LOOPS_TITLE,
-            a.overwrite,
-        )?;
+        plot_loops(&a, law.as_ref(), &prony, &cycle, steps, &result, stem)?;
     }
-    let result = run_cycle(law.as_ref(), &prony, hyp, &cycle, steps)
-    .map_err(|e| {
+    if let Some(csv) = &a.csv {
+        write_csv(csv, &result.history, &units)?;
+    }
+    let v = end_json(&result, &units, &prony)?;
+    if a.json {
+        crate::say!("{v}")?;
+        return Ok(());
+    }
+    print_text(&a, &result, &units, &prony)
+}
+
+impl HistoryArgs {
+    /// The load program the arguments give (the target in the core's units), refused where
+    /// plates' options come without plates or a figure without its cycle.
+    fn cycle(&self, units: &tubemem_app::units::Units) -> Result<Cycle> {
+        let control: Control = self.control.into();
+        let to = match control {
+            Control::Pressure => units.to_core(Dimension::Pressure, self.to),
+            _ => self.to,
+        };
+        if self.plates_to.is_none()
+            && (self.release || self.squeeze_time > 0.0 || self.plates_hold > 0.0)
+        {
+            bail!("--squeeze-time, --plates-hold and --release move plates: give --plates-to ρ");
+        }
+        if self.plot.is_some() && !(self.plates_to.is_some() && self.release) {
+            bail!("--plot draws the force–gap loop: give --plates-to ρ and --release");
+        }
+        if !self.travel_times.is_empty() && self.plot.is_none() {
+            bail!("--travel-times adds loops to the figure: give --plot STEM");
+        }
+        if let Some(t) = self
+            .travel_times
+            .iter()
+            .find(|t| !(t.is_finite() && **t >= 0.0))
+        {
+            bail!("--travel-times: {t} is not a travel time (finite and ≥ 0)");
+        }
+        Ok(Cycle {
+            control,
+            to,
+            ramp: self.ramp,
+            hold: self.hold,
+            plates: self.plates_to.map(|rho| PlatesLeg {
+                supply: match self.supply {
+                    PlateSupply::Gas => Supply::Gas,
+                    PlateSupply::Pressure => Supply::Pressure,
+                },
+                to: rho,
+                travel: self.squeeze_time,
+                hold: self.plates_hold,
+                release: self.release,
+            }),
+        })
+    }
+
+    /// The --csv and --plot files may be written (before anything is computed).
+    fn check_outputs(&self) -> Result<()> {
+        let law_file = self
+            .material
+            .law
+            .as_ref()
+            .map(PathBuf::from)
+            .filter(|p| p.is_file());
+        let inputs: Vec<&std::path::Path> = law_file.iter().map(|p| p.as_path()).collect();
+        if let Some(csv) = &self.csv {
+            tubemem_app::output_file::check("--csv", csv, &inputs, |text| {
+                self.overwrite || text.starts_with(HISTORY_HEADER)
+            })
+            .map_err(|e| anyhow::anyhow!(e.chain()))?;
+        }
+        if let Some(stem) = &self.plot {
+            crate::fit_print::check_plot(
+                stem,
+                &inputs,
+                tubemem_app::figures::LOOPS_TITLE,
+                self.overwrite,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The cycle's failure, with the likely cause under a pressure: the long-term pressure
+    /// maximum (the base law's scaled by g∞) below the target `to`.
+    fn explain(
+        &self,
+        e: tubemem_gps::GpsError,
+        law: &dyn tubemem_material::MembraneLaw,
+        prony: &Prony,
+        to: f64,
+    ) -> anyhow::Error {
         let e = anyhow::anyhow!(e).context("the viscoelastic inflation");
-        // under a pressure the likely cause is the pressure maximum: name it and its
-        // long-term value (the base law's scaled by g∞)
-        let max = (matches!(control, Control::Pressure))
-            .then(|| tubemem_gps::limits::limit_points(law.as_ref(), a.hypothesis.into()).ok())
+        let max = (matches!(self.control, HistoryControl::Pressure))
+            .then(|| tubemem_gps::limits::limit_points(law, self.hypothesis.into()).ok())
             .flatten()
             .and_then(|l| l.max)
             .filter(|m| to > m.w * prony.g_infinity());
         match max {
             Some(m) => e.context(format!(
                 "the target ϖ = {4:.6} is above the long-term pressure maximum ϖ = {2:.6} (g∞ = {3} times the base law's {0} maximum {1:.6}): as the law relaxes the tube passes its pressure maximum and bulges, and no inflated state follows",
-                a.hypothesis_label(),
+                self.hypothesis_label(),
                 m.w,
                 m.w * prony.g_infinity(),
                 prony.g_infinity(),
@@ -227,54 +262,65 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             )),
             None => e,
         }
-    })?;
-    if let Some(stem) = &a.plot {
-        plot_loops(&a, law.as_ref(), &prony, &cycle, steps, &result, stem)?;
     }
-    let h = &result.history;
-    let last = h.end();
-    if let Some(csv) = &a.csv {
-        let si = units.is_si();
-        let header = if si {
-            format!("{HISTORY_HEADER},pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m")
-        } else {
-            HISTORY_HEADER.to_string()
-        };
-        // ρ is empty before the plates come (no NaN in a file a user reads)
-        let mut text = format!("{header}\n");
-        for p in &h.points {
-            let mut r = vec![
-                Some(p.time),
-                Some(p.w),
-                Some(p.lambda_s),
-                Some(p.lambda_z),
-                Some(p.n_s),
-                Some(p.n_z),
-                p.rho,
-                Some(p.chi),
-                Some(p.force),
-            ];
-            if si {
-                r.push(Some(units.from_core(Dimension::Pressure, p.w)));
-                r.push(Some(units.from_core(Dimension::Resultant, p.n_s)));
-                r.push(Some(units.from_core(Dimension::Resultant, p.n_z)));
-                r.push(Some(units.from_core(Dimension::ForcePerLength, p.force)));
-            }
-            if r.iter().flatten().any(|v| !v.is_finite()) {
-                bail!("internal error: a non-finite value was computed at t = {}; please report this input", p.time);
-            }
-            let cells: Vec<String> = r
-                .iter()
-                .map(|v| v.map(|v| v.to_string()).unwrap_or_default())
-                .collect();
-            text.push_str(&cells.join(","));
-            text.push('\n');
+}
+
+/// `--csv`: every state of the history, the SI columns after the dimensionless ones.
+fn write_csv(
+    csv: &std::path::Path,
+    h: &tubemem_gps::visco::TimeHistory,
+    units: &tubemem_app::units::Units,
+) -> Result<()> {
+    let si = units.is_si();
+    let header = if si {
+        format!("{HISTORY_HEADER},pressure_pa,n_s_n_per_m,n_z_n_per_m,force_n_per_m")
+    } else {
+        HISTORY_HEADER.to_string()
+    };
+    // ρ is empty before the plates come (no NaN in a file a user reads)
+    let mut text = format!("{header}\n");
+    for p in &h.points {
+        let mut r = vec![
+            Some(p.time),
+            Some(p.w),
+            Some(p.lambda_s),
+            Some(p.lambda_z),
+            Some(p.n_s),
+            Some(p.n_z),
+            p.rho,
+            Some(p.chi),
+            Some(p.force),
+        ];
+        if si {
+            r.push(Some(units.from_core(Dimension::Pressure, p.w)));
+            r.push(Some(units.from_core(Dimension::Resultant, p.n_s)));
+            r.push(Some(units.from_core(Dimension::Resultant, p.n_z)));
+            r.push(Some(units.from_core(Dimension::ForcePerLength, p.force)));
         }
-        tubemem_app::output_file::write_whole(csv, text.as_bytes())
-            .map_err(|e| anyhow::anyhow!(e.chain()))?;
+        if r.iter().flatten().any(|v| !v.is_finite()) {
+            bail!("internal error: a non-finite value was computed at t = {}; please report this input", p.time);
+        }
+        let cells: Vec<String> = r
+            .iter()
+            .map(|v| v.map(|v| v.to_string()).unwrap_or_default())
+            .collect();
+        text.push_str(&cells.join(","));
+        text.push('\n');
     }
-    let mut v = serde_json::to_value(last)?;
-    add_si(&mut v, &units);
+    tubemem_app::output_file::write_whole(csv, text.as_bytes())
+        .map_err(|e| anyhow::anyhow!(e.chain()))?;
+    Ok(())
+}
+
+/// The end state as JSON, with the SI values, the steps, the estimate, g∞ and the loop's area.
+fn end_json(
+    result: &tubemem_gps::visco::cycle::CycleResult,
+    units: &tubemem_app::units::Units,
+    prony: &Prony,
+) -> Result<serde_json::Value> {
+    let h = &result.history;
+    let mut v = serde_json::to_value(h.end())?;
+    add_si(&mut v, units);
     if let Some(map) = v.as_object_mut() {
         map.insert("steps_per_segment".into(), h.steps_per_segment.into());
         // fixed steps (--steps): no estimate (null, not NaN)
@@ -285,6 +331,8 @@ pub fn run(a: HistoryArgs) -> Result<()> {
         map.insert("g_infinity".into(), prony.g_infinity().into());
         if let Some(area) = result.loop_area {
             map.insert("loop_area".into(), area.into());
+            // back where the plates first touched with no contact: a closed loop
+            map.insert("loop_closed".into(), (h.end().chi == 0.0).into());
             if units.is_si() {
                 map.insert(
                     "loop_area_j_per_m".into(),
@@ -295,63 +343,81 @@ pub fn run(a: HistoryArgs) -> Result<()> {
             }
         }
     }
-    if a.json {
-        crate::say!("{v}")?;
-    } else {
+    Ok(v)
+}
+
+/// The end state in words.
+fn print_text(
+    a: &HistoryArgs,
+    result: &tubemem_gps::visco::cycle::CycleResult,
+    units: &tubemem_app::units::Units,
+    prony: &Prony,
+) -> Result<()> {
+    let h = &result.history;
+    let last = h.end();
+    crate::say!(
+        "{} viscoelastic tube ({} Prony terms, g∞ = {}): at t = {} (the Prony series' time unit) ϖ = {:.9}, λs = {:.9}, λz = {:.9} ({} steps per segment, {}){}",
+        a.hypothesis_label(),
+        prony.terms().len(),
+        prony.g_infinity(),
+        last.time,
+        last.w,
+        last.lambda_s,
+        last.lambda_z,
+        h.steps_per_segment,
+        if h.error_estimate.is_finite() {
+            format!("time-step error ≤ {:.1e}", h.error_estimate)
+        } else {
+            "fixed steps: no error estimate".to_string()
+        },
+        a.csv
+            .as_ref()
+            .map(|c| format!("; wrote {} states to {}", h.points.len(), c.display()))
+            .unwrap_or_default()
+    )?;
+    if let Some(rho) = last.rho {
+        let si = if units.is_si() {
+            format!(
+                " ({:.6e} N/m)",
+                units.from_core(Dimension::ForcePerLength, last.force)
+            )
+        } else {
+            String::new()
+        };
         crate::say!(
-            "{} viscoelastic tube ({} Prony terms, g∞ = {}): at t = {} (the Prony series' time unit) ϖ = {:.9}, λs = {:.9}, λz = {:.9} ({} steps per segment, {}){}",
-            a.hypothesis_label(),
-            prony.terms().len(),
-            prony.g_infinity(),
-            last.time,
-            last.w,
-            last.lambda_s,
-            last.lambda_z,
-            h.steps_per_segment,
-            if h.error_estimate.is_finite() {
-                format!("time-step error ≤ {:.1e}", h.error_estimate)
-            } else {
-                "fixed steps: no error estimate".to_string()
-            },
-            a.csv
-                .as_ref()
-                .map(|c| format!("; wrote {} states to {}", h.points.len(), c.display()))
-                .unwrap_or_default()
+            "  plates at ρ = {rho:.6} R: χ = {:.9}, force ϖχ = {:.9} πμH per unit length{si}",
+            last.chi,
+            last.force
         )?;
-        if let Some(rho) = last.rho {
-            let si = if units.is_si() {
-                format!(
-                    " ({:.6e} N/m)",
-                    units.from_core(Dimension::ForcePerLength, last.force)
-                )
-            } else {
-                String::new()
-            };
-            crate::say!(
-                "  plates at ρ = {rho:.6} R: χ = {:.9}, force ϖχ = {:.9} πμH per unit length{si}",
-                last.chi,
-                last.force
-            )?;
-        }
-        if let Some(area) = result.loop_area {
-            let si = if units.is_si() {
-                format!(
-                    " ({:.6e} J/m)",
-                    units.from_core(Dimension::Force, std::f64::consts::PI * area)
-                )
-            } else {
-                String::new()
-            };
-            crate::say!(
-                "  force–gap loop: the plates did {area:.6e} πμHR{si} of work per plate and unit length over the cycle (dissipated)"
-            )?;
-        }
-        if units.is_si() {
-            crate::say!(
-                "  pressure {:.6e} Pa",
-                units.from_core(Dimension::Pressure, last.w)
-            )?;
-        }
+    }
+    if let Some(area) = result.loop_area {
+        let si = if units.is_si() {
+            format!(
+                " ({:.6e} J/m)",
+                units.from_core(Dimension::Force, std::f64::consts::PI * area)
+            )
+        } else {
+            String::new()
+        };
+        // still pressed at the end: the tube crept wider during the cycle and the path is not
+        // a closed loop, so its work is not the energy dissipated
+        let what = if last.chi > 0.0 {
+            format!(
+                "; the tube is still in contact where the plates first touched (χ = {:.6e}: it crept wider during the cycle), so this is not a closed loop's dissipation",
+                last.chi
+            )
+        } else {
+            " (dissipated)".to_string()
+        };
+        crate::say!(
+            "  force–gap loop: the plates did {area:.6e} πμHR{si} of work per plate and unit length over the cycle{what}"
+        )?;
+    }
+    if units.is_si() {
+        crate::say!(
+            "  pressure {:.6e} Pa",
+            units.from_core(Dimension::Pressure, last.w)
+        )?;
     }
     Ok(())
 }

@@ -2885,10 +2885,10 @@ fn a_viscoelastic_history_and_its_si_twin_agree_and_bad_input_is_named() {
 }
 
 /// Issue #63: `gps history --plot` draws the force–gap loop of the run and one per
-/// `--travel-times`, sorted by speed (the tube relaxed 20 τ₂ at λs = 1.3 first: squeezed
-/// right after a jump it creeps outward during the cycle and ends wider than where the plates
-/// touched, with a negative "loop"); misuse is refused before anything runs, and a file at the
-/// figure's path that tubemem did not write is kept.
+/// `--travel-times`, sorted by speed (the tube relaxed 20 τ₂ at λs = 1.3 first: its loop is
+/// closed, `loop_closed`; squeezed right after the jump it creeps outward during the cycle and
+/// is still pressed where the plates first touched, `loop_closed` false); misuse is refused
+/// before anything runs, and a file at the figure's path that tubemem did not write is kept.
 #[test]
 fn a_viscoelastic_cycle_draws_its_force_gap_loops() {
     let d = tmp("visco-loops");
@@ -2931,6 +2931,16 @@ fn a_viscoelastic_cycle_draws_its_force_gap_loops() {
     ]);
     let v = json(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(num(&v, "loop_area") > 0.0, "{v}");
+    assert_eq!(v["loop_closed"], true, "{v}");
+    // squeezed right after the jump: the tube creeps wider and is still pressed at the end
+    let unrelaxed: Vec<&str> = base
+        .iter()
+        .map(|&a| if a == "200" { "0" } else { a })
+        .chain(["--release", "--json"])
+        .collect();
+    let u = json(&unrelaxed);
+    assert_eq!(u["loop_closed"], false, "{u}");
+    assert!(num(&u, "chi") > 0.0, "{u}");
     let svg = std::fs::read_to_string(d.join("loops.svg")).unwrap();
     assert!(d.join("loops.png").is_file());
     assert!(svg.contains("Force–gap loops of a viscoelastic tube"));

@@ -38,7 +38,10 @@ fn table<'py>(py: Python<'py>, points: &[&TimePoint], plates: bool) -> PyResult<
 /// (`steps`). Returns a dict: `history` (Table: time, w, lambda_s, lambda_z, n_s, n_z of the
 /// free tube), `plates` (Table of the steps with plates, with rho, chi, force; None without
 /// plates), `touch` (where the plates first touched), `loop_area` (the plates' work per plate
-/// and unit length over the cycle, πμHR; None without a release), `error_estimate` (None with
+/// and unit length over the cycle, πμHR; None without a release), `loop_closed` (whether the
+/// release ends with no contact where the plates first touched: only then is the loop's area
+/// the energy dissipated; a tube squeezed before it relaxed creeps wider and is still pressed
+/// there; None without a release), `error_estimate` (None with
 /// fixed steps), `steps_per_segment`, `g_infinity`.
 #[pyfunction]
 #[pyo3(signature = (prony, control, to, ramp=0.0, hold=0.0, material=None, hypothesis="gps", *, plates_to=None, squeeze_time=0.0, plates_hold=0.0, release=false, supply="gas", tolerance=1e-10, steps=None))]
@@ -128,6 +131,7 @@ pub(crate) fn gps_history<'py>(
     )?;
     d.set_item("touch", r.touch)?;
     d.set_item("loop_area", r.loop_area)?;
+    d.set_item("loop_closed", r.loop_area.map(|_| h.end().chi == 0.0))?;
     d.set_item(
         "error_estimate",
         Some(h.error_estimate).filter(|e| e.is_finite()),

@@ -937,10 +937,15 @@ def test_gps_history_matches_the_independent_dae_and_refuses_bad_input():
         assert abs(t[i] - tt) < 1e-12 * tt
         for key, v in [("w", w), ("lambda_s", ls), ("lambda_z", lz), ("force", force)]:
             assert abs(plates[key][i] / v - 1) < 1e-8, (tt, key)
-    assert abs(r["loop_area"] / work - 1) < 1e-6
+    assert abs(r["loop_area"] / work - 1) < 1e-6 and r["loop_closed"] is True
+    # squeezed right after the inflation: the tube creeps wider, still pressed at the end
+    u = tubemem.gps_history(prony, "stretch", 1.3, material=ABB30, plates_to=1.0,
+                            squeeze_time=1.0, release=True, steps=64)
+    assert u["loop_closed"] is False and u["plates"]["chi"][-1] > 0
     # a creep without plates: the plates Table is None, and g_infinity is reported
     c = tubemem.gps_history(prony, "pressure", 0.3, ramp=1.0, hold=20.0, material=ABB30)
-    assert c["plates"] is None and c["loop_area"] is None and c["g_infinity"] == pytest.approx(0.5)
+    assert c["plates"] is None and c["loop_area"] is None and c["loop_closed"] is None
+    assert c["g_infinity"] == pytest.approx(0.5)
     for kwargs, words in [
         (dict(prony=[(0.6, 1.0), (0.5, 2.0)], control="pressure", to=0.3), "g∞"),
         (dict(prony=prony, control="plates", to=0.3), "control"),

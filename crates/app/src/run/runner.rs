@@ -135,7 +135,6 @@ impl<'a> Runner<'a> {
         let (case, model) = (self.case, &self.model);
         let g = &case.geometry;
         RunReport {
-            case: label.to_string(),
             mesh: MeshInfo {
                 nodes: model.mesh().nodes.len(),
                 elements: model.mesh().quads.len(),
@@ -153,18 +152,13 @@ impl<'a> Runner<'a> {
                 contact_edge_fit: fit,
             },
             material: model.law().name(),
-            material_spec: case.material.clone(),
             geometry: GeometryInfo {
                 radius: g.radius,
                 length: g.length,
                 thickness: g.thickness,
                 caps: format!("{:?}", g.caps).to_lowercase(),
             },
-            units: UNITS.into(),
-            case_hash: case.hash().to_string(),
-            scales: case.scales(),
-            stages: vec![],
-            warnings: vec![],
+            ..RunReport::empty(case, label)
         }
     }
 
