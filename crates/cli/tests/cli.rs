@@ -2889,6 +2889,7 @@ fn a_viscoelastic_history_and_its_si_twin_agree_and_bad_input_is_named() {
 /// closed, `loop_closed`; squeezed right after the jump it creeps outward during the cycle and
 /// is still pressed where the plates first touched, `loop_closed` false); misuse is refused
 /// before anything runs, and a file at the figure's path that tubemem did not write is kept.
+/// The SI twin draws the same figure (reduced units) and the same loop.
 #[test]
 fn a_viscoelastic_cycle_draws_its_force_gap_loops() {
     let d = tmp("visco-loops");
@@ -2955,6 +2956,31 @@ fn a_viscoelastic_cycle_draws_its_force_gap_loops() {
         })
         .collect();
     assert_eq!(times, ["0.3", "1", "3"], "one loop per speed, sorted");
+    // its SI twin (R = 5 mm, H = 0.5 mm, μ = 0.1 MPa; a stretch control has no unit) draws the
+    // same figure, in reduced units, and the same loop
+    let si_stem = d.join("loops_si");
+    let si_args = with(&[
+        "--release",
+        "--plot",
+        si_stem.to_str().unwrap(),
+        "--travel-times",
+        "3,0.3",
+        "--radius",
+        "0.005",
+        "--thickness",
+        "0.0005",
+        "--shear-modulus",
+        "1e5",
+        "--json",
+    ]);
+    let w = json(&si_args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(w["loop_closed"], v["loop_closed"]);
+    assert!((num(&w, "loop_area") / num(&v, "loop_area") - 1.0).abs() < 1e-12);
+    assert_eq!(
+        std::fs::read_to_string(d.join("loops_si.svg")).unwrap(),
+        svg,
+        "the SI twin's figure"
+    );
     // again: its own figure is replaced
     json(&args.iter().map(String::as_str).collect::<Vec<_>>());
     // a file it did not write is kept

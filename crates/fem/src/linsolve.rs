@@ -278,14 +278,7 @@ impl SparseLdlt {
                 }
             }
         };
-        Ok(Self {
-            n,
-            entries: pairs.len(),
-            factor,
-            factorized: false,
-            par: Par::Seq,
-            ordering,
-        })
+        Ok(Self::unfactorized(n, pairs.len(), factor, ordering))
     }
 
     /// The tree split of the pattern `pairs` on `n` unknowns whatever its size (runs use it from
@@ -294,14 +287,26 @@ impl SparseLdlt {
     /// ([`SparseLdlt::with_options`] with nested dissection) on small patterns too. `None`
     /// where METIS leaves a half empty.
     pub fn split_of(n: usize, pairs: &[(usize, usize)]) -> Result<Option<Self>, FemError> {
-        Ok(TreeSplit::new(n, pairs)?.map(|t| Self {
+        Ok(TreeSplit::new(n, pairs)?.map(|t| {
+            Self::unfactorized(
+                n,
+                pairs.len(),
+                Factor::Split(Box::new(t)),
+                Ordering::NestedDissection,
+            )
+        }))
+    }
+
+    /// A factor of `n` unknowns and `entries` values, before its first numeric factorization.
+    fn unfactorized(n: usize, entries: usize, factor: Factor, ordering: Ordering) -> Self {
+        Self {
             n,
-            entries: pairs.len(),
-            factor: Factor::Split(Box::new(t)),
+            entries,
+            factor,
             factorized: false,
             par: Par::Seq,
-            ordering: Ordering::NestedDissection,
-        }))
+            ordering,
+        }
     }
 
     /// The threads of the numeric factorization of a whole factor, inside its supernodes: 1

@@ -115,7 +115,7 @@ impl Memory {
             });
         }
         self.histories = histories;
-        self.set_step(self.dt)
+        self.histories_changed()
     }
 
     /// The length of the step being solved.
@@ -139,11 +139,16 @@ impl Memory {
             .par_iter()
             .map(|h| h.offset(step))
             .collect_into_vec(&mut self.offsets);
+        Ok(())
+    }
+
+    /// The histories were replaced: the committed Σᵢ hᵢ and the current step's offsets follow.
+    fn histories_changed(&mut self) -> Result<(), FemError> {
         self.histories
             .par_iter()
             .map(|h| std::array::from_fn(|k| h.h.iter().map(|hi| hi[k]).sum::<f64>()))
             .collect_into_vec(&mut self.held);
-        Ok(())
+        self.set_step(self.dt)
     }
 
     /// The current step at element `e`'s Gauss points.
@@ -180,7 +185,7 @@ impl Memory {
             .zip(base.par_iter())
             .map(|(h, &s0)| h.advanced(step, s0))
             .collect();
-        self.set_step(self.dt)
+        self.histories_changed()
     }
 }
 

@@ -27,6 +27,16 @@ fn abb() -> AnssariBenamBucchi {
 /// The paper's tube (ABB 𝒩 = 30), 9-node elements, `around` around, L/R = `length`, elements
 /// along of the shipped cases' aspect (4 per R at 32 around), an eighth modelled.
 fn tube(around: usize, length: f64, viscoelastic: bool) -> Model {
+    tube_of(around, length, abb(), viscoelastic.then(prony))
+}
+
+/// [`tube`] with the base law `law` and, if given, the relaxation `prony`.
+fn tube_of(
+    around: usize,
+    length: f64,
+    law: impl tubemem_material::MembraneLaw + 'static,
+    prony: Option<Prony>,
+) -> Model {
     let along = (length * around as f64 / 8.0) as usize;
     let mesh = capped_tube_of(
         ElementKind::Quad9,
@@ -37,9 +47,9 @@ fn tube(around: usize, length: f64, viscoelastic: bool) -> Model {
         Symmetry::Eighth,
     )
     .unwrap();
-    let mut model = Model::new(mesh, Box::new(abb())).unwrap();
-    if viscoelastic {
-        model.set_viscoelastic(prony());
+    let mut model = Model::new(mesh, Box::new(law)).unwrap();
+    if let Some(p) = prony {
+        model.set_viscoelastic(p);
     }
     model
 }
@@ -350,18 +360,7 @@ fn program<L: tubemem_material::MembraneLaw + Clone + 'static>(
         track,
     } = tube;
     let mut dae = Stepper::new(law, prony, Hypothesis::Gps);
-    let along = (length * around as f64 / 8.0) as usize;
-    let mesh = capped_tube_of(
-        ElementKind::Quad9,
-        1.0,
-        length,
-        around,
-        along,
-        Symmetry::Eighth,
-    )
-    .unwrap();
-    let mut model = Model::new(mesh, Box::new(law.clone())).unwrap();
-    model.set_viscoelastic(prony.clone());
+    let mut model = tube_of(around, length, law.clone(), Some(prony.clone()));
     let mut state = model.reference_state();
     let mut load = Load::pressure(0.0);
     // (time, ϖ) at the end of each free step
